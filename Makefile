@@ -1,0 +1,29 @@
+# The two set-up commands of the README:
+#   make run    installs what is missing, then runs the default scene (shot C3) into results/C3
+#               (until the solver lands: meshes it, writing mesh.json, mesh.xdmf and mesh.png)
+#   make test   installs what is missing, then runs every test: serially, then the MPI ones on 2 ranks
+PY := .venv/bin/python
+NP ?= 2
+# OpenMPI refuses to start as root unless told; CI and these machines run as root.
+export OMPI_ALLOW_RUN_AS_ROOT := 1
+export OMPI_ALLOW_RUN_AS_ROOT_CONFIRM := 1
+export OMPI_MCA_rmaps_base_oversubscribe := 1
+export OMP_NUM_THREADS := 1
+
+.PHONY: setup run test test-serial test-mpi bench clean
+
+setup:
+	@bash tools/bootstrap.sh
+
+run: setup
+	$(PY) -m fepen mesh scenes/default.toml --out results/C3
+
+test: setup
+	$(PY) -m pytest -q tests
+	mpirun -n $(NP) $(PY) -m pytest -q -m mpi -p no:cacheprovider tests
+
+bench: setup
+	$(PY) benchmarks/mesh_cost.py
+
+clean:
+	rm -rf results meshes/cache .pytest_cache

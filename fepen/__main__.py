@@ -1,0 +1,3 @@
+from fepen.cli import main
+
+raise SystemExit(main())

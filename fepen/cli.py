@@ -1,0 +1,122 @@
+"""The ``fepen`` command (shared/contract.md).
+
+    fepen mesh SCENE.toml [--out DIR] [--set KEY=VALUE ...]
+    fepen keys
+
+Bad input prints one line naming the key and what is allowed and exits with code 2, before anything is
+written; an unstable simulation exits with code 3.
+"""
+
+from __future__ import annotations
+
+import argparse
+import sys
+from pathlib import Path
+
+from fepen.errors import InputError, SimulationError
+
+
+class _Parser(argparse.ArgumentParser):
+    def error(self, message):  # one line, exit 2, as for every other bad input
+        raise InputError("command line", message)
+
+
+def _parser() -> argparse.ArgumentParser:
+    ap = _Parser(prog="fepen", description="Projectile penetrating concrete, projectile-target separation.")
+    sub = ap.add_subparsers(dest="command", required=True, parser_class=_Parser)
+
+    def scene_args(p, out_default):
+        p.add_argument("scene", nargs="?", help="scene file (TOML); absent: the default scene")
+        p.add_argument("--out", default=out_default, help=f"results directory (default {out_default})")
+        p.add_argument("--set", dest="sets", action="append", default=[], metavar="KEY=VALUE",
+                       help="override a dotted scene key; VALUE in TOML syntax, bare words are strings")
+
+    scene_args(sub.add_parser("mesh", help="build the projectile mesh only: mesh.json, mesh.xdmf, mesh.png"),
+               "results/mesh")
+    sub.add_parser("keys", help="list every scene key with its default, unit and allowed values")
+    return ap
+
+
+def _say(*lines: str) -> None:
+    from mpi4py import MPI
+
+    if MPI.COMM_WORLD.rank == 0:
+        print(*lines, sep="\n", flush=True)
+
+
+def cmd_mesh(args) -> int:
+    """Build the mesh of a scene, print and write its figures."""
+    from dolfinx.io import XDMFFile
+    from mpi4py import MPI
+
+    from fepen import figures, mesh, output, scene as fscene, shape
+
+    comm = MPI.COMM_WORLD
+    sc = fscene.load(args.scene, args.sets)
+    shape.shape_from_scene(sc)  # geometry errors before anything is written
+    pm = mesh.create(sc, comm)
+    info = mesh.metrics(pm, sc)
+    out = output.prepare(args.out, comm)
+    info["versions"] = output.versions()
+    output.write_json(out / "mesh.json", info, comm)
+    output.write_text(out / "scene.toml", fscene.to_toml(sc), comm)
+    with XDMFFile(comm, str(out / "mesh.xdmf"), "w") as xdmf:
+        xdmf.write_mesh(pm.mesh)
+        pm.mesh.topology.create_connectivity(2, 3)
+        xdmf.write_meshtags(pm.cell_tags)
+        xdmf.write_meshtags(pm.facet_tags)
+    figures.mesh_picture(pm, out / "mesh.png",
+                         f"{info['cells']} tets, h = {1e3 * sc.mesh.size:g} mm, {1e3 * info['mass_kg']:.2f} g")
+    keys = ("cells", "nodes", "mass_kg", "volume_m3", "min_quality", "shortest_altitude_m", "stable_dt_s")
+    _say(*(f"{k} = {info[k]:.6g}" if isinstance(info[k], float) else f"{k} = {info[k]}" for k in keys),
+         f"altitude_over_size = {info['altitude_over_size']:.4f}",
+         f"written: {out}/mesh.json, mesh.xdmf, mesh.png")
+    return 0
+
+
+def cmd_keys(args) -> int:
+    """Print the scene-key table (Markdown)."""
+    from fepen import scene as fscene
+
+    _say(fscene.describe())
+    return 0
+
+
+COMMANDS = {"mesh": cmd_mesh, "keys": cmd_keys}
+
+
+def main(argv: list[str] | None = None) -> int:
+    """Entry point of the ``fepen`` console script. Returns the exit code."""
+    try:
+        args = _parser().parse_args(argv)
+        _quiet()
+        return COMMANDS[args.command](args)
+    except InputError as err:
+        _error(f"fepen: bad input: {err}")
+        return InputError.exit_code
+    except SimulationError as err:
+        _error(f"fepen: simulation stopped: {err}")
+        return SimulationError.exit_code
+
+
+def _quiet() -> None:
+    import logging
+
+    logging.getLogger("dolfinx").setLevel(logging.WARNING)
+    try:
+        import dolfinx.log
+
+        dolfinx.log.set_log_level(dolfinx.log.LogLevel.WARNING)
+    except Exception:  # pragma: no cover - logging is cosmetic
+        pass
+
+
+def _error(line: str) -> None:
+    from mpi4py import MPI
+
+    if MPI.COMM_WORLD.rank == 0:
+        print(line, file=sys.stderr, flush=True)
+
+
+if __name__ == "__main__":  # pragma: no cover
+    sys.exit(main())

@@ -1,0 +1,22 @@
+"""Exceptions that the command line turns into one readable line and an exit code.
+
+Exit codes (contract): 2 for bad input, 3 for a simulation that became unstable or invalid.
+"""
+
+
+class InputError(ValueError):
+    """Bad input: names the scene key and what is allowed. The command line exits with code 2."""
+
+    exit_code = 2
+
+    def __init__(self, key: str, message: str):
+        self.key = key
+        super().__init__(f"{key}: {message}" if key else message)
+
+
+class SimulationError(RuntimeError):
+    """The simulation became unstable or invalid (NaN, inverted element, collapsed step). Exit code 3.
+
+    The message says where (element, position) and when (step, time)."""
+
+    exit_code = 3

@@ -1,0 +1,404 @@
+"""Scenes: one TOML file in, typed and validated settings with every default filled in.
+
+The key names are the public interface of fepen (shared/contract.md). Every key is declared once in
+``SCHEMA`` below with its type, default, unit and allowed range; nothing else is accepted. Bad input raises
+:class:`fepen.errors.InputError` naming the key and what is allowed, before any solver work starts.
+
+Defaults are the paper's projectile (45 steel, D = 23.6 mm, L = 144 mm, 367 g), its concrete target
+(Table 3) and the striking conditions of Table 1 shot C3. The choices the paper leaves open (nose CRH,
+cavity, tensile strength, ...) are explained in docs/theory.md.
+"""
+
+from __future__ import annotations
+
+import difflib
+import math
+import tomllib
+from dataclasses import dataclass
+from pathlib import Path
+from typing import Any
+
+from fepen.errors import InputError
+from fepen.experiments import SHOTS, shot
+
+_ABSENT = object()  # marks an optional key whose absence means something (e.g. semi-infinite target)
+
+
+@dataclass(frozen=True)
+class Key:
+    """One scene key: its type, default, unit and allowed values."""
+
+    kind: type
+    default: Any
+    unit: str = ""
+    lo: float | None = None
+    hi: float | None = None
+    lo_open: bool = False
+    hi_open: bool = False
+    choices: tuple = ()
+    doc: str = ""
+
+    def allowed(self) -> str:
+        """Human-readable description of the allowed values."""
+        if self.choices:
+            return "one of " + ", ".join(repr(c) for c in self.choices)
+        if self.kind is bool:
+            return "true or false"
+        if self.kind is str:
+            return "a string"
+        lo = "-inf" if self.lo is None else f"{self.lo:g}"
+        hi = "inf" if self.hi is None else f"{self.hi:g}"
+        brackets = ("(" if self.lo_open or self.lo is None else "[") + lo + ", " + hi + (
+            ")" if self.hi_open or self.hi is None else "]")
+        what = "an integer" if self.kind is int else "a number"
+        return f"{what} in {brackets}" + (f" {self.unit}" if self.unit else "")
+
+    def check(self, name: str, value: Any) -> Any:
+        """Return the value converted to the key's type, or raise InputError."""
+        if self.kind is float:
+            if isinstance(value, bool) or not isinstance(value, (int, float)):
+                raise InputError(name, f"got {value!r}, expected {self.allowed()}")
+            value = float(value)
+            if not math.isfinite(value):
+                raise InputError(name, f"got {value!r}, expected {self.allowed()}")
+        elif self.kind is int:
+            if isinstance(value, bool) or not isinstance(value, int):
+                raise InputError(name, f"got {value!r}, expected {self.allowed()}")
+        elif self.kind is bool:
+            if not isinstance(value, bool):
+                raise InputError(name, f"got {value!r}, expected true or false")
+        elif self.kind is str:
+            if not isinstance(value, str):
+                raise InputError(name, f"got {value!r}, expected {self.allowed()}")
+        if self.choices and value not in self.choices:
+            raise InputError(name, f"got {value!r}, expected {self.allowed()}")
+        if self.kind in (int, float):
+            bad_lo = self.lo is not None and (value < self.lo or (self.lo_open and value == self.lo))
+            bad_hi = self.hi is not None and (value > self.hi or (self.hi_open and value == self.hi))
+            if bad_lo or bad_hi:
+                raise InputError(name, f"got {value:g}, expected {self.allowed()}")
+        return value
+
+
+def _num(default, unit, lo=None, hi=None, lo_open=False, hi_open=False, doc=""):
+    return Key(float, default, unit, lo, hi, lo_open, hi_open, doc=doc)
+
+
+def _pos(default, unit, hi=None, doc=""):
+    """A strictly positive number."""
+    return Key(float, default, unit, 0.0, hi, lo_open=True, doc=doc)
+
+
+def _choice(default, *choices, doc=""):
+    return Key(str, default, choices=choices, doc=doc)
+
+
+def _flag(default, doc=""):
+    return Key(bool, default, doc=doc)
+
+
+C3 = shot("C3")
+
+#: Every scene key, dotted name -> Key. Units are SI. ``_ABSENT`` defaults are optional keys whose absence
+#: has a meaning given in their doc.
+SCHEMA: dict[str, Key] = {
+    # --- projectile geometry (docs/theory.md, "The projectile") ---
+    "projectile.nose": _choice("ogive", "ogive", "flat", doc="tangent ogive, or flat (a plain cylinder)"),
+    "projectile.diameter": _pos(0.0236, "m", 1.0),
+    "projectile.length": _pos(0.144, "m", 10.0),
+    "projectile.crh": _num(3.0, "", 0.5, 50.0, doc="ogive radius over diameter (0.5: hemisphere)"),
+    "projectile.mass": _pos(0.367, "kg", 1.0e4,
+                            doc="total mass; the cavity length is sized to reach it on the mesh"),
+    "projectile.cavity_diameter": _num(0.012, "m", 0.0, 1.0, doc="main (rear) cavity diameter; 0: solid"),
+    "projectile.cavity_length": _pos(_ABSENT, "m", 10.0,
+                                     doc="total cavity length; absent: sized from projectile.mass"),
+    "projectile.cavity_step_diameter": _num(0.008, "m", 0.0, 1.0,
+                                            doc="diameter of the narrower forward cavity section (the step)"),
+    "projectile.cavity_step_length": _num(0.020, "m", 0.0, 10.0,
+                                          doc="length of the narrower forward cavity section; 0: no step"),
+    "projectile.base_thickness": _pos(0.015, "m", 10.0, doc="solid rear wall behind the cavity"),
+    # --- projectile material: 45 steel, Johnson-Cook (Table 2) ---
+    "projectile.material.density": _num(7850.0, "kg/m^3", 100.0, 30000.0),
+    "projectile.material.youngs_modulus": _num(210.0e9, "Pa", 1.0e6, 1.0e13),
+    "projectile.material.poisson_ratio": _num(0.3, "", 0.0, 0.5, hi_open=True),
+    "projectile.material.A": _num(950.0e6, "Pa", 0.0, 1.0e11, lo_open=True),
+    "projectile.material.B": _num(725.0e6, "Pa", 0.0, 1.0e11),
+    "projectile.material.n": _num(0.375, "", 0.0, 2.0, lo_open=True),
+    "projectile.material.C": _num(0.015, "", 0.0, 1.0),
+    "projectile.material.m": _num(0.625, "", 0.0, 10.0, lo_open=True),
+    "projectile.material.melt_temperature": _num(1765.0, "K", 0.0, 1.0e4, lo_open=True),
+    "projectile.material.room_temperature": _num(294.0, "K", 0.0, 1.0e4, lo_open=True),
+    "projectile.material.reference_strain_rate": _pos(1.0, "1/s", 1.0e9),
+    "projectile.material.specific_heat": _pos(470.0, "J/(kg K)", 1.0e5),
+    "projectile.material.taylor_quinney": _num(0.9, "", 0.0, 1.0),
+    # --- explosive charge (Table 4) ---
+    "charge.material.density": _num(1850.0, "kg/m^3", 100.0, 30000.0),
+    "charge.material.youngs_modulus": _num(10.1e9, "Pa", 1.0e5, 1.0e13),
+    "charge.material.poisson_ratio": _num(0.3, "", 0.0, 0.5, hi_open=True),
+    "charge.material.yield_stress": _pos(45.0e6, "Pa", 1.0e11),
+    "charge.material.tangent_modulus": _num(600.0e6, "Pa", 0.0, 1.0e12),
+    "charge.friction": _num(0.1, "", 0.0, 2.0),
+    "charge.contact": _choice("frictional", "frictional", "tied", doc="shell-charge interface"),
+    # --- target (Table 3, section 4 of physics.md) ---
+    "target.kind": _choice("concrete", "concrete", "rigid-wall"),
+    "target.compressive_strength": _num(40.0e6, "Pa", 1.0e5, 1.0e10),
+    "target.density": _num(2400.0, "kg/m^3", 100.0, 30000.0),
+    "target.youngs_modulus": _num(32.5e9, "Pa", 1.0e6, 1.0e13),
+    "target.tensile_strength": _pos(_ABSENT, "Pa", 1.0e10, doc="absent: compressive_strength / 10"),
+    "target.pressure_hardening": _num(0.67, "", 0.0, 3.0, hi_open=True, doc="lambda of Mohr-Coulomb"),
+    "target.crater_depth_factor": _num(2.37, "", 0.0, 50.0, doc="crater depth k over diameter"),
+    "target.quasi_static_stress": _pos(_ABSENT, "Pa", 1.0e11,
+                                       doc="overrides the cavity-expansion sigma_s; absent: computed"),
+    "target.inertial_factor": _num(1.0, "", 0.0, 10.0, doc="B of sigma_n = sigma_s + B rho (v.n)^2"),
+    "target.friction": _num(0.1, "", 0.0, 2.0, doc="Coulomb coefficient, used when effects.friction"),
+    "target.separation_angle_deg": _num(0.0, "deg", 0.0, 90.0, hi_open=True),
+    "target.thickness": _pos(_ABSENT, "m", 100.0, doc="absent: semi-infinite"),
+    # --- striking conditions (Table 1; defaults are shot C3) ---
+    "impact.velocity": _num(C3.v0, "m/s", 0.0, 3000.0, lo_open=True),
+    "impact.obliquity_deg": _num(C3.obliquity_deg, "deg", 0.0, 90.0, hi_open=True),
+    "impact.attack_deg": _num(C3.attack_deg, "deg", -90.0, 90.0, lo_open=True, hi_open=True),
+    "impact.shot": Key(str, _ABSENT, choices=tuple(SHOTS), doc="fills the three above from Table 1"),
+    # --- effects: what is off costs nothing ---
+    "effects.fidelity": _choice("plastic", "rigid", "elastic", "plastic"),
+    "effects.crater": _choice("energy", "none", "linear", "energy"),
+    "effects.separation": _flag(True),
+    "effects.free_surface": _flag(True),
+    "effects.friction": _flag(False),
+    "effects.thermal": _flag(True),
+    "effects.strain_rate": _flag(True),
+    "effects.charge": _flag(False),
+    # --- mesh ---
+    "mesh.size": _num(0.0025, "m", 2.0e-4, 0.05, doc="nominal element size"),
+    "mesh.nose_size": _num(_ABSENT, "m", 2.0e-4, 0.05, doc="element size at the nose tip; absent: mesh.size"),
+    "mesh.optimize": _choice("netgen", "none", "gmsh", "netgen",
+                             doc="tetrahedron optimiser; the stable step is set by the worst element"),
+    # --- run control ---
+    "run.end_time": _pos(_ABSENT, "s", 1.0, doc="absent: until stopped, perforated or ricocheted"),
+    "run.output_interval": _pos(5.0e-5, "s", 1.0),
+    "run.safety_factor": _num(0.8, "", 0.0, 1.0, lo_open=True, doc="stable step = factor * h_min / c"),
+    "run.fields": _flag(True, doc="write fields.xdmf"),
+}
+
+SECTIONS = sorted({name.split(".")[0] for name in SCHEMA})
+
+
+class Section:
+    """Read-only attribute access to a part of a resolved scene (``scene.projectile.material.A``)."""
+
+    def __init__(self, values: dict[str, Any]):
+        object.__setattr__(self, "_values", values)
+
+    def __getattr__(self, name: str) -> Any:
+        values = object.__getattribute__(self, "_values")
+        if name not in values:
+            raise AttributeError(name)
+        value = values[name]
+        return Section(value) if isinstance(value, dict) else value
+
+    def __setattr__(self, name, value):
+        raise AttributeError("a resolved scene is read-only")
+
+    def as_dict(self) -> dict[str, Any]:
+        """A deep copy as plain dicts (absent optional keys are left out)."""
+        import copy
+
+        return copy.deepcopy(object.__getattribute__(self, "_values"))
+
+    def get(self, dotted: str) -> Any:
+        """Value of a dotted key, None when an optional key is absent."""
+        node = object.__getattribute__(self, "_values")
+        for part in dotted.split("."):
+            if not isinstance(node, dict) or part not in node:
+                return None
+            node = node[part]
+        return node
+
+
+class Scene(Section):
+    """A resolved scene: every key validated, every default filled in.
+
+    ``scene.explicit`` is the set of dotted keys the user gave (file or --set)."""
+
+    def __init__(self, values: dict[str, Any], explicit: set[str]):
+        super().__init__(values)
+        object.__setattr__(self, "explicit", frozenset(explicit))
+
+
+def _flatten(tree: dict, prefix: str = "") -> dict[str, Any]:
+    flat = {}
+    for k, v in tree.items():
+        name = f"{prefix}{k}"
+        if isinstance(v, dict):
+            if not v:
+                raise InputError(name, "empty table")
+            flat.update(_flatten(v, name + "."))
+        else:
+            flat[name] = v
+    return flat
+
+
+def _unknown(name: str) -> InputError:
+    close = difflib.get_close_matches(name, SCHEMA.keys(), n=1, cutoff=0.5)
+    if not close:  # a key in the wrong table: match on the last part
+        tail = name.split(".")[-1]
+        close = [k for k in SCHEMA if k.split(".")[-1] == tail][:1]
+    hint = f" (did you mean '{close[0]}'?)" if close else f" (sections: {', '.join(SECTIONS)})"
+    return InputError(name, "unknown key" + hint)
+
+
+def parse_set(item: str) -> tuple[str, Any]:
+    """Parse one ``--set KEY=VALUE``: VALUE in TOML syntax, a bare word taken as a string.
+
+    Args:
+        item: the text after --set.
+
+    Returns:
+        (dotted key, value).
+    """
+    if "=" not in item:
+        raise InputError("--set", f"expected KEY=VALUE, got {item!r}")
+    key, text = (s.strip() for s in item.split("=", 1))
+    if not key:
+        raise InputError("--set", f"expected KEY=VALUE, got {item!r}")
+    try:
+        value = tomllib.loads(f"v = {text}")["v"]
+    except tomllib.TOMLDecodeError:
+        value = text
+    return key, value
+
+
+def read_toml(path: str | Path) -> dict[str, Any]:
+    """Read a scene file into a flat {dotted key: value} dict, without validating the keys."""
+    p = Path(path)
+    if not p.is_file():
+        raise InputError("SCENE", f"no such scene file: {p}")
+    try:
+        with open(p, "rb") as fh:
+            tree = tomllib.load(fh)
+    except tomllib.TOMLDecodeError as err:
+        raise InputError("SCENE", f"{p} is not valid TOML: {err}") from None
+    return _flatten(tree)
+
+
+def resolve(given: dict[str, Any]) -> Scene:
+    """Validate user-given keys and fill in every default.
+
+    Args:
+        given: flat {dotted key: value} from the file and --set options, later entries winning.
+
+    Returns:
+        The resolved, read-only Scene.
+    """
+    for name in given:
+        if name not in SCHEMA:
+            raise _unknown(name)
+    flat: dict[str, Any] = {}
+    for name, key in SCHEMA.items():
+        if name in given:
+            flat[name] = key.check(name, given[name])
+        elif key.default is not _ABSENT:
+            flat[name] = key.default
+
+    _resolve_shot(flat, given)
+    _check_consistency(flat, given)
+
+    tree: dict[str, Any] = {}
+    for name, value in flat.items():
+        node = tree
+        parts = name.split(".")
+        for part in parts[:-1]:
+            node = node.setdefault(part, {})
+        node[parts[-1]] = value
+    return Scene(tree, set(given))
+
+
+def _resolve_shot(flat: dict, given: dict) -> None:
+    name = flat.get("impact.shot")
+    if name is None:
+        return
+    s = shot(name)
+    for key, value in (("impact.velocity", s.v0), ("impact.obliquity_deg", s.obliquity_deg),
+                       ("impact.attack_deg", s.attack_deg)):
+        if key in given and flat[key] != value:
+            raise InputError(key, f"conflicts with impact.shot = {name!r}, which sets it to {value:g}; "
+                                  "give one of the two")
+        flat[key] = value
+
+
+def _check_consistency(flat: dict, given: dict) -> None:
+    """Checks that involve several keys. Geometry is checked in full by fepen.geometry."""
+    if "projectile.cavity_length" in given:
+        if "projectile.mass" in given:
+            raise InputError("projectile.mass", "give projectile.mass or projectile.cavity_length, not both")
+        flat.pop("projectile.mass", None)
+    if flat["projectile.cavity_diameter"] == 0.0:
+        if "projectile.mass" in given:
+            raise InputError("projectile.mass",
+                             "a solid body (projectile.cavity_diameter = 0) has its mass set by its shape; "
+                             "drop projectile.mass")
+        flat.pop("projectile.mass", None)
+        flat.pop("projectile.cavity_length", None)
+    if flat["effects.charge"] and flat["projectile.cavity_diameter"] == 0.0:
+        raise InputError("effects.charge", "needs a cavity to fill: projectile.cavity_diameter must be > 0")
+    if "target.tensile_strength" not in flat:
+        flat["target.tensile_strength"] = 0.1 * flat["target.compressive_strength"]
+    if "mesh.nose_size" in flat and flat["mesh.nose_size"] > flat["mesh.size"]:
+        raise InputError("mesh.nose_size", f"must be at most mesh.size = {flat['mesh.size']:g} m")
+
+
+def load(path: str | Path | None = None, sets: list[str] | tuple[str, ...] = ()) -> Scene:
+    """Read a scene file (or none: all defaults), apply ``--set`` overrides, validate.
+
+    Args:
+        path: TOML scene file, or None for the default scene.
+        sets: ``KEY=VALUE`` strings, applied after the file in order.
+
+    Returns:
+        The resolved Scene.
+    """
+    given = read_toml(path) if path is not None else {}
+    for item in sets:
+        key, value = parse_set(item)
+        given[key] = value
+    return resolve(given)
+
+
+def to_toml(scene: Section) -> str:
+    """The resolved scene as TOML text (every key, SI units), for results directories."""
+    lines: list[str] = []
+
+    def emit(prefix: str, node: dict) -> None:
+        scalars = {k: v for k, v in node.items() if not isinstance(v, dict)}
+        if scalars:
+            lines.append(f"[{prefix}]")
+            for k, v in scalars.items():
+                if isinstance(v, bool):
+                    text = "true" if v else "false"
+                elif isinstance(v, str):
+                    text = f'"{v}"'
+                else:
+                    text = repr(v)
+                lines.append(f"{k} = {text}")
+            lines.append("")
+        for k, v in node.items():
+            if isinstance(v, dict):
+                emit(f"{prefix}.{k}" if prefix else k, v)
+
+    emit("", scene.as_dict())
+    return "\n".join(lines)
+
+
+def describe() -> str:
+    """A Markdown table of every scene key: default, unit, allowed values, meaning."""
+    rows = ["| key | default | allowed | meaning |", "|---|---|---|---|"]
+    for name, key in SCHEMA.items():
+        if key.default is _ABSENT:
+            default = "(absent)"
+        elif isinstance(key.default, bool):
+            default = str(key.default).lower()
+        elif isinstance(key.default, str):
+            default = f'"{key.default}"'
+        else:
+            default = f"{key.default:g}"
+        rows.append(f"| `{name}` | {default} | {key.allowed()} | {key.doc} |")
+    return "\n".join(rows)
