@@ -8,7 +8,7 @@ set -euo pipefail
 here=$(cd "$(dirname "$0")/.." && pwd)
 cd "$here"
 
-apt_pkgs="python3-dolfinx-real python3-h5py python3-numba python3-matplotlib python3-venv python3-pip \
+apt_pkgs="gcc python3-dolfinx-real python3-h5py python3-numba python3-matplotlib python3-venv python3-pip \
 openmpi-bin libglu1-mesa libxcursor1 libxft2 libxinerama1 libgl1 libegl1 libosmesa6"
 
 sudo=""
