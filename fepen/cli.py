@@ -1,5 +1,6 @@
 """The ``fepen`` command (shared/contract.md).
 
+    fepen run SCENE.toml [--out DIR] [--set KEY=VALUE ...]
     fepen mesh SCENE.toml [--out DIR] [--set KEY=VALUE ...]
     fepen keys
 
@@ -31,6 +32,8 @@ def _parser() -> argparse.ArgumentParser:
         p.add_argument("--set", dest="sets", action="append", default=[], metavar="KEY=VALUE",
                        help="override a dotted scene key; VALUE in TOML syntax, bare words are strings")
 
+    scene_args(sub.add_parser("run", help="one simulation: summary.json, history.csv, fields.xdmf, figures"),
+               "results/run")
     scene_args(sub.add_parser("mesh", help="build the projectile mesh only: mesh.json, mesh.xdmf, mesh.png"),
                "results/mesh")
     sub.add_parser("keys", help="list every scene key with its default, unit and allowed values")
@@ -74,6 +77,31 @@ def cmd_mesh(args) -> int:
     return 0
 
 
+def cmd_run(args) -> int:
+    """Run one scene."""
+    from mpi4py import MPI
+
+    from fepen import output, scene as fscene, shape, simulation
+
+    comm = MPI.COMM_WORLD
+    sc = fscene.load(args.scene, args.sets)
+    shape.shape_from_scene(sc)
+    simulation.check_supported(sc)
+    out = output.prepare(args.out, comm)
+    output.write_text(out / "scene.toml", fscene.to_toml(sc), comm)
+    try:
+        summary = simulation.run_scene(sc, out, comm, progress=True)
+    finally:
+        if (out / "history.csv").exists():
+            simulation.figures(out, comm)
+    keys = ("outcome", "Hx_mm", "Hy_mm", "Tx_mm", "Ty_mm", "length_mm", "residual_speed_m_s", "max_peeq",
+            "energy_error", "steps", "dt_s", "wall_s")
+    _say(*(f"{k} = {summary[k]:.6g}" if isinstance(summary[k], float) else f"{k} = {summary[k]}"
+           for k in keys), f"written: {out}/summary.json, history.csv, history.png"
+         + (", fields.xdmf" if sc.run.fields else ""))
+    return 0
+
+
 def cmd_keys(args) -> int:
     """Print the scene-key table (Markdown)."""
     from fepen import scene as fscene
@@ -82,7 +110,7 @@ def cmd_keys(args) -> int:
     return 0
 
 
-COMMANDS = {"mesh": cmd_mesh, "keys": cmd_keys}
+COMMANDS = {"run": cmd_run, "mesh": cmd_mesh, "keys": cmd_keys}
 
 
 def main(argv: list[str] | None = None) -> int:

@@ -1,0 +1,353 @@
+"""Cell kernels of the explicit solver on plain arrays (numba): kinematics, nodal volumes, stress update.
+
+Element: the linear tetrahedron with averaged nodal pressure (Bonet & Burton 1998). Each node carries the
+volume Σ V_e/4 of its cells (per material); its volume ratio J_a = V_a / V0_a defines a nodal pressure
+p_a = K ln(J_a) / J_a, the derivative of the volumetric energy K/2 (ln J_a)^2 stored at the node; a cell's
+mean stress is the average of its four nodes' pressures. The cell's deviatoric stress is its own. With
+``nodal = False`` each cell uses its own J (the plain, locking-prone element).
+
+Deviatoric stress: hypoelastic with the Hughes–Winget incremental rotation. The increment of the
+displacement gradient at the mid-step configuration, ΔL = (∂Δu/∂X) F_{n+1/2}^{-1}, gives ΔD = sym ΔL and
+ΔW = skew ΔL; the stress is rotated by Q = (I − ΔW/2)^{-1}(I + ΔW/2), which is exactly orthogonal and, for a
+rigid rotation, exactly the rotation of the step; then s += 2 G dev(ΔD) and the radial return of
+fepen.materials. The first Piola–Kirchhoff stress handed to the force form is P = J σ F^{-T}.
+
+Arrays: x (n_nodes, 3) current positions; dofs (n_cells, 4) node indices; grad0 (n_cells, 4, 3) reference
+shape-function gradients; vol0 (n_cells,) reference volumes; mat (n_cells,) material index into params
+(n_materials, N_PARAMS); s (n_cells, 6) deviatoric Cauchy stress (xx, yy, zz, xy, yz, xz).
+"""
+
+from __future__ import annotations
+
+import math
+
+import numba
+import numpy as np
+
+from fepen import materials as M
+
+#: fast-math flags that keep IEEE NaN/inf semantics (inverted or NaN elements must still be detected)
+_FAST = {"nsz", "arcp", "contract", "afn", "reassoc"}
+
+
+def reference_gradients(X: np.ndarray, dofs: np.ndarray):
+    """Shape-function gradients and volumes of the reference cells.
+
+    Args:
+        X: reference node coordinates (n_nodes, 3).
+        dofs: cell node indices (n_cells, 4).
+
+    Returns:
+        (grad0 (n_cells, 4, 3), vol0 (n_cells,)); vol0 > 0 whatever the node ordering.
+    """
+    p = X[dofs]
+    Jm = np.stack([p[:, 1] - p[:, 0], p[:, 2] - p[:, 0], p[:, 3] - p[:, 0]], axis=2)  # columns
+    inv = np.linalg.inv(Jm)  # rows: gradients of phi_1..3
+    grad0 = np.empty((len(dofs), 4, 3))
+    grad0[:, 1:] = inv
+    grad0[:, 0] = -inv.sum(axis=1)
+    vol0 = np.abs(np.linalg.det(Jm)) / 6.0
+    return grad0, vol0
+
+
+@numba.njit(cache=True, inline="always", fastmath=_FAST, error_model="numpy")
+def _det(F):
+    return (F[0, 0] * (F[1, 1] * F[2, 2] - F[1, 2] * F[2, 1])
+            - F[0, 1] * (F[1, 0] * F[2, 2] - F[1, 2] * F[2, 0])
+            + F[0, 2] * (F[1, 0] * F[2, 1] - F[1, 1] * F[2, 0]))
+
+
+@numba.njit(cache=True, inline="always", fastmath=_FAST, error_model="numpy")
+def _inv(F, out):
+    d = _det(F)
+    out[0, 0] = (F[1, 1] * F[2, 2] - F[1, 2] * F[2, 1]) / d
+    out[0, 1] = (F[0, 2] * F[2, 1] - F[0, 1] * F[2, 2]) / d
+    out[0, 2] = (F[0, 1] * F[1, 2] - F[0, 2] * F[1, 1]) / d
+    out[1, 0] = (F[1, 2] * F[2, 0] - F[1, 0] * F[2, 2]) / d
+    out[1, 1] = (F[0, 0] * F[2, 2] - F[0, 2] * F[2, 0]) / d
+    out[1, 2] = (F[0, 2] * F[1, 0] - F[0, 0] * F[1, 2]) / d
+    out[2, 0] = (F[1, 0] * F[2, 1] - F[1, 1] * F[2, 0]) / d
+    out[2, 1] = (F[0, 1] * F[2, 0] - F[0, 0] * F[2, 1]) / d
+    out[2, 2] = (F[0, 0] * F[1, 1] - F[0, 1] * F[1, 0]) / d
+    return d
+
+
+@numba.njit(cache=True, fastmath=_FAST, error_model="numpy")
+def volumes_and_step(x, dofs, grad0, vol0, mat, speed, nodal_vol, with_step=True):
+    """Current cell volumes into nodal volumes; the smallest J; the stable step of the current mesh.
+
+    Args:
+        x: current positions (n_nodes, 3).
+        dofs, grad0, vol0, mat: see module docstring.
+        speed: dilatational wave speed per material (m/s).
+        nodal_vol: (n_nodes, n_materials) output, zeroed and filled with Σ V_e / 4.
+        with_step: also compute the shortest altitudes (else the third result is inf).
+
+    Returns:
+        (min J, cell of min J, min over cells of shortest altitude / wave speed).
+    """
+    nodal_vol[:] = 0.0
+    jmin = np.inf
+    worst = -1
+    dtmin = np.inf
+    F = np.empty((3, 3))
+    for e in range(dofs.shape[0]):
+        for i in range(3):
+            for j in range(3):
+                acc = 0.0
+                for a in range(4):
+                    acc += x[dofs[e, a], i] * grad0[e, a, j]
+                F[i, j] = acc
+        J = _det(F)
+        if not (J > jmin):
+            if not (J >= jmin):  # also catches NaN
+                jmin = J
+                worst = e
+        V = J * vol0[e]
+        m = mat[e]
+        for a in range(4):
+            nodal_vol[dofs[e, a], m] += 0.25 * V
+        if not with_step:
+            continue
+        # shortest altitude = 3 V / largest face area
+        amax = 0.0
+        for f in range(4):
+            i0 = dofs[e, (f + 1) % 4]
+            i1 = dofs[e, (f + 2) % 4]
+            i2 = dofs[e, (f + 3) % 4]
+            ax = x[i1, 0] - x[i0, 0]
+            ay = x[i1, 1] - x[i0, 1]
+            az = x[i1, 2] - x[i0, 2]
+            bx = x[i2, 0] - x[i0, 0]
+            by = x[i2, 1] - x[i0, 1]
+            bz = x[i2, 2] - x[i0, 2]
+            cx = ay * bz - az * by
+            cy = az * bx - ax * bz
+            cz = ax * by - ay * bx
+            area2 = cx * cx + cy * cy + cz * cz
+            if area2 > amax:
+                amax = area2
+        if amax > 0.0 and V > 0.0:
+            h = 3.0 * V / (0.5 * math.sqrt(amax))
+            t = h / speed[m]
+            if t < dtmin:
+                dtmin = t
+    return jmin, worst, dtmin
+
+
+@numba.njit(cache=True, fastmath=_FAST, error_model="numpy")
+def nodal_pressures(nodal_vol, nodal_vol0, bulk, out):
+    """Nodal mean stress p_a = K ln(J_a) / J_a per material (Pa), J_a = V_a / V0_a; 0 where no volume."""
+    for n in range(nodal_vol.shape[0]):
+        for m in range(nodal_vol.shape[1]):
+            v0 = nodal_vol0[n, m]
+            if v0 > 0.0:
+                Ja = nodal_vol[n, m] / v0
+                out[n, m] = bulk[m] * math.log(Ja) / Ja
+            else:
+                out[n, m] = 0.0
+
+
+@numba.njit(cache=True, fastmath=_FAST, error_model="numpy")
+def stress_update(x, v, dt, dofs, grad0, vol0, mat, params, nodal_p, nodal, s, eps_p, temp, P_out, totals):
+    """Advance every cell's stress over one step and write P = J σ F^{-T} (row-major) into P_out.
+
+    Written with scalars rather than 3x3 temporaries (twice as fast under numba).
+
+    Args:
+        x: positions at the end of the step (n_nodes, 3); v: velocities over the step (n_nodes, 3).
+        dt: the step (s).
+        params: material parameters (n_materials, N_PARAMS).
+        nodal_p: nodal mean stress per material (n_nodes, n_materials), from nodal_pressures.
+        nodal: True for the averaged nodal pressure, False for the plain element (own J).
+        s, eps_p, temp: deviatoric stress (n, 6), plastic strain (n,), temperature (n,); updated in place.
+        P_out: (n_cells_packed, 9) output, first n_cells rows written.
+        totals: (4,) output: plastic work, heat, deviatoric elastic energy, largest plastic increment.
+    """
+    nmat = params.shape[0]
+    G_m = np.empty(nmat)
+    K_m = np.empty(nmat)
+    for m in range(nmat):
+        G_m[m] = params[m, M.E_] / (2.0 * (1.0 + params[m, M.NU]))
+        K_m[m] = params[m, M.E_] / (3.0 * (1.0 - 2.0 * params[m, M.NU]))
+    de = np.empty(6)
+    se = np.empty(6)
+    buf = np.empty(2)
+    totals[:] = 0.0
+    for e in range(dofs.shape[0]):
+        m = mat[e]
+        G = G_m[m]
+        # F = sum_a x_a (x) grad0_a and the increment D = sum_a (v_a dt) (x) grad0_a
+        F00 = F01 = F02 = F10 = F11 = F12 = F20 = F21 = F22 = 0.0
+        D00 = D01 = D02 = D10 = D11 = D12 = D20 = D21 = D22 = 0.0
+        for a in range(4):
+            nd = dofs[e, a]
+            g0 = grad0[e, a, 0]
+            g1 = grad0[e, a, 1]
+            g2 = grad0[e, a, 2]
+            x0 = x[nd, 0]
+            x1 = x[nd, 1]
+            x2 = x[nd, 2]
+            u0 = v[nd, 0] * dt
+            u1 = v[nd, 1] * dt
+            u2 = v[nd, 2] * dt
+            F00 += x0 * g0
+            F01 += x0 * g1
+            F02 += x0 * g2
+            F10 += x1 * g0
+            F11 += x1 * g1
+            F12 += x1 * g2
+            F20 += x2 * g0
+            F21 += x2 * g1
+            F22 += x2 * g2
+            D00 += u0 * g0
+            D01 += u0 * g1
+            D02 += u0 * g2
+            D10 += u1 * g0
+            D11 += u1 * g1
+            D12 += u1 * g2
+            D20 += u2 * g0
+            D21 += u2 * g1
+            D22 += u2 * g2
+        # mid-step configuration F_m = F - D/2 and L = D F_m^-1 (through the cofactor of F_m)
+        a00 = F00 - 0.5 * D00
+        a01 = F01 - 0.5 * D01
+        a02 = F02 - 0.5 * D02
+        a10 = F10 - 0.5 * D10
+        a11 = F11 - 0.5 * D11
+        a12 = F12 - 0.5 * D12
+        a20 = F20 - 0.5 * D20
+        a21 = F21 - 0.5 * D21
+        a22 = F22 - 0.5 * D22
+        c00 = a11 * a22 - a12 * a21
+        c01 = a12 * a20 - a10 * a22
+        c02 = a10 * a21 - a11 * a20
+        c10 = a02 * a21 - a01 * a22
+        c11 = a00 * a22 - a02 * a20
+        c12 = a01 * a20 - a00 * a21
+        c20 = a01 * a12 - a02 * a11
+        c21 = a02 * a10 - a00 * a12
+        c22 = a00 * a11 - a01 * a10
+        idet = 1.0 / (a00 * c00 + a01 * c01 + a02 * c02)
+        L00 = (D00 * c00 + D01 * c01 + D02 * c02) * idet
+        L01 = (D00 * c10 + D01 * c11 + D02 * c12) * idet
+        L02 = (D00 * c20 + D01 * c21 + D02 * c22) * idet
+        L10 = (D10 * c00 + D11 * c01 + D12 * c02) * idet
+        L11 = (D10 * c10 + D11 * c11 + D12 * c12) * idet
+        L12 = (D10 * c20 + D11 * c21 + D12 * c22) * idet
+        L20 = (D20 * c00 + D21 * c01 + D22 * c02) * idet
+        L21 = (D20 * c10 + D21 * c11 + D22 * c12) * idet
+        L22 = (D20 * c20 + D21 * c21 + D22 * c22) * idet
+        # Hughes-Winget rotation Q = (I - W/2)^-1 (I + W/2), W = skew(L), in closed form (Cayley):
+        # with w the axial vector of W/2, Q = I + 2 (W/2 + (W/2)^2) / (1 + |w|^2)
+        w0 = 0.25 * (L21 - L12)
+        w1 = 0.25 * (L02 - L20)
+        w2 = 0.25 * (L10 - L01)
+        c = 2.0 / (1.0 + w0 * w0 + w1 * w1 + w2 * w2)
+        Q00 = 1.0 - c * (w1 * w1 + w2 * w2)
+        Q11 = 1.0 - c * (w0 * w0 + w2 * w2)
+        Q22 = 1.0 - c * (w0 * w0 + w1 * w1)
+        Q01 = c * (-w2 + w0 * w1)
+        Q10 = c * (w2 + w0 * w1)
+        Q02 = c * (w1 + w0 * w2)
+        Q20 = c * (-w1 + w0 * w2)
+        Q12 = c * (-w0 + w1 * w2)
+        Q21 = c * (w0 + w1 * w2)
+        # rotated deviatoric stress Q S Q^T
+        S00 = s[e, 0]
+        S11 = s[e, 1]
+        S22 = s[e, 2]
+        S01 = s[e, 3]
+        S12 = s[e, 4]
+        S02 = s[e, 5]
+        T00 = Q00 * S00 + Q01 * S01 + Q02 * S02
+        T01 = Q00 * S01 + Q01 * S11 + Q02 * S12
+        T02 = Q00 * S02 + Q01 * S12 + Q02 * S22
+        T10 = Q10 * S00 + Q11 * S01 + Q12 * S02
+        T11 = Q10 * S01 + Q11 * S11 + Q12 * S12
+        T12 = Q10 * S02 + Q11 * S12 + Q12 * S22
+        T20 = Q20 * S00 + Q21 * S01 + Q22 * S02
+        T21 = Q20 * S01 + Q21 * S11 + Q22 * S12
+        T22 = Q20 * S02 + Q21 * S12 + Q22 * S22
+        se[0] = T00 * Q00 + T01 * Q01 + T02 * Q02
+        se[1] = T10 * Q10 + T11 * Q11 + T12 * Q12
+        se[2] = T20 * Q20 + T21 * Q21 + T22 * Q22
+        se[3] = T00 * Q10 + T01 * Q11 + T02 * Q12
+        se[4] = T10 * Q20 + T11 * Q21 + T12 * Q22
+        se[5] = T00 * Q20 + T01 * Q21 + T02 * Q22
+        tr = (L00 + L11 + L22) / 3.0
+        de[0] = L00 - tr
+        de[1] = L11 - tr
+        de[2] = L22 - tr
+        de[3] = 0.5 * (L01 + L10)
+        de[4] = 0.5 * (L12 + L21)
+        de[5] = 0.5 * (L02 + L20)
+        # cofactor C = J F^-T of the end-of-step F, so that P = J sigma F^-T = sigma C
+        C00 = F11 * F22 - F12 * F21
+        C01 = F12 * F20 - F10 * F22
+        C02 = F10 * F21 - F11 * F20
+        C10 = F02 * F21 - F01 * F22
+        C11 = F00 * F22 - F02 * F20
+        C12 = F01 * F20 - F00 * F21
+        C20 = F01 * F12 - F02 * F11
+        C21 = F02 * F10 - F00 * F12
+        C22 = F00 * F11 - F01 * F10
+        J = F00 * C00 + F01 * C01 + F02 * C02
+        V = J * vol0[e]
+        if params[m, M.KIND] == M.ELASTIC:
+            for i in range(6):
+                se[i] += 2.0 * G * de[i]
+        else:
+            p = params[m]
+            ep_new, T_new = M.update_deviatoric(se, de, eps_p[e], temp[e], dt, p, buf)
+            eps_p[e] = ep_new
+            temp[e] = T_new
+            if buf[1] > 0.0:
+                totals[0] += buf[0] * V
+                if p[M.THERMAL_ON] > 0.0:
+                    totals[1] += p[M.BETA] * buf[0] * V
+                if buf[1] > totals[3]:
+                    totals[3] = buf[1]
+        s0 = se[0]
+        s1 = se[1]
+        s2 = se[2]
+        s3 = se[3]
+        s4 = se[4]
+        s5 = se[5]
+        s[e, 0] = s0
+        s[e, 1] = s1
+        s[e, 2] = s2
+        s[e, 3] = s3
+        s[e, 4] = s4
+        s[e, 5] = s5
+        totals[2] += V * (s0 * s0 + s1 * s1 + s2 * s2 + 2.0 * (s3 * s3 + s4 * s4 + s5 * s5)) / (4.0 * G)
+        if nodal:
+            pm = 0.25 * (nodal_p[dofs[e, 0], m] + nodal_p[dofs[e, 1], m] + nodal_p[dofs[e, 2], m]
+                         + nodal_p[dofs[e, 3], m])
+        else:
+            pm = K_m[m] * math.log(J) / J
+        p00 = s0 + pm
+        p11 = s1 + pm
+        p22 = s2 + pm
+        P_out[e, 0] = p00 * C00 + s3 * C01 + s5 * C02
+        P_out[e, 1] = p00 * C10 + s3 * C11 + s5 * C12
+        P_out[e, 2] = p00 * C20 + s3 * C21 + s5 * C22
+        P_out[e, 3] = s3 * C00 + p11 * C01 + s4 * C02
+        P_out[e, 4] = s3 * C10 + p11 * C11 + s4 * C12
+        P_out[e, 5] = s3 * C20 + p11 * C21 + s4 * C22
+        P_out[e, 6] = s5 * C00 + s4 * C01 + p22 * C02
+        P_out[e, 7] = s5 * C10 + s4 * C11 + p22 * C12
+        P_out[e, 8] = s5 * C20 + s4 * C21 + p22 * C22
+
+
+@numba.njit(cache=True, fastmath=_FAST, error_model="numpy")
+def volumetric_energy(nodal_vol, nodal_vol0, bulk, n_owned):
+    """Σ over owned nodes and materials of V0_a K/2 (ln J_a)^2 (J)."""
+    total = 0.0
+    for n in range(n_owned):
+        for m in range(nodal_vol.shape[1]):
+            v0 = nodal_vol0[n, m]
+            if v0 > 0.0:
+                lj = math.log(nodal_vol[n, m] / v0)
+                total += v0 * 0.5 * bulk[m] * lj * lj
+    return total

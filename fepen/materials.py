@@ -1,0 +1,319 @@
+"""Material laws on plain arrays (numba-compiled), tested without a mesh.
+
+Stress convention: tension positive, Cauchy stress. Deviatoric stress ``s`` is stored as 6 Voigt
+components (xx, yy, zz, xy, yz, xz); the pressure part comes from the volume change (fepen.kinematics).
+
+Laws:
+    elastic                       s_dot = 2 G e_dot (objective rate: see fepen.kinematics)
+    Johnson-Cook (45 steel)       sigma_y = (A + B eps_p^n)(1 + C ln(max(eps_dot_p / eps_dot_0, 1)))(1 - T*^m)
+                                  T* = (T - T_room) / (T_melt - T_room), clipped to [0, 1]
+    adiabatic heating             rho c_p dT = beta sigma_y d eps_p      (beta: Taylor-Quinney)
+    bilinear isotropic (charge)   sigma_y = sigma_0 + H eps_p,  H = E E_t / (E - E_t)
+
+The radial return solves the consistency condition
+    sigma_eq_trial - 3 G d_eps - sigma_y(eps_p + d_eps, d_eps / dt, T + dT(d_eps)) = 0
+for d_eps by a safeguarded Newton iteration to a relative residual of 1e-12, the temperature rise of the
+increment included (full consistency, no lagged hardening, rate or temperature).
+"""
+
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass
+
+import numba
+import numpy as np
+
+#: fast-math flags that keep IEEE NaN/inf semantics (inverted or NaN elements must still be detected)
+_FAST = {"nsz", "arcp", "contract", "afn", "reassoc"}
+
+# Layout of the parameter vector handed to compiled code
+KIND, E_, NU, RHO, A_, B_, N_, C_, M_, TMELT, TROOM, EPS0, CP, BETA, RATE_ON, THERMAL_ON, H_ = range(17)
+N_PARAMS = 17
+ELASTIC, JOHNSON_COOK, BILINEAR = 0, 1, 2
+
+
+@dataclass(frozen=True)
+class Material:
+    """A material as fepen's compiled kernels see it.
+
+    Attributes:
+        params: float64 vector, layout given by the module constants (KIND, E_, NU, ...).
+    """
+
+    params: np.ndarray
+
+    @property
+    def E(self):
+        return self.params[E_]
+
+    @property
+    def nu(self):
+        return self.params[NU]
+
+    @property
+    def density(self):
+        return self.params[RHO]
+
+    @property
+    def shear_modulus(self):
+        return self.params[E_] / (2.0 * (1.0 + self.params[NU]))
+
+    @property
+    def bulk_modulus(self):
+        return self.params[E_] / (3.0 * (1.0 - 2.0 * self.params[NU]))
+
+    @property
+    def kind(self):
+        return int(self.params[KIND])
+
+
+def elastic(E: float, nu: float, density: float) -> Material:
+    """Linear (hypo)elastic material."""
+    p = np.zeros(N_PARAMS)
+    p[[KIND, E_, NU, RHO]] = ELASTIC, E, nu, density
+    return Material(p)
+
+
+def johnson_cook(E, nu, density, A, B, n, C, m, melt_temperature, room_temperature,
+                 reference_strain_rate=1.0, specific_heat=470.0, taylor_quinney=0.9,
+                 strain_rate=True, thermal=True) -> Material:
+    """Johnson-Cook plasticity with optional strain-rate and thermal-softening terms.
+
+    Args:
+        E, nu, density: elastic constants (Pa, -, kg/m^3).
+        A, B, n, C, m: Johnson-Cook constants (Pa, Pa, -, -, -).
+        melt_temperature, room_temperature: K.
+        reference_strain_rate: eps_dot_0 (1/s).
+        specific_heat: J/(kg K); taylor_quinney: fraction of plastic work turned into heat.
+        strain_rate, thermal: switch the rate term and thermal softening + adiabatic heating.
+    """
+    p = np.zeros(N_PARAMS)
+    p[[KIND, E_, NU, RHO, A_, B_, N_, C_, M_, TMELT, TROOM, EPS0, CP, BETA, RATE_ON, THERMAL_ON]] = (
+        JOHNSON_COOK, E, nu, density, A, B, n, C, m, melt_temperature, room_temperature,
+        reference_strain_rate, specific_heat, taylor_quinney, float(strain_rate), float(thermal))
+    return Material(p)
+
+
+def bilinear(E, nu, density, yield_stress, tangent_modulus) -> Material:
+    """Bilinear isotropic hardening: sigma_y = sigma_0 + H eps_p, H = E E_t / (E - E_t)."""
+    if tangent_modulus >= E:
+        raise ValueError("tangent modulus must be below Young's modulus")
+    p = np.zeros(N_PARAMS)
+    p[[KIND, E_, NU, RHO, A_, H_]] = BILINEAR, E, nu, density, yield_stress, E * tangent_modulus / (E - tangent_modulus)
+    return Material(p)
+
+
+def from_scene(scene) -> Material:
+    """The projectile material of a scene: elastic or Johnson-Cook by effects.fidelity."""
+    m = scene.projectile.material
+    if scene.effects.fidelity == "elastic":
+        return elastic(m.youngs_modulus, m.poisson_ratio, m.density)
+    return johnson_cook(m.youngs_modulus, m.poisson_ratio, m.density, m.A, m.B, m.n, m.C, m.m,
+                        m.melt_temperature, m.room_temperature, m.reference_strain_rate, m.specific_heat,
+                        m.taylor_quinney, scene.effects.strain_rate, scene.effects.thermal)
+
+
+def charge_from_scene(scene) -> Material:
+    """The explosive charge material (Table 4)."""
+    c = scene.charge.material
+    return bilinear(c.youngs_modulus, c.poisson_ratio, c.density, c.yield_stress, c.tangent_modulus)
+
+
+# ---------------------------------------------------------------------------------------------------------
+# Compiled scalar laws
+# ---------------------------------------------------------------------------------------------------------
+@numba.njit(cache=True, fastmath=_FAST, error_model="numpy")
+def homologous_temperature(T, p):
+    """T* clipped to [0, 1]."""
+    ts = (T - p[TROOM]) / (p[TMELT] - p[TROOM])
+    return min(max(ts, 0.0), 1.0)
+
+
+@numba.njit(cache=True, fastmath=_FAST, error_model="numpy")
+def yield_stress(eps_p, rate, T, p):
+    """Flow stress (Pa) at plastic strain eps_p, plastic strain rate ``rate`` (1/s), temperature T (K)."""
+    kind = int(p[KIND])
+    if kind == BILINEAR:
+        return p[A_] + p[H_] * eps_p
+    if kind != JOHNSON_COOK:
+        return np.inf
+    s = p[A_] + p[B_] * max(eps_p, 0.0) ** p[N_]
+    if p[RATE_ON] > 0.0 and rate > p[EPS0]:
+        s *= 1.0 + p[C_] * math.log(rate / p[EPS0])
+    if p[THERMAL_ON] > 0.0:
+        s *= 1.0 - homologous_temperature(T, p) ** p[M_]
+    return s
+
+
+@numba.njit(cache=True, fastmath=_FAST, error_model="numpy")
+def _yield_and_slope(eps_p, d, dt, T0, p):
+    """sigma_y(eps_p + d, d/dt, T0 + dT(d)) and its derivative in d (with dT from adiabatic heating
+    computed with the same sigma_y: dT = beta sigma_y d / (rho c_p))."""
+    kind = int(p[KIND])
+    if kind == BILINEAR:
+        return p[A_] + p[H_] * (eps_p + d), p[H_], T0
+    e = eps_p + d
+    # strain hardening
+    emin = 1e-12
+    ee = max(e, emin)
+    h0 = p[A_] + p[B_] * ee ** p[N_]
+    dh0 = p[N_] * p[B_] * ee ** (p[N_] - 1.0) if e > emin else 0.0
+    if dh0 > 1e3 * p[E_]:  # n < 1: infinite slope at eps_p = 0; cap it for Newton
+        dh0 = 1e3 * p[E_]
+    # strain rate
+    r, dr = 1.0, 0.0
+    if p[RATE_ON] > 0.0 and dt > 0.0:
+        rate = d / dt
+        if rate > p[EPS0]:
+            r = 1.0 + p[C_] * math.log(rate / p[EPS0])
+            dr = p[C_] / d
+    g = h0 * r
+    dg = dh0 * r + h0 * dr
+    if p[THERMAL_ON] <= 0.0:
+        return g, dg, T0
+    # thermal softening with adiabatic heating solved together: s = g (1 - T*(s)^m), T = T0 + k s d
+    k = p[BETA] / (p[RHO] * p[CP])
+    span = p[TMELT] - p[TROOM]
+    s = g * (1.0 - homologous_temperature(T0, p) ** p[M_])
+    for _ in range(50):  # fixed point in s (contractive: k s d / span << 1 per step)
+        T = T0 + k * s * d
+        s_new = g * (1.0 - homologous_temperature(T, p) ** p[M_])
+        if abs(s_new - s) <= 1e-14 * abs(s_new) + 1e-6:
+            s = s_new
+            break
+        s = s_new
+    T = T0 + k * s * d
+    ts = homologous_temperature(T, p)
+    if 0.0 < ts < 1.0:
+        # s = g (1 - ts^m): ds/dd = dg (1-ts^m) - g m ts^(m-1) dts/dd, dts/dd = k (s + d ds/dd)/span
+        q = g * p[M_] * ts ** (p[M_] - 1.0) * k / span
+        ds = (dg * (1.0 - ts ** p[M_]) - q * s) / (1.0 + q * d)
+    else:
+        ds = dg * (1.0 - ts ** p[M_])
+    return s, ds, T
+
+
+@numba.njit(cache=True, fastmath=_FAST, error_model="numpy")
+def radial_return(q_trial, eps_p, T, dt, G, p):
+    """Solve q_trial - 3 G d - sigma_y(eps_p + d, d/dt, T(d)) = 0 for the plastic increment d >= 0.
+
+    Args:
+        q_trial: von Mises stress of the elastic trial state (Pa).
+        eps_p, T: equivalent plastic strain and temperature (K) at the start of the step.
+        dt: time step (s), for the strain rate d/dt.
+        G: shear modulus (Pa).
+        p: material parameter vector.
+
+    Returns:
+        (d, sigma_y, T_new): plastic strain increment, flow stress, temperature after the step. d = 0 when
+        the trial state is elastic.
+    """
+    kind = int(p[KIND])
+    if kind == ELASTIC:
+        return 0.0, np.inf, T
+    s0, _, _ = _yield_and_slope(eps_p, 0.0, dt, T, p)
+    if q_trial <= s0:
+        return 0.0, s0, T
+    # bracket: f(0) > 0, f(q_trial / 3G) <= 0 since sigma_y >= 0
+    lo, hi = 0.0, q_trial / (3.0 * G)
+    d = min(max((q_trial - s0) / (3.0 * G), 1e-14), hi)
+    s, ds, Tn = s0, 0.0, T
+    for _ in range(100):
+        s, ds, Tn = _yield_and_slope(eps_p, d, dt, T, p)
+        f = q_trial - 3.0 * G * d - s
+        if abs(f) <= 1e-12 * q_trial:
+            break
+        if f > 0.0:
+            lo = d
+        else:
+            hi = d
+        step = f / (3.0 * G + ds)
+        dn = d + step
+        if not (lo < dn < hi):  # Newton left the bracket: bisect
+            dn = 0.5 * (lo + hi)
+        d = dn
+    return d, s, Tn
+
+
+@numba.njit(cache=True, fastmath=_FAST, error_model="numpy")
+def update_deviatoric(s, de, eps_p, T, dt, p, out_dwp):
+    """Elastic trial + radial return of one point, in place.
+
+    Args:
+        s: deviatoric Cauchy stress, 6 Voigt components (xx, yy, zz, xy, yz, xz), already rotated to the
+           end of the step; updated in place.
+        de: deviatoric strain increment, 6 components with tensor (not engineering) shears.
+        eps_p, T: plastic strain and temperature at the start of the step.
+        dt: step (s).
+        p: material parameters.
+        out_dwp: length-2 array: receives (plastic work per unit volume, plastic strain increment).
+
+    Returns:
+        (eps_p_new, T_new).
+    """
+    G = p[E_] / (2.0 * (1.0 + p[NU]))
+    for i in range(6):
+        s[i] += 2.0 * G * de[i]
+    q = math.sqrt(1.5 * (s[0] ** 2 + s[1] ** 2 + s[2] ** 2 + 2.0 * (s[3] ** 2 + s[4] ** 2 + s[5] ** 2)))
+    d, sy, Tn = radial_return(q, eps_p, T, dt, G, p)
+    out_dwp[0] = 0.0
+    out_dwp[1] = d
+    if d > 0.0:
+        scale = sy / q
+        for i in range(6):
+            s[i] *= scale
+        out_dwp[0] = sy * d
+    return eps_p + d, Tn
+
+
+def uniaxial_stress_path(material: Material, strains: np.ndarray, dt: float, T0: float | None = None):
+    """Drive one point along uniaxial stress (lateral stresses zero) through a strain history.
+
+    A small driver for the material tests: the lateral strain is iterated each step so that the lateral
+    stress vanishes (an incompressible plastic flow plus elastic Poisson contraction).
+
+    Args:
+        material: the material.
+        strains: axial logarithmic strains, increasing from 0.
+        dt: time per increment (s), sets the strain rate.
+        T0: initial temperature (K); default the room temperature.
+
+    Returns:
+        (axial stress, plastic strain, temperature) arrays, one entry per strain.
+    """
+    p = material.params
+    K, G = material.bulk_modulus, material.shear_modulus
+    T = p[TROOM] if T0 is None else T0
+    s = np.zeros(6)
+    ep, pres = 0.0, 0.0
+    out = np.zeros((len(strains), 3))
+    buf = np.zeros(2)
+    prev = 0.0
+    for i, e in enumerate(strains):
+        dax = e - prev
+        prev = e
+        # lateral increment from the condition sigma_lat = 0, by secant iterations
+        lat = -0.5 * dax
+
+        def trial(lat):
+            dv = dax + 2.0 * lat
+            dev = np.array([dax - dv / 3.0, lat - dv / 3.0, lat - dv / 3.0, 0.0, 0.0, 0.0])
+            st = s.copy()
+            ep_n, T_n = update_deviatoric(st, dev, ep, T, dt, p, buf)
+            pr = pres + K * dv
+            return st, ep_n, T_n, pr, st[1] + pr
+
+        x0, x1 = lat, -0.3 * dax
+        f0, f1 = trial(x0)[4], trial(x1)[4]
+        for _ in range(60):
+            if abs(f1 - f0) < 1e-30:
+                break
+            x2 = x1 - f1 * (x1 - x0) / (f1 - f0)
+            x0, f0 = x1, f1
+            x1, f1 = x2, trial(x2)[4]
+            if abs(f1) < 1e-9 * max(1.0, abs(p[A_])):
+                break
+        s, ep, T, pres, _ = trial(x1)
+        out[i] = s[0] + pres, ep, T
+    return out[:, 0], out[:, 1], out[:, 2]
