@@ -121,6 +121,7 @@ class ExplicitSolver:
         self.acc = self.a_fn.x.array.reshape(-1, 3)
         self.fint = self.fint_fn.x.array.reshape(-1, 3)
         self.fint_old = np.zeros_like(self.fint)
+        self.fixed = None  # (n_nodes, 3) bool: velocity components held at zero (symmetry planes)
         self.fext = np.zeros((self.n_nodes, 3))
         self.fext_old = np.zeros_like(self.fext)
         self._nvol = la.vector(imap, bs=nm)
@@ -194,7 +195,14 @@ class ExplicitSolver:
             self.U[:] = displacement(self.X) if callable(displacement) else displacement
         if velocity is not None:
             self.Vel[:] = velocity(self.X) if callable(velocity) else velocity
+        if self.fixed is not None:
+            self.Vel[self.fixed] = 0.0
         self._forces(0.0)
+        n = self.n_owned
+        self.acc[:n] = (self.fext[:n] - self.fint[:n]) / self.mass[:n, None]
+        if self.fixed is not None:
+            self.acc[self.fixed] = 0.0
+        self.a_fn.x.scatter_forward()
         self.ke0 = self.kinetic_energy(self.Vel)
         self.dt = self.stable_step()
         self.dt0 = self.dt_min = self.dt
@@ -268,6 +276,8 @@ class ExplicitSolver:
         n = self.n_owned
         f = self.fext[:n] - self.fint[:n]
         self.acc[:n] = f / self.mass[:n, None]
+        if self.fixed is not None:
+            self.acc[self.fixed] = 0.0
         self.a_fn.x.scatter_forward()
         self._w_int += 0.5 * float(np.sum(du[:n] * (self.fint_old[:n] + self.fint[:n])))
         self._w_ext += 0.5 * float(np.sum(du[:n] * (self.fext_old[:n] + self.fext[:n])))

@@ -329,15 +329,16 @@ def stress_update(x, v, dt, dofs, grad0, vol0, mat, params, nodal_p, nodal, s, e
         p00 = s0 + pm
         p11 = s1 + pm
         p22 = s2 + pm
-        P_out[e, 0] = p00 * C00 + s3 * C01 + s5 * C02
-        P_out[e, 1] = p00 * C10 + s3 * C11 + s5 * C12
-        P_out[e, 2] = p00 * C20 + s3 * C21 + s5 * C22
-        P_out[e, 3] = s3 * C00 + p11 * C01 + s4 * C02
-        P_out[e, 4] = s3 * C10 + p11 * C11 + s4 * C12
-        P_out[e, 5] = s3 * C20 + p11 * C21 + s4 * C22
-        P_out[e, 6] = s5 * C00 + s4 * C01 + p22 * C02
-        P_out[e, 7] = s5 * C10 + s4 * C11 + p22 * C12
-        P_out[e, 8] = s5 * C20 + s4 * C21 + p22 * C22
+        # P_ij = sum_k sigma_ik C_kj
+        P_out[e, 0] = p00 * C00 + s3 * C10 + s5 * C20
+        P_out[e, 1] = p00 * C01 + s3 * C11 + s5 * C21
+        P_out[e, 2] = p00 * C02 + s3 * C12 + s5 * C22
+        P_out[e, 3] = s3 * C00 + p11 * C10 + s4 * C20
+        P_out[e, 4] = s3 * C01 + p11 * C11 + s4 * C21
+        P_out[e, 5] = s3 * C02 + p11 * C12 + s4 * C22
+        P_out[e, 6] = s5 * C00 + s4 * C10 + p22 * C20
+        P_out[e, 7] = s5 * C01 + s4 * C11 + p22 * C21
+        P_out[e, 8] = s5 * C02 + s4 * C12 + p22 * C22
 
 
 @numba.njit(cache=True, fastmath=_FAST, error_model="numpy")

@@ -147,21 +147,25 @@ def yield_stress(eps_p, rate, T, p):
 
 
 @numba.njit(cache=True, fastmath=_FAST, error_model="numpy")
-def _yield_and_slope(eps_p, d, dt, T0, p):
-    """sigma_y(eps_p + d, d/dt, T0 + dT(d)) and its derivative in d (with dT from adiabatic heating
-    computed with the same sigma_y: dT = beta sigma_y d / (rho c_p))."""
+def _yield_and_slope(eps_p, d, dt, T0, p, s_heat):
+    """sigma_y(eps_p + d, d/dt, T) and its derivative in d, with the adiabatic temperature
+    T = T0 + beta s_heat d / (rho c_p) computed from the flow stress s_heat of the previous Newton iterate
+    (at convergence s_heat equals the returned flow stress: hardening, rate and heating are consistent).
+
+    Returns:
+        (sigma_y, d sigma_y / d d, T).
+    """
     kind = int(p[KIND])
     if kind == BILINEAR:
         return p[A_] + p[H_] * (eps_p + d), p[H_], T0
     e = eps_p + d
-    # strain hardening
     emin = 1e-12
     ee = max(e, emin)
-    h0 = p[A_] + p[B_] * ee ** p[N_]
-    dh0 = p[N_] * p[B_] * ee ** (p[N_] - 1.0) if e > emin else 0.0
+    en = ee ** p[N_]
+    h0 = p[A_] + p[B_] * en
+    dh0 = p[N_] * p[B_] * en / ee if e > emin else 0.0
     if dh0 > 1e3 * p[E_]:  # n < 1: infinite slope at eps_p = 0; cap it for Newton
         dh0 = 1e3 * p[E_]
-    # strain rate
     r, dr = 1.0, 0.0
     if p[RATE_ON] > 0.0 and dt > 0.0:
         rate = d / dt
@@ -172,25 +176,16 @@ def _yield_and_slope(eps_p, d, dt, T0, p):
     dg = dh0 * r + h0 * dr
     if p[THERMAL_ON] <= 0.0:
         return g, dg, T0
-    # thermal softening with adiabatic heating solved together: s = g (1 - T*(s)^m), T = T0 + k s d
     k = p[BETA] / (p[RHO] * p[CP])
-    span = p[TMELT] - p[TROOM]
-    s = g * (1.0 - homologous_temperature(T0, p) ** p[M_])
-    for _ in range(50):  # fixed point in s (contractive: k s d / span << 1 per step)
-        T = T0 + k * s * d
-        s_new = g * (1.0 - homologous_temperature(T, p) ** p[M_])
-        if abs(s_new - s) <= 1e-14 * abs(s_new) + 1e-6:
-            s = s_new
-            break
-        s = s_new
-    T = T0 + k * s * d
+    T = T0 + k * s_heat * d
     ts = homologous_temperature(T, p)
-    if 0.0 < ts < 1.0:
-        # s = g (1 - ts^m): ds/dd = dg (1-ts^m) - g m ts^(m-1) dts/dd, dts/dd = k (s + d ds/dd)/span
-        q = g * p[M_] * ts ** (p[M_] - 1.0) * k / span
-        ds = (dg * (1.0 - ts ** p[M_]) - q * s) / (1.0 + q * d)
-    else:
-        ds = dg * (1.0 - ts ** p[M_])
+    if ts <= 0.0:
+        return g, dg, T
+    tm = ts ** p[M_]
+    s = g * (1.0 - tm)
+    ds = dg * (1.0 - tm)
+    if ts < 1.0:  # dT/dd = k s_heat
+        ds -= g * p[M_] * tm / ts * k * s_heat / (p[TMELT] - p[TROOM])
     return s, ds, T
 
 
@@ -212,24 +207,25 @@ def radial_return(q_trial, eps_p, T, dt, G, p):
     kind = int(p[KIND])
     if kind == ELASTIC:
         return 0.0, np.inf, T
-    s0, _, _ = _yield_and_slope(eps_p, 0.0, dt, T, p)
+    s0, _, _ = _yield_and_slope(eps_p, 0.0, dt, T, p, 0.0)
     if q_trial <= s0:
         return 0.0, s0, T
     # bracket: f(0) > 0, f(q_trial / 3G) <= 0 since sigma_y >= 0
     lo, hi = 0.0, q_trial / (3.0 * G)
     d = min(max((q_trial - s0) / (3.0 * G), 1e-14), hi)
-    s, ds, Tn = s0, 0.0, T
+    s, Tn = s0, T
+    s_heat = s0
     for _ in range(100):
-        s, ds, Tn = _yield_and_slope(eps_p, d, dt, T, p)
+        s, ds, Tn = _yield_and_slope(eps_p, d, dt, T, p, s_heat)
         f = q_trial - 3.0 * G * d - s
-        if abs(f) <= 1e-12 * q_trial:
+        if abs(f) <= 1e-12 * q_trial and abs(s - s_heat) <= 1e-12 * q_trial:
             break
+        s_heat = s
         if f > 0.0:
             lo = d
         else:
             hi = d
-        step = f / (3.0 * G + ds)
-        dn = d + step
+        dn = d + f / (3.0 * G + ds)
         if not (lo < dn < hi):  # Newton left the bracket: bisect
             dn = 0.5 * (lo + hi)
         d = dn
