@@ -1,6 +1,6 @@
 # The two set-up commands of the README:
-#   make run    installs what is missing, then runs the default scene (shot C3) into results/C3
-#               (until the solver lands: meshes it, writing mesh.json, mesh.xdmf and mesh.png)
+#   make run    installs what is missing, meshes the default projectile (shot C3 scene) into results/C3 and
+#               runs the 4340 steel Taylor impact into results/taylor_4340 (until the concrete target lands)
 #   make test   installs what is missing, then runs every test: serially, then the MPI ones on 2 ranks
 PY := .venv/bin/python
 NP ?= 2
@@ -17,6 +17,7 @@ setup:
 
 run: setup
 	$(PY) -m fepen mesh scenes/default.toml --out results/C3
+	$(PY) -m fepen run demos/verification/taylor_4340.toml --out results/taylor_4340
 
 test: setup
 	$(PY) -m pytest -q tests
@@ -24,6 +25,8 @@ test: setup
 
 bench: setup
 	$(PY) benchmarks/mesh_cost.py
+	$(PY) benchmarks/step_cost.py
+	mpirun -n $(NP) $(PY) benchmarks/step_cost.py 2.5
 
 clean:
 	rm -rf results meshes/cache .pytest_cache

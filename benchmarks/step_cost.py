@@ -1,0 +1,78 @@
+"""Cost of one explicit step on the default projectile (plastic, hitting the rigid wall at 300 m/s).
+
+For each mesh size: the per-step time split (kinematics and nodal volumes, material update, internal-force
+assembly, boundary forces, vector updates), the full step over the bare internal-force assembly (the same
+compiled form assembled alone, coefficients pre-packed), cell-steps per second, and the stable step over
+(shortest altitude / dilatational speed).
+
+    .venv/bin/python benchmarks/step_cost.py [sizes in mm ...]      (also under mpirun -n 2)
+"""
+
+import sys
+import time
+
+import numpy as np
+from dolfinx import cpp as _cpp, la
+from mpi4py import MPI
+
+from fepen import explicit, materials as M, mesh, rigidwall, scene, tetra
+
+STEPS = 300
+
+
+def measure(h_mm, comm):
+    sc = scene.load(None, [f"mesh.size={h_mm * 1e-3}", "target.kind=rigid-wall", "impact.velocity=300",
+                           "impact.obliquity_deg=0", "impact.attack_deg=0"])
+    pm = mesh.create(sc, comm)
+    info = mesh.metrics(pm, sc)
+    s = explicit.ExplicitSolver(pm.mesh, [M.from_scene(sc)],
+                                np.zeros(pm.mesh.topology.index_map(3).size_local, dtype=np.int64),
+                                sc.run.safety_factor)
+    s.external = rigidwall.RigidWall(s)
+    s.set_initial(velocity=lambda X: np.tile([0.0, -300.0, 0.0], (len(X), 1)))
+    for _ in range(20):  # compile and warm up
+        s.step()
+    s.times = explicit.StepTimes()
+    comm.barrier()
+    t0 = time.perf_counter()
+    for _ in range(STEPS):
+        s.step()
+    comm.barrier()
+    full = (time.perf_counter() - t0) / STEPS
+    t0 = time.perf_counter()
+    for _ in range(STEPS):
+        s.fint[:] = 0.0
+        _cpp.fem.assemble_vector(s.fint_fn.x.array, s.form, s._consts, s._coeffs)
+        s.fint_fn.x.scatter_reverse(la.ScatterMode.add)
+    comm.barrier()
+    bare = (time.perf_counter() - t0) / STEPS
+    tm = s.times
+    split = {k: comm.allreduce(getattr(tm, k), op=MPI.MAX) / STEPS
+             for k in ("kinematics", "material", "assembly", "boundary", "update")}
+    mat = M.from_scene(sc)
+    c = float(tetra.dilatational_speed(mat.E, mat.nu, mat.density))
+    h_over_c = info["shortest_altitude_m"] / c
+    return dict(h=h_mm, cells=info["cells"], full=full, bare=bare, split=split,
+                cell_steps=info["cells"] / full, dt=s.dt0, dt_ratio=s.dt0 / h_over_c,
+                plastic=comm.allreduce(int((s.eps_p > 0).sum()), op=MPI.SUM))
+
+
+def main(sizes):
+    comm = MPI.COMM_WORLD
+    rows = [measure(h, comm) for h in sizes]
+    if comm.rank:
+        return
+    print(f"ranks: {comm.size}; {STEPS} steps after 20 warm-up steps; times per step in ms")
+    print(f"{'h_mm':>5} {'cells':>7} {'kinem':>6} {'mater':>6} {'assem':>6} {'bound':>6} {'update':>6} "
+          f"{'full':>6} {'bare':>6} {'full/bare':>9} {'Mcell-steps/s':>13} {'dt_ns':>6} {'dt/(h/c)':>8} "
+          f"{'plastic_cells':>13}")
+    for r in rows:
+        sp = r["split"]
+        print(f"{r['h']:5.2f} {r['cells']:7d} {sp['kinematics'] * 1e3:6.3f} {sp['material'] * 1e3:6.3f} "
+              f"{sp['assembly'] * 1e3:6.3f} {sp['boundary'] * 1e3:6.3f} {sp['update'] * 1e3:6.3f} "
+              f"{r['full'] * 1e3:6.3f} {r['bare'] * 1e3:6.3f} {r['full'] / r['bare']:9.2f} "
+              f"{r['cell_steps'] / 1e6:13.2f} {r['dt'] * 1e9:6.1f} {r['dt_ratio']:8.3f} {r['plastic']:13d}")
+
+
+if __name__ == "__main__":
+    main([float(a) for a in sys.argv[1:]] or [4.0, 2.5, 1.2])
