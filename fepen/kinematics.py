@@ -135,6 +135,14 @@ def volumes_and_step(x, dofs, grad0, vol0, mat, speed, nodal_vol, with_step=True
     return jmin, worst, dtmin
 
 
+@numba.njit(cache=True, inline="always", fastmath=_FAST, error_model="numpy")
+def _cofactor(a00, a01, a02, a10, a11, a12, a20, a21, a22):
+    """Cofactor matrix (J A^-T) of a 3x3 matrix given by its entries, as a 9-tuple, row-major."""
+    return (a11 * a22 - a12 * a21, a12 * a20 - a10 * a22, a10 * a21 - a11 * a20,
+            a02 * a21 - a01 * a22, a00 * a22 - a02 * a20, a01 * a20 - a00 * a21,
+            a01 * a12 - a02 * a11, a02 * a10 - a00 * a12, a00 * a11 - a01 * a10)
+
+
 @numba.njit(cache=True, fastmath=_FAST, error_model="numpy")
 def nodal_pressures(nodal_vol, nodal_vol0, bulk, out):
     """Nodal mean stress p_a = K ln(J_a) / J_a per material (Pa), J_a = V_a / V0_a; 0 where no volume."""
@@ -219,15 +227,7 @@ def stress_update(x, v, dt, dofs, grad0, vol0, mat, params, nodal_p, nodal, s, e
         a20 = F20 - 0.5 * D20
         a21 = F21 - 0.5 * D21
         a22 = F22 - 0.5 * D22
-        c00 = a11 * a22 - a12 * a21
-        c01 = a12 * a20 - a10 * a22
-        c02 = a10 * a21 - a11 * a20
-        c10 = a02 * a21 - a01 * a22
-        c11 = a00 * a22 - a02 * a20
-        c12 = a01 * a20 - a00 * a21
-        c20 = a01 * a12 - a02 * a11
-        c21 = a02 * a10 - a00 * a12
-        c22 = a00 * a11 - a01 * a10
+        c00, c01, c02, c10, c11, c12, c20, c21, c22 = _cofactor(a00, a01, a02, a10, a11, a12, a20, a21, a22)
         idet = 1.0 / (a00 * c00 + a01 * c01 + a02 * c02)
         L00 = (D00 * c00 + D01 * c01 + D02 * c02) * idet
         L01 = (D00 * c10 + D01 * c11 + D02 * c12) * idet
@@ -283,15 +283,7 @@ def stress_update(x, v, dt, dofs, grad0, vol0, mat, params, nodal_p, nodal, s, e
         de[4] = 0.5 * (L12 + L21)
         de[5] = 0.5 * (L02 + L20)
         # cofactor C = J F^-T of the end-of-step F, so that P = J sigma F^-T = sigma C
-        C00 = F11 * F22 - F12 * F21
-        C01 = F12 * F20 - F10 * F22
-        C02 = F10 * F21 - F11 * F20
-        C10 = F02 * F21 - F01 * F22
-        C11 = F00 * F22 - F02 * F20
-        C12 = F01 * F20 - F00 * F21
-        C20 = F01 * F12 - F02 * F11
-        C21 = F02 * F10 - F00 * F12
-        C22 = F00 * F11 - F01 * F10
+        C00, C01, C02, C10, C11, C12, C20, C21, C22 = _cofactor(F00, F01, F02, F10, F11, F12, F20, F21, F22)
         J = F00 * C00 + F01 * C01 + F02 * C02
         V = J * vol0[e]
         if params[m, M.KIND] == M.ELASTIC:
