@@ -153,6 +153,8 @@ SCHEMA: dict[str, Key] = {
     "target.friction": _num(0.1, "", 0.0, 2.0, doc="Coulomb coefficient, used when effects.friction"),
     "target.separation_angle_deg": _num(0.0, "deg", 0.0, 90.0, hi_open=True),
     "target.thickness": _pos(_ABSENT, "m", 100.0, doc="absent: semi-infinite"),
+    "target.lock_density": _num(2650.0, "kg/m^3", 100.0, 30000.0,
+                                doc="Q1, density of fully compacted concrete (energy crater)"),
     # --- striking conditions (Table 1; defaults are shot C3) ---
     "impact.velocity": _num(C3.v0, "m/s", 0.0, 3000.0, lo_open=True),
     "impact.obliquity_deg": _num(C3.obliquity_deg, "deg", 0.0, 90.0, hi_open=True),
@@ -340,6 +342,9 @@ def _check_consistency(flat: dict, given: dict) -> None:
         flat.pop("projectile.cavity_length", None)
     if flat["effects.charge"] and flat["projectile.cavity_diameter"] == 0.0:
         raise InputError("effects.charge", "needs a cavity to fill: projectile.cavity_diameter must be > 0")
+    if flat["target.lock_density"] <= flat["target.density"]:
+        raise InputError("target.lock_density", f"{flat['target.lock_density']:g} kg/m^3: must exceed "
+                                                f"target.density = {flat['target.density']:g} kg/m^3")
     if "target.tensile_strength" not in flat:
         flat["target.tensile_strength"] = 0.1 * flat["target.compressive_strength"]
     if "mesh.nose_size" in flat and flat["mesh.nose_size"] > flat["mesh.size"]:
