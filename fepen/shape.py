@@ -135,7 +135,84 @@ class Shape:
             m += charge_density * self.cavity_volume()
         return m
 
-    # ---- limits of the cavity ---------------------------------------------------------------------
+    # ---- outer surface, for the target law -------------------------------------------------------
+    def surface_info(self, X: np.ndarray, tol: float | None = None):
+        """Exact outward normals and curvature data of outer-surface points given in the body frame.
+
+        Args:
+            X: points on the outer surface (k, 3), body frame (tip at the origin, axis +y).
+            tol: distance tolerance (default 1e-7 L).
+
+        Returns:
+            (normal (k, 3), nan rows on edges and the ogive apex where no single normal exists;
+             radius (k,): distance from the axis;
+             R_meridian (k,): meridional radius of curvature (s on the ogive, inf elsewhere);
+             sin_phi0 (k,): sine of the angle between the surface and the axis (1 on flat faces)).
+        """
+        tol = 1e-7 * self.length if tol is None else tol
+        X = np.asarray(X, dtype=float)
+        x, y, z = X[:, 0], X[:, 1], X[:, 2]
+        r = np.hypot(x, z)
+        safe = np.maximum(r, 1e-300)
+        radial = np.stack([x / safe, np.zeros_like(r), z / safe], axis=1)
+        normal = np.full_like(X, np.nan)
+        Rm = np.full(len(X), np.inf)
+        sphi = np.zeros(len(X))
+        a, L, ln = self.radius, self.length, self.nose_length
+        on_rim = np.abs(r - a) < tol
+        rear = np.abs(y - L) < tol
+        normal[rear & ~on_rim] = [0.0, 1.0, 0.0]
+        sphi[rear] = 1.0
+        if ln == 0.0:
+            front = np.abs(y) < tol
+            normal[front & ~on_rim] = [0.0, -1.0, 0.0]
+            sphi[front] = 1.0
+            side = on_rim & ~front & ~rear
+        else:
+            s = self.ogive_radius
+            nose = (y < ln - tol) & (r > tol)
+            rc = r[nose] - (a - s)  # meridional offset from the arc centre (a - s, ln)
+            yc = y[nose] - ln
+            normal[nose] = (rc[:, None] * radial[nose] + yc[:, None] * np.array([0.0, 1.0, 0.0])) / s
+            Rm[nose] = s
+            sphi[nose] = np.abs(yc) / s
+            side = on_rim & (y >= ln - tol) & ~rear
+        normal[side] = radial[side]
+        return normal, r, Rm, sphi
+
+    def project(self, X: np.ndarray, patch: np.ndarray) -> np.ndarray:
+        """Closest points on the exact outer surface of points near it, given their patch.
+
+        Args:
+            X: points (k, 3), body frame. patch: per point 0 = lateral (ogive or shank, by y), 1 = rear face,
+               2 = flat front face.
+
+        Returns:
+            (k, 3) points on the exact surface.
+        """
+        X = np.array(X, dtype=float)
+        out = X.copy()
+        r = np.hypot(X[:, 0], X[:, 2])
+        safe = np.maximum(r, 1e-300)
+        a, ln = self.radius, self.nose_length
+        rear, front, lat = patch == 1, patch == 2, patch == 0
+        out[rear, 1] = self.length
+        out[front, 1] = 0.0
+        shank = lat & (X[:, 1] >= ln)
+        out[shank, 0] *= a / safe[shank]
+        out[shank, 2] *= a / safe[shank]
+        nose = lat & (X[:, 1] < ln)
+        if np.any(nose):
+            s = self.ogive_radius
+            rc, yc = r[nose] - (a - s), X[nose, 1] - ln  # from the arc centre (a - s, ln)
+            d = np.hypot(rc, yc)
+            rn = (a - s) + s * rc / d
+            out[nose, 1] = ln + s * yc / d
+            out[nose, 0] = X[nose, 0] * rn / safe[nose]
+            out[nose, 2] = X[nose, 2] * rn / safe[nose]
+        return out
+
+    # ---- limits of the cavity --------------------------------------------------------------------
     def _min_wall(self) -> float:
         return MIN_WALL_FRACTION * self.diameter
 
