@@ -81,7 +81,7 @@ def cmd_run(args) -> int:
     """Run one scene."""
     from mpi4py import MPI
 
-    from fepen import output, scene as fscene, shape, simulation
+    from fepen import output, results, scene as fscene, shape, simulation
 
     comm = MPI.COMM_WORLD
     sc = fscene.load(args.scene, args.sets)
@@ -93,12 +93,12 @@ def cmd_run(args) -> int:
         summary = simulation.run_scene(sc, out, comm, progress=True)
     finally:
         if (out / "history.csv").exists():
-            simulation.figures(out, comm)
+            results.figures(out, sc, comm)
     keys = ("outcome", "Hx_mm", "Hy_mm", "Tx_mm", "Ty_mm", "length_mm", "residual_speed_m_s", "max_peeq",
             "energy_error", "steps", "dt_s", "wall_s")
     _say(*(f"{k} = {summary[k]:.6g}" if isinstance(summary[k], float) else f"{k} = {summary[k]}"
            for k in keys), f"written: {out}/summary.json, history.csv, history.png"
-         + (", fields.xdmf" if sc.run.fields else ""))
+         + (", fields.xdmf" if sc.run.fields and sc.effects.fidelity != "rigid" else ""))
     return 0
 
 

@@ -10,24 +10,14 @@ both from the impact point, in mm.
 
 from __future__ import annotations
 
-import csv
-import io
 import math
 import time
-from pathlib import Path
 
 import numpy as np
 from mpi4py import MPI
 
-from fepen import explicit, materials as M, mesh as fmesh, output
-from fepen.errors import InputError, SimulationError
-
-G0 = 9.80665  # m/s^2, for accelerations in g
-
-HISTORY_COLUMNS = ["t_s", "nose_x_mm", "nose_y_mm", "tail_x_mm", "tail_y_mm", "speed_m_s", "decel_g",
-                   "vx_m_s", "vy_m_s", "force_x_N", "force_y_N", "length_mm", "kinetic_J", "internal_work_J",
-                   "external_work_J", "elastic_J", "plastic_J", "heat_J", "energy_error", "contact_nodes",
-                   "dt_s", "max_peeq"]
+from fepen import explicit, materials as M, mesh as fmesh, output, results
+from fepen.errors import InputError
 
 
 def placement(scene):
@@ -41,12 +31,14 @@ def placement(scene):
 
 def check_supported(scene) -> None:
     """Raise InputError for scene settings this version cannot simulate yet."""
-    if scene.target.kind != "rigid-wall":
-        raise InputError("target.kind", "only 'rigid-wall' can be simulated in this version; the concrete "
-                                        "cavity-expansion target is the next milestone")
-    if scene.effects.fidelity == "rigid":
-        raise InputError("effects.fidelity", "'rigid' needs the concrete target (next milestone); allowed "
-                                             "here: 'elastic', 'plastic'")
+    rigid = scene.effects.fidelity == "rigid"
+    if rigid and scene.target.kind != "concrete":
+        raise InputError("effects.fidelity", "'rigid' runs against target.kind = 'concrete'; a rigid "
+                                             "projectile on a rigid wall has nothing to compute")
+    if not rigid and scene.target.kind != "rigid-wall":
+        raise InputError("target.kind", "the deformable projectile runs against 'rigid-wall' in this version; "
+                                        "against 'concrete' use effects.fidelity = 'rigid' (the deformable "
+                                        "penetration is the next milestone)")
     if scene.effects.charge:
         raise InputError("effects.charge", "the charged projectile is not available in this version")
 
@@ -64,7 +56,6 @@ class Simulation:
     def __init__(self, scene, out, comm=MPI.COMM_WORLD, progress: bool = False):
         from fepen import rigidwall
 
-        check_supported(scene)
         self.scene, self.comm, self.progress = scene, comm, progress
         self.wall_t0 = time.perf_counter()
         self.pm = fmesh.create(scene, comm)
@@ -101,19 +92,13 @@ class Simulation:
         """Append one history row (and return it)."""
         s = self.solver
         x = s.positions()
-        tip = s.node_value(self.tip, x)
-        tail = s.node_value(self.tail, x)
-        vel = self._momentum()
         e = s.energies()
-        axis = (tip - tail) / np.linalg.norm(tip - tail)
-        force = self.wall.force
-        decel = -float(force @ axis) / s.total_mass / G0
-        row = [s.t, tip[0] * 1e3, -tip[1] * 1e3, tail[0] * 1e3, -tail[1] * 1e3, float(np.linalg.norm(vel)),
-               decel, vel[0], -vel[1], force[0], -force[1], float(np.linalg.norm(tip - tail)) * 1e3, e.kinetic,
-               e.internal_work, e.external_work, e.elastic, e.plastic, e.heat, e.balance_error,
-               self.wall.contact_nodes, s.dt, self._max_peeq()]
-        if not all(math.isfinite(v) for v in row):
-            raise SimulationError(f"non-finite state at step {s.step_count}, t = {s.t * 1e6:.3f} us")
+        en = dict(kinetic=e.kinetic, internal_work=e.internal_work, external_work=e.external_work,
+                  elastic=e.elastic, plastic=e.plastic, heat=e.heat, energy_error=e.balance_error)
+        row = results.history_row(s.t, s.node_value(self.tip, x), s.node_value(self.tail, x), self._momentum(),
+                                  self.wall.force, s.total_mass, en, self.wall.contact_nodes, s.dt,
+                                  self._max_peeq())
+        results.finite_row(row, s.step_count, s.t)
         self.rows.append(row)
         return row
 
@@ -162,7 +147,7 @@ class Simulation:
                 bar.close()
             if self.fields is not None:
                 self.fields.close()
-            self._write_history()
+            results.write_history(self.rows, self.out, self.comm)
         loop_s = time.perf_counter() - t_loop
         return self._summary(outcome, loop_s)
 
@@ -200,63 +185,23 @@ class Simulation:
         self.fields.write_function(s.u, t)
         self.fields.write_function(s.v, t)
 
-    def _write_history(self):
-        if self.comm.rank != 0:
-            return
-        buf = io.StringIO()
-        w = csv.writer(buf)
-        w.writerow(HISTORY_COLUMNS)
-        for r in self.rows:
-            w.writerow([f"{v:.9g}" for v in r])
-        output.write_text(self.out / "history.csv", buf.getvalue(), self.comm)
-
     def _summary(self, outcome: str, loop_s: float) -> dict:
         s = self.solver
-        last = self.rows[-1]
-        col = {k: i for i, k in enumerate(HISTORY_COLUMNS)}
-        depth = max(r[col["nose_y_mm"]] for r in self.rows)
-        summary = {
-            "Hx_mm": abs(last[col["nose_x_mm"]]), "Hy_mm": abs(last[col["nose_y_mm"]]),
-            "Tx_mm": abs(last[col["tail_x_mm"]]), "Ty_mm": abs(last[col["tail_y_mm"]]),
-            "depth_mm": depth, "length_mm": last[col["length_mm"]],
-            "residual_speed_m_s": last[col["speed_m_s"]], "outcome": outcome,
-            "steps": s.step_count, "dt_s": s.dt_min, "end_time_s": s.t,
-            "wall_s": time.perf_counter() - self.wall_t0,
-            "time_split_s": {"mesh": self.mesh_s, "setup_jit": self.jit_s, "time_loop": loop_s},
-            "energy_error": last[col["energy_error"]], "max_peeq": last[col["max_peeq"]],
-            "mass_kg": s.total_mass, "cells": self.pm.mesh.topology.index_map(3).size_global,
-            "ranks": self.comm.size, "scene": self.scene.as_dict(), "versions": output.versions(),
-        }
+        extra = {"steps": s.step_count, "dt_s": s.dt_min, "end_time_s": s.t,
+                 "wall_s": time.perf_counter() - self.wall_t0,
+                 "time_split_s": {"mesh": self.mesh_s, "setup_jit": self.jit_s, "time_loop": loop_s},
+                 "mass_kg": s.total_mass, "cells": self.pm.mesh.topology.index_map(3).size_global,
+                 "ranks": self.comm.size}
+        summary = results.summary(self.scene, self.rows, outcome, extra)
         output.write_json(self.out / "summary.json", summary, self.comm)
         return summary
 
 
 def run_scene(scene, out, comm=MPI.COMM_WORLD, progress=False) -> dict:
-    """Run one scene into a results directory; returns the summary."""
-    sim = Simulation(scene, out, comm, progress)
-    return sim.run()
+    """Run one scene into a results directory (the rigid or the deformable projectile); returns the summary."""
+    check_supported(scene)
+    if scene.effects.fidelity == "rigid":
+        from fepen.rigidrun import RigidRun
 
-
-def figures(out: Path, comm=MPI.COMM_WORLD) -> None:
-    """History figures of a rigid-wall run (rank 0)."""
-    if comm.rank != 0:
-        return
-    import matplotlib
-
-    matplotlib.use("Agg")
-    import matplotlib.pyplot as plt
-
-    data = np.genfromtxt(Path(out) / "history.csv", delimiter=",", names=True)
-    fig, ax = plt.subplots(1, 3, figsize=(13, 3.6))
-    t = data["t_s"] * 1e6
-    ax[0].plot(t, -data["force_y_N"] * 1e-3)
-    ax[0].set(xlabel="t (us)", ylabel="wall force (kN)")
-    ax[1].plot(t, data["length_mm"])
-    ax[1].set(xlabel="t (us)", ylabel="nose-tail length (mm)")
-    for k in ("kinetic_J", "internal_work_J", "plastic_J", "external_work_J"):
-        ax[2].plot(t, data[k], label=k)
-    ax[2].set(xlabel="t (us)", ylabel="energy (J)")
-    ax[2].legend(fontsize=7)
-    fig.tight_layout()
-    fig.savefig(Path(out) / "history.png", dpi=110)
-    plt.close(fig)
+        return RigidRun(scene, out, comm).run()
+    return Simulation(scene, out, comm, progress).run()

@@ -9,6 +9,8 @@ The target pushes on it with the normal compressive stress σ_n (and, optionally
 Laws, each in one function below:
     quasi_static_stress   σ_s of the elastic–cracked–plastic spherical cavity expansion (§4.1)
     tunnel_stress         σ_n = σ_s + B ρ0 (v·n)² where inside and v·n > 0 (§4.2)
+    wake                  no load on points moving backward along the axis (v·a < 0): behind the
+                          projectile the tunnel it has dug is open, there is no intact concrete to push
     separation            σ_n = 0 where the surface angle φ = asin(v̂·n) ≤ φ_min (§4.4)
     free-surface          the plastic zone cut by the face: σ_s with c/a → min(c/a, 1 + h/r) (§4.4)
     crater "energy"       splash-streamline energy balance: no load where the medium is thrown out (§4.3)
@@ -135,6 +137,7 @@ class SurfaceState:
         radius: distance of the point from the projectile axis (k,) (the local cavity radius).
         R_meridian: meridional radius of curvature of the surface at the point (k,), inf where flat.
         sin_phi0: sine of the angle between the surface and the axis at the point (k,) (0 on the shank).
+        axis: unit vector of the projectile axis, tail to nose (3,), or None (no wake rule).
     """
 
     x: np.ndarray
@@ -144,6 +147,7 @@ class SurfaceState:
     radius: np.ndarray
     R_meridian: np.ndarray
     sin_phi0: np.ndarray
+    axis: np.ndarray | None = None
 
 
 def inside(law: TargetLaw, x: np.ndarray) -> np.ndarray:
@@ -155,17 +159,29 @@ def inside(law: TargetLaw, x: np.ndarray) -> np.ndarray:
     return mask
 
 
+def immersion(law: TargetLaw, x: np.ndarray, area: np.ndarray) -> np.ndarray:
+    """Immersed fraction of each load point's patch, clip(½ − y/ℓ, 0, 1) with ℓ = √A (and likewise at the
+    rear face): a patch crossing the face is loaded in proportion to the part of it inside the target, so
+    the force grows continuously as the projectile enters instead of jumping point by point."""
+    ell = np.sqrt(area)
+    y = x[:, 1]
+    w = np.clip(0.5 - y / ell, 0.0, 1.0)
+    if law.thickness is not None:
+        w *= np.clip(0.5 + (y + law.thickness) / ell, 0.0, 1.0)
+    return w
+
+
 def escape_length(law: TargetLaw, x: np.ndarray, n: np.ndarray) -> np.ndarray:
     """Distance L_e from the point to the nearest free face along the outward normal (inf if the normal
     never reaches a face): the path along which crushed medium escapes (docs/theory.md §8.3)."""
-    depth = -x[:, 1]
+    depth = np.maximum(-x[:, 1], 0.0)
     ny = n[:, 1]
     L = np.full(len(x), np.inf)
     up = ny > SIN_TOL
     L[up] = depth[up] / ny[up]
     if law.thickness is not None:
         down = ny < -SIN_TOL
-        L[down] = (law.thickness - depth[down]) / (-ny[down])
+        L[down] = np.maximum(law.thickness - depth[down], 0.0) / (-ny[down])
     return L
 
 
@@ -205,13 +221,16 @@ def normal_stress(law: TargetLaw, s: SurfaceState, vhat_tol: float = SIN_TOL):
     :func:`forces` because it is a statement about the total force.
 
     Returns:
-        (σ_n (k,), inside mask (k,), v·n (k,)).
+        (σ_n (k,) (already weighted by the immersed fraction), inside mask (k,), v·n (k,)).
     """
-    ins = inside(law, s.x)
+    frac = immersion(law, s.x, s.area)
+    ins = frac > 0.0
     vn = np.einsum("ij,ij->i", s.v, s.n)
     speed = np.linalg.norm(s.v, axis=1)
     sin_phi = np.where(speed > 0.0, vn / np.maximum(speed, 1e-300), 0.0)
     loaded = ins & (sin_phi > vhat_tol)
+    if s.axis is not None:  # the wake: moving backward, a point meets the open tunnel, not concrete
+        loaded &= s.v @ s.axis > 0.0
     if law.separation:
         loaded &= sin_phi > math.sin(law.phi_min)
     sigma_s = np.full(len(vn), law.sigma_s)
@@ -224,7 +243,7 @@ def normal_stress(law: TargetLaw, s: SurfaceState, vhat_tol: float = SIN_TOL):
         ca = np.minimum(law.c_over_a, 1.0 + L_e / np.maximum(s.radius, 1e-12))
         sigma_s = law.sigma_s * quasi_static_stress(law.Y, law.E, law.T, law.lam, ca) / quasi_static_stress(
             law.Y, law.E, law.T, law.lam, law.c_over_a)
-    sig = np.where(loaded, tunnel_stress(law, vn, sigma_s), 0.0)
+    sig = np.where(loaded, tunnel_stress(law, vn, sigma_s), 0.0) * frac
     if law.crater == "energy":
         shallow = loaded & (-s.x[:, 1] < law.k * law.D)
         if np.any(shallow):

@@ -1,0 +1,124 @@
+"""What a run writes (contract): history.csv, summary.json with the Table 1 comparison, figures."""
+
+from __future__ import annotations
+
+import csv
+import io
+import math
+from pathlib import Path
+
+import numpy as np
+from mpi4py import MPI
+
+from fepen import output
+from fepen.experiments import shot
+
+G0 = 9.80665  # m/s^2, for accelerations in g
+
+HISTORY_COLUMNS = ["t_s", "nose_x_mm", "nose_y_mm", "tail_x_mm", "tail_y_mm", "speed_m_s", "decel_g",
+                   "vx_m_s", "vy_m_s", "force_x_N", "force_y_N", "length_mm", "kinetic_J", "internal_work_J",
+                   "external_work_J", "elastic_J", "plastic_J", "heat_J", "energy_error", "contact_nodes",
+                   "dt_s", "max_peeq"]
+COL = {k: i for i, k in enumerate(HISTORY_COLUMNS)}
+
+
+def history_row(t, tip, tail, velocity, force, mass, energies: dict, contact: int, dt: float, peeq: float):
+    """One history row in the reported frame: x along the face, y depth into the target (mm from O).
+
+    Args:
+        tip, tail: world positions (m) of the nose tip and tail centre. velocity: centre-of-mass velocity.
+        force: target force on the projectile (N, world). mass: projectile mass (kg).
+        energies: kinetic, internal_work, external_work, elastic, plastic, heat, energy_error (J, -).
+    """
+    axis = (tip - tail) / np.linalg.norm(tip - tail)
+    decel = -float(np.dot(force, axis)) / mass / G0
+    row = [t, tip[0] * 1e3, -tip[1] * 1e3, tail[0] * 1e3, -tail[1] * 1e3, float(np.linalg.norm(velocity)), decel,
+           velocity[0], -velocity[1], force[0], -force[1], float(np.linalg.norm(tip - tail)) * 1e3,
+           energies["kinetic"], energies["internal_work"], energies["external_work"], energies["elastic"],
+           energies["plastic"], energies["heat"], energies["energy_error"], contact, dt, peeq]
+    return row
+
+
+def write_history(rows, out: Path, comm=MPI.COMM_WORLD) -> None:
+    """history.csv (rank 0, atomically)."""
+    if comm.rank != 0:
+        return
+    buf = io.StringIO()
+    w = csv.writer(buf)
+    w.writerow(HISTORY_COLUMNS)
+    for r in rows:
+        w.writerow([f"{v:.9g}" for v in r])
+    output.write_text(Path(out) / "history.csv", buf.getvalue(), comm)
+
+
+def comparison(scene, summary: dict) -> dict | None:
+    """Errors against Table 1 when the scene names a shot: nose error |H_sim − H_exp| / |H_exp| with
+    H = (Hx, Hy) 2-vectors, likewise the tail; and each component's relative error."""
+    name = scene.get("impact.shot")
+    if name is None:
+        return None
+    s = shot(name)
+    H_exp, T_exp = np.array([s.Hx_mm, s.Hy_mm]), np.array([s.Tx_mm, s.Ty_mm])
+    H = np.array([summary["Hx_mm"], summary["Hy_mm"]])
+    T = np.array([summary["Tx_mm"], summary["Ty_mm"]])
+    return {"shot": name, "Hx_mm": s.Hx_mm, "Hy_mm": s.Hy_mm, "Tx_mm": s.Tx_mm, "Ty_mm": s.Ty_mm,
+            "nose_error": float(np.linalg.norm(H - H_exp) / np.linalg.norm(H_exp)),
+            "tail_error": float(np.linalg.norm(T - T_exp) / np.linalg.norm(T_exp)),
+            "Hy_error": float(summary["Hy_mm"] / s.Hy_mm - 1), "Ty_error": float(summary["Ty_mm"] / s.Ty_mm - 1)}
+
+
+def summary(scene, rows, outcome: str, extra: dict) -> dict:
+    """summary.json content (contract keys first)."""
+    last = rows[-1]
+    out = {"Hx_mm": abs(last[COL["nose_x_mm"]]), "Hy_mm": abs(last[COL["nose_y_mm"]]),
+           "Tx_mm": abs(last[COL["tail_x_mm"]]), "Ty_mm": abs(last[COL["tail_y_mm"]]),
+           "depth_mm": max(r[COL["nose_y_mm"]] for r in rows), "length_mm": last[COL["length_mm"]],
+           "residual_speed_m_s": last[COL["speed_m_s"]], "outcome": outcome,
+           "energy_error": max(r[COL["energy_error"]] for r in rows), "max_peeq": last[COL["max_peeq"]]}
+    out.update(extra)
+    out["experiment"] = comparison(scene, out)
+    out["scene"] = scene.as_dict()
+    out["versions"] = output.versions()
+    return out
+
+
+def figures(out: Path, scene=None, comm=MPI.COMM_WORLD) -> None:
+    """history.png: force, trajectory (with the experiment's end points when a shot is named), energies."""
+    if comm.rank != 0:
+        return
+    import matplotlib
+
+    matplotlib.use("Agg")
+    import matplotlib.pyplot as plt
+
+    data = np.genfromtxt(Path(out) / "history.csv", delimiter=",", names=True)
+    data = np.atleast_1d(data)
+    fig, ax = plt.subplots(1, 3, figsize=(14, 3.8))
+    t = data["t_s"] * 1e6
+    ax[0].plot(t, data["decel_g"] / 1e3)
+    ax[0].set(xlabel="t (us)", ylabel="deceleration (1000 g)")
+    ax[1].plot(data["nose_x_mm"], data["nose_y_mm"], label="nose tip")
+    ax[1].plot(data["tail_x_mm"], data["tail_y_mm"], label="tail centre")
+    name = scene.get("impact.shot") if scene is not None else None
+    if name:
+        s = shot(name)
+        ax[1].plot([s.Hx_mm], [s.Hy_mm], "o", color="C0", label=f"{name} nose, test")
+        ax[1].plot([s.Tx_mm], [s.Ty_mm], "s", color="C1", label=f"{name} tail, test")
+    ax[1].invert_yaxis()
+    ax[1].set(xlabel="x along the face (mm)", ylabel="depth (mm)", aspect="equal")
+    ax[1].legend(fontsize=7)
+    for k in ("kinetic_J", "internal_work_J", "plastic_J", "external_work_J"):
+        ax[2].plot(t, data[k], label=k)
+    ax[2].set(xlabel="t (us)", ylabel="energy (J)")
+    ax[2].legend(fontsize=7)
+    fig.tight_layout()
+    fig.savefig(Path(out) / "history.png", dpi=110)
+    plt.close(fig)
+
+
+def finite_row(row, step, t) -> None:
+    """Raise SimulationError if a history row holds a non-finite number."""
+    from fepen.errors import SimulationError
+
+    if not all(math.isfinite(v) for v in row):
+        raise SimulationError(f"non-finite state at step {step}, t = {t * 1e6:.3f} us")
