@@ -1,6 +1,7 @@
 # The two set-up commands of the README:
-#   make run    installs what is missing, meshes the default projectile (shot C3 scene) into results/C3 and
-#               runs the 4340 steel Taylor impact into results/taylor_4340 (until the concrete target lands)
+#   make run    installs what is missing, runs shot C3 on the default mesh with the rigid projectile into
+#               results/C3 (the deformable penetration is the next milestone), writes the mesh and its
+#               picture into results/C3-mesh, and runs the 4340 steel Taylor impact into results/taylor_4340
 #   make test   installs what is missing, then runs every test: serially, then the MPI ones on 2 ranks
 PY := .venv/bin/python
 NP ?= 2
@@ -16,7 +17,8 @@ setup:
 	@bash tools/bootstrap.sh
 
 run: setup
-	$(PY) -m fepen mesh scenes/default.toml --out results/C3
+	$(PY) -m fepen run scenes/default.toml --set effects.fidelity=rigid --out results/C3
+	$(PY) -m fepen mesh scenes/default.toml --out results/C3-mesh
 	$(PY) -m fepen run demos/verification/taylor_4340.toml --out results/taylor_4340
 
 test: setup
@@ -27,6 +29,7 @@ bench: setup
 	$(PY) benchmarks/mesh_cost.py
 	$(PY) benchmarks/step_cost.py
 	mpirun -n $(NP) $(PY) benchmarks/step_cost.py 2.5
+	$(PY) benchmarks/rigid_shot.py
 
 clean:
 	rm -rf results meshes/cache .pytest_cache

@@ -2,6 +2,7 @@
 
     fepen run SCENE.toml [--out DIR] [--set KEY=VALUE ...]
     fepen mesh SCENE.toml [--out DIR] [--set KEY=VALUE ...]
+    fepen validate [SCENE.toml] [--out DIR] [--set KEY=VALUE ...]
     fepen keys
 
 Bad input prints one line naming the key and what is allowed and exits with code 2, before anything is
@@ -34,6 +35,8 @@ def _parser() -> argparse.ArgumentParser:
 
     scene_args(sub.add_parser("run", help="one simulation: summary.json, history.csv, fields.xdmf, figures"),
                "results/run")
+    scene_args(sub.add_parser("validate", help="the Table 1 sweep: validation.csv, validation.md, figures"),
+               "results/validation")
     scene_args(sub.add_parser("mesh", help="build the projectile mesh only: mesh.json, mesh.xdmf, mesh.png"),
                "results/mesh")
     sub.add_parser("keys", help="list every scene key with its default, unit and allowed values")
@@ -102,6 +105,18 @@ def cmd_run(args) -> int:
     return 0
 
 
+def cmd_validate(args) -> int:
+    """The eight Table 1 shots."""
+    from fepen import validate
+
+    rows = validate.validate(args.scene, args.sets, args.out)
+    _say(*(f"{r['shot']}: Hx {r['Hx_mm']:.1f}/{r['Hx_exp_mm']:g} Hy {r['Hy_mm']:.1f}/{r['Hy_exp_mm']:g} "
+           f"Tx {r['Tx_mm']:.1f}/{r['Tx_exp_mm']:g} Ty {r['Ty_mm']:.1f}/{r['Ty_exp_mm']:g} mm  nose error "
+           f"{100 * r['nose_error']:.1f} %  tail error {100 * r['tail_error']:.1f} %  {r['outcome']}" for r in rows),
+         f"written: {args.out}/validation.csv, validation.md, validation.png")
+    return 0
+
+
 def cmd_keys(args) -> int:
     """Print the scene-key table (Markdown)."""
     from fepen import scene as fscene
@@ -110,7 +125,7 @@ def cmd_keys(args) -> int:
     return 0
 
 
-COMMANDS = {"run": cmd_run, "mesh": cmd_mesh, "keys": cmd_keys}
+COMMANDS = {"run": cmd_run, "mesh": cmd_mesh, "validate": cmd_validate, "keys": cmd_keys}
 
 
 def main(argv: list[str] | None = None) -> int:
