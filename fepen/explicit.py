@@ -25,7 +25,7 @@ raises SimulationError saying where and when.
 
 from __future__ import annotations
 
-from dataclasses import dataclass, field
+from dataclasses import dataclass
 
 import numpy as np
 import ufl
@@ -65,7 +65,6 @@ class StepTimes:
     assembly: float = 0.0
     boundary: float = 0.0
     update: float = 0.0
-    parts: dict = field(default_factory=dict)
 
 
 #: steps between two evaluations of the stable step
