@@ -101,7 +101,7 @@ class ExplicitSolver:
         self.n_cells = n_cells
         self.dofs = np.ascontiguousarray(V.dofmap.list.array.reshape(-1, 4)[:n_cells]).astype(np.int64)
         self.X = V.tabulate_dof_coordinates()[: self.n_nodes].copy()
-        self.grad0, self.vol0 = kinematics.reference_gradients(self.X, self.dofs)
+        self.grad0, self.vol0, self.orient = kinematics.reference_gradients(self.X, self.dofs)
         self.materials = materials
         self.params = np.stack([m.params for m in materials])
         self.mat = np.ascontiguousarray(cell_material, dtype=np.int64)
@@ -128,7 +128,7 @@ class ExplicitSolver:
         self.nodal_vol = self._nvol.array.reshape(-1, nm)
         self.nodal_vol0 = self._nvol0.array.reshape(-1, nm)
         self.nodal_p = np.zeros_like(self.nodal_vol0)
-        kinematics.volumes_and_step(self.X, self.dofs, self.grad0, self.vol0, self.mat, self.speed,
+        kinematics.volumes_and_step(self.X, self.dofs, self.orient, self.vol0, self.mat, self.speed,
                                     self.nodal_vol0)
         self._ghost_sum(self._nvol0)
 
@@ -147,6 +147,8 @@ class ExplicitSolver:
         self.eps_p = np.zeros(n_cells)
         self.temp = np.array([m.params[M.TROOM] for m in materials])[self.mat].astype(float)
         self._totals = np.zeros(4)
+        self.sy0 = np.empty(n_cells)
+        kinematics.static_flow_stress(self.mat, self.params, self.eps_p, self.temp, self.sy0)
 
         # the internal-force form, with P packed once and rewritten in place each step
         self.P = fem.Function(Q, name="P")
@@ -183,7 +185,7 @@ class ExplicitSolver:
 
     def stable_step(self) -> float:
         """Safety x min over cells of (shortest altitude / dilatational speed), current mesh, all ranks."""
-        jmin, worst, h_c = kinematics.volumes_and_step(self.positions(), self.dofs, self.grad0, self.vol0,
+        jmin, worst, h_c = kinematics.volumes_and_step(self.positions(), self.dofs, self.orient, self.vol0,
                                                        self.mat, self.speed, self.nodal_vol)
         return self.safety * self.comm.allreduce(h_c, op=MPI.MIN)
 
@@ -224,7 +226,7 @@ class ExplicitSolver:
         t0 = time.perf_counter()
         x = self.positions()
         with_step = self.step_count % STEP_EVERY == 0
-        jmin, worst, h_c = kinematics.volumes_and_step(x, self.dofs, self.grad0, self.vol0, self.mat,
+        jmin, worst, h_c = kinematics.volumes_and_step(x, self.dofs, self.orient, self.vol0, self.mat,
                                                        self.speed, self.nodal_vol, with_step)
         if not (jmin > 0.0):
             c = x[self.dofs[worst]].mean(axis=0)
@@ -238,8 +240,8 @@ class ExplicitSolver:
         if self.nodal:
             kinematics.nodal_pressures(self.nodal_vol, self.nodal_vol0, self.bulk, self.nodal_p)
         kinematics.stress_update(x, self.Vel, dt, self.dofs, self.grad0, self.vol0, self.mat, self.params,
-                                 self.nodal_p, self.nodal, self.s, self.eps_p, self.temp, self.P_packed,
-                                 self._totals)
+                                 self.nodal_p, self.nodal, self.s, self.eps_p, self.temp, self.sy0,
+                                 self.P_packed, self._totals)
         self._plastic += self._totals[0]
         self._heat += self._totals[1]
         t2 = time.perf_counter()
@@ -302,16 +304,21 @@ class ExplicitSolver:
         vol = kinematics.volumetric_energy(self.nodal_vol, self.nodal_vol0, self.bulk, self.n_owned)
         if not self.nodal:
             vol = self._element_volumetric_energy()
-        dev = float(self._totals[2])
+        dev = self._deviatoric_energy()
         sums = c.allreduce(np.array([self._w_int, self._w_ext, vol + dev, self._plastic, self._heat]),
                            op=MPI.SUM)
         return Energies(ke, sums[0], sums[1], sums[2], sums[3], sums[4], self.ke0 or 0.0)
 
+    def _cell_J(self) -> np.ndarray:
+        p = self.positions()[self.dofs]
+        return np.linalg.det(np.einsum("eai,eaj->eij", p, self.grad0))
+
+    def _deviatoric_energy(self) -> float:
+        G = np.array([m.shear_modulus for m in self.materials])[self.mat]
+        return kinematics.deviatoric_energy(self.s, self._cell_J(), self.vol0, G)
+
     def _element_volumetric_energy(self) -> float:
-        x = self.positions()
-        p = x[self.dofs]
-        J = np.einsum("eai,eaj->eij", p, self.grad0)
-        lj = np.log(np.linalg.det(J))
+        lj = np.log(self._cell_J())
         return float(np.sum(self.vol0 * 0.5 * self.bulk[self.mat] * lj * lj))
 
     # ------------------------------------------------------------------------------------------------

@@ -31,14 +31,14 @@ _FAST = {"nsz", "arcp", "contract", "afn", "reassoc"}
 
 
 def reference_gradients(X: np.ndarray, dofs: np.ndarray):
-    """Shape-function gradients and volumes of the reference cells.
+    """Shape-function gradients, volumes and orientation signs of the reference cells.
 
     Args:
         X: reference node coordinates (n_nodes, 3).
         dofs: cell node indices (n_cells, 4).
 
     Returns:
-        (grad0 (n_cells, 4, 3), vol0 (n_cells,)); vol0 > 0 whatever the node ordering.
+        (grad0 (n_cells, 4, 3), vol0 (n_cells,) > 0 whatever the node ordering, orient (n_cells,) ±1).
     """
     p = X[dofs]
     Jm = np.stack([p[:, 1] - p[:, 0], p[:, 2] - p[:, 0], p[:, 3] - p[:, 0]], axis=2)  # columns
@@ -46,8 +46,8 @@ def reference_gradients(X: np.ndarray, dofs: np.ndarray):
     grad0 = np.empty((len(dofs), 4, 3))
     grad0[:, 1:] = inv
     grad0[:, 0] = -inv.sum(axis=1)
-    vol0 = np.abs(np.linalg.det(Jm)) / 6.0
-    return grad0, vol0
+    det = np.linalg.det(Jm)
+    return grad0, np.abs(det) / 6.0, np.sign(det)
 
 
 @numba.njit(cache=True, inline="always", fastmath=_FAST, error_model="numpy")
@@ -73,12 +73,13 @@ def _inv(F, out):
 
 
 @numba.njit(cache=True, fastmath=_FAST, error_model="numpy")
-def volumes_and_step(x, dofs, grad0, vol0, mat, speed, nodal_vol, with_step=True):
+def volumes_and_step(x, dofs, orient, vol0, mat, speed, nodal_vol, with_step=True):
     """Current cell volumes into nodal volumes; the smallest J; the stable step of the current mesh.
 
     Args:
         x: current positions (n_nodes, 3).
-        dofs, grad0, vol0, mat: see module docstring.
+        dofs, vol0, mat: see module docstring. orient: +1 or −1 per cell, the sign of the reference
+            det(X1 − X0, X2 − X0, X3 − X0) (so that J > 0 for an uninverted cell whatever the node order).
         speed: dilatational wave speed per material (m/s).
         nodal_vol: (n_nodes, n_materials) output, zeroed and filled with Σ V_e / 4.
         with_step: also compute the shortest altitudes (else the third result is inf).
@@ -90,15 +91,14 @@ def volumes_and_step(x, dofs, grad0, vol0, mat, speed, nodal_vol, with_step=True
     jmin = np.inf
     worst = -1
     dtmin = np.inf
-    F = np.empty((3, 3))
     for e in range(dofs.shape[0]):
-        for i in range(3):
-            for j in range(3):
-                acc = 0.0
-                for a in range(4):
-                    acc += x[dofs[e, a], i] * grad0[e, a, j]
-                F[i, j] = acc
-        J = _det(F)
+        # J = det(x1 - x0, x2 - x0, x3 - x0) / (6 V0): needs the positions only, not the gradients
+        n0, n1, n2, n3 = dofs[e, 0], dofs[e, 1], dofs[e, 2], dofs[e, 3]
+        ax, ay, az = x[n1, 0] - x[n0, 0], x[n1, 1] - x[n0, 1], x[n1, 2] - x[n0, 2]
+        bx, by, bz = x[n2, 0] - x[n0, 0], x[n2, 1] - x[n0, 1], x[n2, 2] - x[n0, 2]
+        cx, cy, cz = x[n3, 0] - x[n0, 0], x[n3, 1] - x[n0, 1], x[n3, 2] - x[n0, 2]
+        six_v = ax * (by * cz - bz * cy) - ay * (bx * cz - bz * cx) + az * (bx * cy - by * cx)
+        J = six_v / (6.0 * vol0[e]) * orient[e]
         if not (J > jmin):
             if not (J >= jmin):  # also catches NaN
                 jmin = J
@@ -157,7 +157,8 @@ def nodal_pressures(nodal_vol, nodal_vol0, bulk, out):
 
 
 @numba.njit(cache=True, fastmath=_FAST, error_model="numpy")
-def stress_update(x, v, dt, dofs, grad0, vol0, mat, params, nodal_p, nodal, s, eps_p, temp, P_out, totals):
+def stress_update(x, v, dt, dofs, grad0, vol0, mat, params, nodal_p, nodal, s, eps_p, temp, sy0, P_out,
+                  totals):
     """Advance every cell's stress over one step and write P = J σ F^{-T} (row-major) into P_out.
 
     Written with scalars rather than 3x3 temporaries (twice as fast under numba).
@@ -169,8 +170,9 @@ def stress_update(x, v, dt, dofs, grad0, vol0, mat, params, nodal_p, nodal, s, e
         nodal_p: nodal mean stress per material (n_nodes, n_materials), from nodal_pressures.
         nodal: True for the averaged nodal pressure, False for the plain element (own J).
         s, eps_p, temp: deviatoric stress (n, 6), plastic strain (n,), temperature (n,); updated in place.
+        sy0: static flow stress σ_y(ε_p, T) of each cell (n,) (inf for elastic cells); updated in place.
         P_out: (n_cells_packed, 9) output, first n_cells rows written.
-        totals: (4,) output: plastic work, heat, deviatoric elastic energy, largest plastic increment.
+        totals: (4,) output: plastic work, heat, (unused), largest plastic increment.
     """
     nmat = params.shape[0]
     G_m = np.empty(nmat)
@@ -180,7 +182,6 @@ def stress_update(x, v, dt, dofs, grad0, vol0, mat, params, nodal_p, nodal, s, e
         K_m[m] = params[m, M.E_] / (3.0 * (1.0 - 2.0 * params[m, M.NU]))
     de = np.empty(6)
     se = np.empty(6)
-    buf = np.empty(2)
     totals[:] = 0.0
     for e in range(dofs.shape[0]):
         m = mat[e]
@@ -286,20 +287,28 @@ def stress_update(x, v, dt, dofs, grad0, vol0, mat, params, nodal_p, nodal, s, e
         C00, C01, C02, C10, C11, C12, C20, C21, C22 = _cofactor(F00, F01, F02, F10, F11, F12, F20, F21, F22)
         J = F00 * C00 + F01 * C01 + F02 * C02
         V = J * vol0[e]
-        if params[m, M.KIND] == M.ELASTIC:
-            for i in range(6):
-                se[i] += 2.0 * G * de[i]
-        else:
-            p = params[m]
-            ep_new, T_new = M.update_deviatoric(se, de, eps_p[e], temp[e], dt, p, buf)
-            eps_p[e] = ep_new
-            temp[e] = T_new
-            if buf[1] > 0.0:
-                totals[0] += buf[0] * V
-                if p[M.THERMAL_ON] > 0.0:
-                    totals[1] += p[M.BETA] * buf[0] * V
-                if buf[1] > totals[3]:
-                    totals[3] = buf[1]
+        for i in range(6):
+            se[i] += 2.0 * G * de[i]
+        if params[m, M.KIND] != M.ELASTIC:
+            # yield check against the cell's current static flow stress (kept in sy0, refreshed only
+            # when the cell yields): elastic cells pay no flow-stress evaluation
+            q = math.sqrt(1.5 * (se[0] ** 2 + se[1] ** 2 + se[2] ** 2
+                                 + 2.0 * (se[3] ** 2 + se[4] ** 2 + se[5] ** 2)))
+            if q > sy0[e]:
+                p = params[m]
+                d, sy, T_new = M.radial_return(q, eps_p[e], temp[e], dt, G, p)
+                if d > 0.0:
+                    scale = sy / q
+                    for i in range(6):
+                        se[i] *= scale
+                    eps_p[e] += d
+                    temp[e] = T_new
+                    sy0[e] = M.yield_stress(eps_p[e], 0.0, T_new, p)
+                    totals[0] += sy * d * V
+                    if p[M.THERMAL_ON] > 0.0:
+                        totals[1] += p[M.BETA] * sy * d * V
+                    if d > totals[3]:
+                        totals[3] = d
         s0 = se[0]
         s1 = se[1]
         s2 = se[2]
@@ -312,7 +321,6 @@ def stress_update(x, v, dt, dofs, grad0, vol0, mat, params, nodal_p, nodal, s, e
         s[e, 3] = s3
         s[e, 4] = s4
         s[e, 5] = s5
-        totals[2] += V * (s0 * s0 + s1 * s1 + s2 * s2 + 2.0 * (s3 * s3 + s4 * s4 + s5 * s5)) / (4.0 * G)
         if nodal:
             pm = 0.25 * (nodal_p[dofs[e, 0], m] + nodal_p[dofs[e, 1], m] + nodal_p[dofs[e, 2], m]
                          + nodal_p[dofs[e, 3], m])
@@ -331,6 +339,19 @@ def stress_update(x, v, dt, dofs, grad0, vol0, mat, params, nodal_p, nodal, s, e
         P_out[e, 6] = s5 * C00 + s4 * C10 + p22 * C20
         P_out[e, 7] = s5 * C01 + s4 * C11 + p22 * C21
         P_out[e, 8] = s5 * C02 + s4 * C12 + p22 * C22
+
+
+@numba.njit(cache=True, fastmath=_FAST, error_model="numpy")
+def static_flow_stress(mat, params, eps_p, temp, out):
+    """σ_y(ε_p, ε̇ = 0, T) of every cell into out (inf for elastic materials)."""
+    for e in range(len(mat)):
+        out[e] = M.yield_stress(eps_p[e], 0.0, temp[e], params[mat[e]])
+
+
+def deviatoric_energy(s: np.ndarray, J: np.ndarray, vol0: np.ndarray, G: np.ndarray) -> float:
+    """Σ V s:s / (4G) over cells (J): the stored deviatoric elastic energy."""
+    ss = s[:, 0] ** 2 + s[:, 1] ** 2 + s[:, 2] ** 2 + 2.0 * (s[:, 3] ** 2 + s[:, 4] ** 2 + s[:, 5] ** 2)
+    return float(np.sum(J * vol0 * ss / (4.0 * G)))
 
 
 @numba.njit(cache=True, fastmath=_FAST, error_model="numpy")

@@ -27,7 +27,7 @@ def voigt_to_mat(s):
 
 def test_gradients_reproduce_linear_fields():
     X, dofs = tets()
-    g, v0 = K.reference_gradients(X, dofs)
+    g, v0, orient = K.reference_gradients(X, dofs)
     assert np.allclose(g.sum(axis=1), 0.0, atol=1e-12)
     F = np.einsum("eai,eaj->eij", X[dofs], g)
     assert np.allclose(F, np.eye(3), atol=1e-12)
@@ -36,22 +36,24 @@ def test_gradients_reproduce_linear_fields():
 
 def run_motion(X, dofs, positions, dt, s0, material, nodal=True):
     """Drive the stress kernel through a prescribed sequence of node positions."""
-    g, v0 = K.reference_gradients(X, dofs)
+    g, v0, orient = K.reference_gradients(X, dofs)
     n = len(dofs)
     mat = np.zeros(n, dtype=np.int64)
     params = material.params[None]
     s = np.tile(s0, (n, 1))
     ep, T = np.zeros(n), np.full(n, 294.0)
+    sy0 = np.empty(n)
+    K.static_flow_stress(mat, params, ep, T, sy0)
     P = np.zeros((n, 9))
     tot = np.zeros(4)
     nv, nv0, npres = np.zeros((len(X), 1)), np.zeros((len(X), 1)), np.zeros((len(X), 1))
     speed = np.array([6000.0])
-    K.volumes_and_step(X, dofs, g, v0, mat, speed, nv0)
+    K.volumes_and_step(X, dofs, orient, v0, mat, speed, nv0)
     for a, b in zip(positions[:-1], positions[1:]):
         v = (b - a) / dt
-        K.volumes_and_step(b, dofs, g, v0, mat, speed, nv)
+        K.volumes_and_step(b, dofs, orient, v0, mat, speed, nv)
         K.nodal_pressures(nv, nv0, np.array([material.bulk_modulus]), npres)
-        K.stress_update(b, v, dt, dofs, g, v0, mat, params, npres, nodal, s, ep, T, P, tot)
+        K.stress_update(b, v, dt, dofs, g, v0, mat, params, npres, nodal, s, ep, T, sy0, P, tot)
     return s, P, ep
 
 
