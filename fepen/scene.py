@@ -152,6 +152,8 @@ SCHEMA: dict[str, Key] = {
     "target.inertial_factor": _num(1.0, "", 0.0, 10.0, doc="B of sigma_n = sigma_s + B rho (v.n)^2"),
     "target.friction": _num(0.1, "", 0.0, 2.0, doc="Coulomb coefficient, used when effects.friction"),
     "target.separation_angle_deg": _num(0.0, "deg", 0.0, 90.0, hi_open=True),
+    "target.onset_angle_deg": _num(0.0, "deg", 0.0, 30.0,
+                                   doc="sigma_s develops over this first surface angle (0: at once)"),
     "target.thickness": _pos(_ABSENT, "m", 100.0, doc="absent: semi-infinite"),
     "target.lock_density": _num(2650.0, "kg/m^3", 100.0, 30000.0,
                                 doc="Q1, density of fully compacted concrete (energy crater)"),

@@ -111,6 +111,7 @@ class TargetLaw:
     crush_strain: float = 0.094
     c_over_a: float = 1.0
     given_sigma_s: bool = False
+    onset: float = 0.0
 
 
 def law_from_scene(scene) -> TargetLaw:
@@ -125,7 +126,8 @@ def law_from_scene(scene) -> TargetLaw:
         D=scene.projectile.diameter, separation=e.separation, phi_min=math.radians(t.separation_angle_deg),
         free_surface=e.free_surface, friction=e.friction, mu=t.friction,
         lock_density=t.lock_density, crush_strain=1.0 - t.density / t.lock_density,
-        c_over_a=cavity_ratio(Y, E, T), given_sigma_s=given is not None)
+        c_over_a=cavity_ratio(Y, E, T), given_sigma_s=given is not None,
+        onset=math.radians(t.onset_angle_deg))
 
 
 @dataclass
@@ -243,6 +245,8 @@ def normal_stress(law: TargetLaw, s: SurfaceState, vhat_tol: float = SIN_TOL):
         ca = np.minimum(law.c_over_a, 1.0 + L_e / np.maximum(s.radius, 1e-12))
         sigma_s = law.sigma_s * quasi_static_stress(law.Y, law.E, law.T, law.lam, ca) / quasi_static_stress(
             law.Y, law.E, law.T, law.lam, law.c_over_a)
+    if law.onset > 0.0:  # σ_s develops over the first `onset` of surface angle (grazing: no expansion)
+        sigma_s = sigma_s * np.minimum(sin_phi / math.sin(law.onset), 1.0)
     sig = np.where(loaded, tunnel_stress(law, vn, sigma_s), 0.0) * frac
     if law.crater == "energy":
         shallow = loaded & (-s.x[:, 1] < law.k * law.D)

@@ -166,3 +166,17 @@ def test_immersion_is_the_submerged_fraction_of_a_patch():
     x = np.stack([np.zeros_like(y), y, np.zeros_like(y)], axis=1)
     w = tg.immersion(L, x, np.full(len(y), A))
     assert np.allclose(w, [0, 0, 0.5, 1, 1, 1, 0.5, 0, 0])
+
+
+def test_sigma_s_onset_ramps_over_the_first_degrees():
+    """target.onset_angle_deg: sigma_s grows linearly in sin(phi) up to the onset angle, then is whole."""
+    L = law(onset=math.radians(2.0))
+    ang = np.radians([0.5, 1.0, 5.0])
+    n = np.stack([np.cos(ang), -np.sin(ang), 0 * ang], axis=1)
+    st = tg.SurfaceState(np.array([[0, -0.05, 0]] * 3), np.array([[0, -300.0, 0]] * 3), n, np.full(3, SMALL),
+                         np.ones(3), np.full(3, np.inf), np.zeros(3))
+    sig, _, vn = tg.normal_stress(L, st)
+    inertial = 2400 * vn**2
+    ramp = np.sin(ang[:2]) / math.sin(math.radians(2.0))
+    assert sig[:2] == pytest.approx(300e6 * ramp + inertial[:2], rel=1e-12)
+    assert sig[2] == pytest.approx(300e6 + inertial[2], rel=1e-12)
