@@ -35,10 +35,6 @@ def check_supported(scene) -> None:
     if rigid and scene.target.kind != "concrete":
         raise InputError("effects.fidelity", "'rigid' runs against target.kind = 'concrete'; a rigid "
                                              "projectile on a rigid wall has nothing to compute")
-    if not rigid and scene.target.kind != "rigid-wall":
-        raise InputError("target.kind", "the deformable projectile runs against 'rigid-wall' in this version; "
-                                        "against 'concrete' use effects.fidelity = 'rigid' (the deformable "
-                                        "penetration is the next milestone)")
     if scene.effects.charge:
         raise InputError("effects.charge", "the charged projectile is not available in this version")
 
@@ -65,14 +61,25 @@ class Simulation:
         cellmat = np.zeros(self.pm.mesh.topology.index_map(3).size_local, dtype=np.int64)
         t0 = time.perf_counter()
         self.solver = explicit.ExplicitSolver(self.pm.mesh, mats, cellmat, scene.run.safety_factor)
-        self.wall = rigidwall.RigidWall(self.solver)
-        self.solver.external = self.wall
-        R, v = placement(scene)
-        self.R = R
-        self.solver.set_initial(displacement=lambda X: X @ R.T - X, velocity=lambda X: np.tile(v, (len(X), 1)))
-        self.jit_s = time.perf_counter() - t0
         self.tip = self.solver.node_at((0.0, 0.0, 0.0))
         self.tail = self.solver.node_at((0.0, self.pm.shape.length, 0.0))
+        R, v = placement(scene)
+        self.R, self.v0 = R, float(np.linalg.norm(v))
+        self.concrete = scene.target.kind == "concrete"
+        if self.concrete:
+            from fepen import concrete, surface, target as tg
+
+            law = tg.law_from_scene(scene)
+            crater = (tg.ForrestalCrater(law, self.solver.total_mass, self.v0, scene.projectile.crh)
+                      if law.crater == "linear" else None)
+            surf = surface.outer_surface(self.solver.V, self.pm.facet_tags, self.pm.shape)
+            self.load = concrete.ConcreteLoad(self.solver, surf, law, self.tip, self.tail, crater)
+            self.surf, self.law = surf, law
+        else:
+            self.load = rigidwall.RigidWall(self.solver)
+        self.solver.external = self.load
+        self.solver.set_initial(displacement=lambda X: X @ R.T - X, velocity=lambda X: np.tile(v, (len(X), 1)))
+        self.jit_s = time.perf_counter() - t0
         self.rows: list[list[float]] = []
         self.fields = None
 
@@ -96,7 +103,7 @@ class Simulation:
         en = dict(kinetic=e.kinetic, internal_work=e.internal_work, external_work=e.external_work,
                   elastic=e.elastic, plastic=e.plastic, heat=e.heat, energy_error=e.balance_error)
         row = results.history_row(s.t, s.node_value(self.tip, x), s.node_value(self.tail, x), self._momentum(),
-                                  self.wall.force, s.total_mass, en, self.wall.contact_nodes, s.dt,
+                                  self.load.force, s.total_mass, en, self.load.contact_nodes, s.dt,
                                   self._max_peeq())
         results.finite_row(row, s.step_count, s.t)
         self.rows.append(row)
@@ -132,7 +139,13 @@ class Simulation:
                 if bar is not None and s.step_count % 200 == 0:
                     bar.n = round(s.t * 1e6)
                     bar.refresh()
-                if self.wall.contact_nodes > 0:
+                if self.concrete:
+                    outcome = self._penetration_event(s, end)
+                    if outcome != "running":
+                        break
+                    outcome = "ended"
+                    continue
+                if self.load.contact_nodes > 0:
                     touched, free_since = True, None
                 elif touched and free_since is None:
                     free_since = s.t
@@ -150,6 +163,32 @@ class Simulation:
             results.write_history(self.rows, self.out, self.comm)
         loop_s = time.perf_counter() - t_loop
         return self._summary(outcome, loop_s)
+
+    def _penetration_event(self, s, end) -> str:
+        """Stop events in the concrete target, checked every 20 steps: "embedded" (the centre of mass has
+        stopped advancing along the axis, or its kinetic energy is below 1e-5 of the initial),
+        "perforated" (every load point beyond the rear face), "ricochet" (back above the face, moving away),
+        else "running"."""
+        if s.step_count % 20:
+            return "running"
+        x_all = s.positions()
+        pts = self.surf.kinematics(x_all, s.Vel)[0]
+        ymin = self.comm.allreduce(float(pts[:, 1].min()) if len(pts) else np.inf, op=MPI.MIN)
+        ymax = self.comm.allreduce(float(pts[:, 1].max()) if len(pts) else -np.inf, op=MPI.MAX)
+        self._entered = getattr(self, "_entered", False) or ymin < 0.0
+        if not self._entered:
+            return "running"
+        vcm = self._momentum()
+        if self.law.thickness is not None and ymax < -self.law.thickness:
+            return "perforated"
+        if ymin > 0.0 and vcm[1] > 0.0:
+            return "ricochet"
+        if end is None:
+            tip, tail = s.node_value(self.tip, x_all), s.node_value(self.tail, x_all)
+            axis = (tip - tail) / np.linalg.norm(tip - tail)
+            if float(vcm @ axis) <= 0.0 or 0.5 * s.total_mass * float(vcm @ vcm) < 1e-5 * s.ke0:
+                return "embedded"
+        return "running"
 
     # ------------------------------------------------------------------------------------------------
     def _open_fields(self):
