@@ -1,7 +1,7 @@
 # The two set-up commands of the README:
-#   make run    installs what is missing, runs shot C3 on the default mesh with the rigid projectile into
-#               results/C3 (the deformable penetration is the next milestone), writes the mesh and its
-#               picture into results/C3-mesh, and runs the 4340 steel Taylor impact into results/taylor_4340
+#   make run    installs what is missing, runs the default scene (Table 1 shot C3, plastic projectile in the
+#               concrete target, default mesh) on $(NP) ranks into results/C3, the same shot with the rigid
+#               projectile into results/C3-rigid, and the mesh with its picture into results/C3-mesh
 #   make test   installs what is missing, then runs every test: serially, then the MPI ones on 2 ranks
 PY := .venv/bin/python
 NP ?= 2
@@ -17,9 +17,9 @@ setup:
 	@bash tools/bootstrap.sh
 
 run: setup
-	$(PY) -m fepen run scenes/default.toml --set effects.fidelity=rigid --out results/C3
+	mpirun -n $(NP) $(PY) -m fepen run scenes/default.toml --out results/C3
+	$(PY) -m fepen run scenes/default.toml --set effects.fidelity=rigid --out results/C3-rigid
 	$(PY) -m fepen mesh scenes/default.toml --out results/C3-mesh
-	$(PY) -m fepen run demos/verification/taylor_4340.toml --out results/taylor_4340
 
 test: setup
 	$(PY) -m pytest -q tests
