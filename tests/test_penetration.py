@@ -26,6 +26,16 @@ def test_stiff_projectile_reproduces_the_rigid_one(tmp_path):
     assert abs(deform["length_mm"] - 144.0) < 0.5  # elastic: the length comes back
     s = json.loads((tmp_path / "elastic" / "summary.json").read_text())
     assert s["max_peeq"] == 0.0
+    # the paper's analyses: hazard map along the axis and the eight strain gauges
+    haz = np.loadtxt(tmp_path / "elastic" / "hazard.csv", delimiter=",", skiprows=1)
+    assert haz[:, 0].max() > 140.0 and np.all(haz[:, 1] == 0.0)  # elastic: no plastic strain anywhere
+    gauges = np.loadtxt(tmp_path / "elastic" / "strains.csv", delimiter=",", skiprows=1)
+    assert gauges.shape[1] == 9 and gauges.shape[0] > 10
+    # at normal incidence the projectile is compressed axially, about equally on all four sides
+    peak = np.abs(gauges[:, 1:5]).max(axis=0)
+    assert peak.min() > 1e-5 and peak.max() / peak.min() < 3.0
+    for f in ("deformed.png", "hazard.png"):
+        assert (tmp_path / "elastic" / f).stat().st_size > 5000
 
 
 def short_history(comm):

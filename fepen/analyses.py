@@ -1,0 +1,149 @@
+"""The paper's analyses of a deformable run (physics.md §8), gathered on rank 0.
+
+- Hazard map: the largest equivalent plastic strain of the surface cells (cells with a face on the outer
+  surface) in axial bins along the projectile, from the nose (``hazard.csv``, ``hazard.png``).
+- Strain gauges: four surface cells — top (+x), bottom (−x), two sides (±z) in the body frame, where x is
+  the plane of incidence — at 1/3 L and 1/2 L from the nose; their axial logarithmic strain
+  ln |F a0| (a0 the reference axis) over time (``strains.csv``). Bending shows as top/bottom ≫ sides.
+- The deformed projectile, cut in the plane of incidence, coloured by PEEQ (``deformed.png``).
+"""
+
+from __future__ import annotations
+
+from pathlib import Path
+
+import numpy as np
+from mpi4py import MPI
+
+from fepen import geometry
+
+GAUGE_NAMES = ["top", "bottom", "side+", "side-"]
+GAUGE_DIRECTIONS = np.array([[1.0, 0.0, 0.0], [-1.0, 0.0, 0.0], [0.0, 0.0, 1.0], [0.0, 0.0, -1.0]])
+
+
+def surface_cells(pm, n_cells: int) -> np.ndarray:
+    """Local indices of the owned cells having a face on the outer surface."""
+    mesh = pm.mesh
+    tdim = mesh.topology.dim
+    mesh.topology.create_connectivity(tdim - 1, tdim)
+    f2c = mesh.topology.connectivity(tdim - 1, tdim)
+    cells = {int(f2c.links(f)[0]) for f in pm.facet_tags.find(geometry.OUTER)}
+    return np.array(sorted(c for c in cells if c < n_cells), dtype=np.int64)
+
+
+class Gauges:
+    """The eight strain-gauge cells and the surface cells of the hazard map of an ExplicitSolver.
+
+    Args:
+        solver: the ExplicitSolver. pm: its ProjectileMesh.
+    """
+
+    def __init__(self, solver, pm):
+        self.solver, self.comm = solver, solver.comm
+        L, a = pm.shape.length, pm.shape.radius
+        self.surface = surface_cells(pm, solver.n_cells)
+        centres = solver.X[solver.dofs].mean(axis=1)
+        self.surface_y = centres[self.surface, 1]  # reference axial position from the nose
+        self.targets = [(frac, name, np.array([0.0, frac * L, 0.0]) + a * d)
+                        for frac in (1 / 3, 1 / 2) for name, d in zip(GAUGE_NAMES, GAUGE_DIRECTIONS)]
+        self.cells = []
+        for _, _, p in self.targets:  # the owned surface cell nearest to each gauge point, on one rank
+            if len(self.surface):
+                d = np.linalg.norm(centres[self.surface] - p, axis=1)
+                k = int(np.argmin(d))
+                best = (float(d[k]), self.comm.rank)
+            else:
+                best, k = (np.inf, self.comm.rank), -1
+            winner = self.comm.allreduce(best, op=MPI.MIN)
+            self.cells.append(int(self.surface[k]) if winner[1] == self.comm.rank else -1)
+        self.columns = ["t_s"] + [f"{name}_{round(frac * 100)}pctL" for frac, name, _ in self.targets]
+        self.rows = []
+
+    def axial_strains(self) -> list[float]:
+        """Axial logarithmic strain ln|F a0| of the gauge cells (a0 = reference axis), every rank."""
+        s = self.solver
+        x = s.positions()
+        out = []
+        for c in self.cells:
+            val = 0.0
+            if c >= 0:
+                F = np.einsum("ai,aj->ij", x[s.dofs[c]], s.grad0[c])
+                val = float(np.log(np.linalg.norm(F @ np.array([0.0, 1.0, 0.0]))))
+            out.append(val)
+        return list(self.comm.allreduce(np.array(out), op=MPI.SUM))
+
+    def record(self) -> None:
+        self.rows.append([self.solver.t, *self.axial_strains()])
+
+    def hazard(self, bin_mm: float = 2.0):
+        """(axial bin centres from the nose in mm, largest surface-cell PEEQ per bin) on rank 0, else None."""
+        s = self.solver
+        parts = self.comm.gather((self.surface_y, s.eps_p[self.surface]), root=0)
+        if self.comm.rank:
+            return None
+        y = np.concatenate([p[0] for p in parts]) * 1e3
+        e = np.concatenate([p[1] for p in parts])
+        edges = np.arange(0.0, y.max() + bin_mm, bin_mm)
+        idx = np.clip(np.digitize(y, edges) - 1, 0, len(edges) - 2)
+        peak = np.zeros(len(edges) - 1)
+        np.maximum.at(peak, idx, e)
+        return 0.5 * (edges[1:] + edges[:-1]), peak
+
+    def write(self, out: Path) -> None:
+        """strains.csv, hazard.csv and hazard.png (rank 0)."""
+        haz = self.hazard()
+        if self.comm.rank:
+            return
+        out = Path(out)
+        np.savetxt(out / "strains.csv", np.array(self.rows), delimiter=",", header=",".join(self.columns),
+                   comments="", fmt="%.9g")
+        np.savetxt(out / "hazard.csv", np.column_stack(haz), delimiter=",",
+                   header="axial_from_nose_mm,max_surface_peeq", comments="", fmt="%.6g")
+        import matplotlib
+
+        matplotlib.use("Agg")
+        import matplotlib.pyplot as plt
+
+        fig, ax = plt.subplots(1, 2, figsize=(12, 3.8))
+        ax[0].plot(*haz)
+        ax[0].set(xlabel="distance from the nose (mm)", ylabel="max surface PEEQ", title="hazard map")
+        d = np.array(self.rows)
+        for k, name in enumerate(self.columns[1:]):
+            ax[1].plot(d[:, 0] * 1e6, d[:, k + 1] * 1e3, label=name, ls="-" if "33" in name else "--")
+        ax[1].set(xlabel="t (us)", ylabel="axial strain (1e-3)", title="surface cells at L/3 and L/2")
+        ax[1].legend(fontsize=6, ncol=2)
+        fig.tight_layout()
+        fig.savefig(out / "hazard.png", dpi=110)
+        plt.close(fig)
+
+
+def deformed_picture(solver, path: Path, title: str = "") -> None:
+    """Half of the deformed projectile (cells with z <= 0 in the body frame), coloured by PEEQ."""
+    from fepen.figures import pyvista
+
+    comm = solver.comm
+    x = solver.positions()
+    p = x[solver.dofs]
+    centres0 = solver.X[solver.dofs].mean(axis=1)
+    keep = centres0[:, 2] <= 0.0
+    parts = comm.gather((p[keep], solver.eps_p[keep]), root=0)
+    if comm.rank:
+        return
+    pts = np.concatenate([q[0] for q in parts])
+    peeq = np.concatenate([q[1] for q in parts])
+    pv = pyvista()
+    n = len(pts)
+    cells = np.hstack([np.full((n, 1), 4), np.arange(4 * n).reshape(n, 4)]).ravel()
+    grid = pv.UnstructuredGrid(cells, np.full(n, pv.CellType.TETRA, dtype=np.uint8), pts.reshape(-1, 3) * 1e3)
+    grid.cell_data["PEEQ"] = peeq
+    plotter = pv.Plotter(off_screen=True, window_size=(1400, 700))
+    plotter.set_background("white")
+    # no scalar bar: VTK's bar formats its labels with std::regex, which crashes beside the libstdc++ that
+    # dolfinx loads; the colour range is written as text instead
+    hi = max(float(peeq.max()), 1e-12)
+    plotter.add_mesh(grid, scalars="PEEQ", cmap="inferno", clim=(0.0, hi), show_edges=False,
+                     show_scalar_bar=False)
+    plotter.view_vector((0.0, 0.0, 1.0), viewup=(0.0, 1.0, 0.0))
+    plotter.add_text(f"{title}\nPEEQ colour scale: black 0 ... yellow {hi:.3g}", font_size=10, color="black")
+    plotter.screenshot(str(path))
+    plotter.close()
