@@ -38,9 +38,13 @@ def validate(scene_path, sets, out, comm=MPI.COMM_WORLD) -> list[dict]:
         simulation.check_supported(sc)
     out = output.prepare(out, comm)
     rows = []
+    summaries = _side_by_side(scenes, out) if _parallel(scenes, comm) else {}
     for name, sc in scenes.items():
-        s = simulation.run_scene(sc, out / name, comm)
-        results.figures(out / name, sc, comm)
+        if name in summaries:
+            s = summaries[name]
+        else:
+            s = simulation.run_scene(sc, out / name, comm)
+            results.figures(out / name, sc, comm)
         e = SHOTS[name]
         rows.append({"shot": name, "v0_m_s": e.v0, "obliquity_deg": e.obliquity_deg, "attack_deg": e.attack_deg,
                      "Hx_mm": s["Hx_mm"], "Hy_mm": s["Hy_mm"], "Tx_mm": s["Tx_mm"], "Ty_mm": s["Ty_mm"],
@@ -56,7 +60,68 @@ def validate(scene_path, sets, out, comm=MPI.COMM_WORLD) -> list[dict]:
         output.write_text(out / "validation.csv", buf.getvalue(), comm)
         output.write_text(out / "validation.md", table(rows, scenes["C1"]), comm)
         figure(rows, out)
+        if all((out / r["shot"] / "hazard.csv").is_file() for r in rows):
+            hazard_figure(out)
     return rows
+
+
+def _parallel(scenes, comm) -> bool:
+    """Shots side by side: one rank, a deformable projectile (rigid shots take a second), several cores."""
+    import os
+
+    fid = next(iter(scenes.values())).effects.fidelity
+    return comm.size == 1 and fid != "rigid" and (os.cpu_count() or 1) > 1
+
+
+def _side_by_side(scenes, out: Path) -> dict:
+    """Run each shot as its own ``fepen run`` process, as many at once as there are cores."""
+    import json
+    import os
+    import subprocess
+    import sys
+    import time
+
+    todo = list(scenes.items())
+    running = []
+    workers = min(os.cpu_count() or 1, len(todo))
+    while todo or running:
+        while todo and len(running) < workers:
+            name, sc = todo.pop(0)
+            d = output.prepare(out / name, MPI.COMM_SELF)
+            output.write_text(d / "scene.toml", fscene.to_toml(sc), MPI.COMM_SELF)
+            log = open(d / "run.log", "w")
+            proc = subprocess.Popen([sys.executable, "-m", "fepen", "run", str(d / "scene.toml"), "--out", str(d)],
+                                    stdout=log, stderr=subprocess.STDOUT)
+            running.append((name, proc, log))
+        time.sleep(0.5)
+        for item in list(running):
+            name, proc, log = item
+            if proc.poll() is not None:
+                log.close()
+                running.remove(item)
+                if proc.returncode != 0:
+                    raise RuntimeError(f"shot {name} failed (exit {proc.returncode}); see {out / name / 'run.log'}")
+    return {name: json.loads((out / name / "summary.json").read_text()) for name in scenes}
+
+
+def hazard_figure(out: Path) -> None:
+    """Hazard maps (max surface PEEQ along the axis) overlaid: C2/C3/C6 (angle) and C3/C4/C5 (speed)."""
+    import matplotlib
+
+    matplotlib.use("Agg")
+    import matplotlib.pyplot as plt
+
+    fig, ax = plt.subplots(1, 2, figsize=(12, 3.8))
+    for a, (group, what) in zip(ax, ((("C2", "C3", "C6"), "obliquity"), (("C3", "C4", "C5"), "speed"))):
+        for name in group:
+            d = np.loadtxt(Path(out) / name / "hazard.csv", delimiter=",", skiprows=1)
+            e = SHOTS[name]
+            a.plot(d[:, 0], d[:, 1], label=f"{name}: {e.v0:g} m/s, {e.obliquity_deg:g}°")
+        a.set(xlabel="distance from the nose (mm)", ylabel="max surface PEEQ", title=f"hazard map by {what}")
+        a.legend(fontsize=8)
+    fig.tight_layout()
+    fig.savefig(Path(out) / "hazard_maps.png", dpi=110)
+    plt.close(fig)
 
 
 def table(rows, sc) -> str:
