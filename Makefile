@@ -30,6 +30,7 @@ bench: setup
 	$(PY) benchmarks/step_cost.py
 	mpirun -n $(NP) $(PY) benchmarks/step_cost.py 2.5
 	$(PY) benchmarks/rigid_shot.py
+	$(PY) benchmarks/shot_cost.py 1 2
 
 clean:
 	rm -rf results meshes/cache .pytest_cache
