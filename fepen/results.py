@@ -18,16 +18,18 @@ G0 = 9.80665  # m/s^2, for accelerations in g
 HISTORY_COLUMNS = ["t_s", "nose_x_mm", "nose_y_mm", "tail_x_mm", "tail_y_mm", "speed_m_s", "decel_g",
                    "vx_m_s", "vy_m_s", "force_x_N", "force_y_N", "length_mm", "kinetic_J", "internal_work_J",
                    "external_work_J", "elastic_J", "plastic_J", "heat_J", "energy_error", "contact_nodes",
-                   "dt_s", "max_peeq"]
+                   "dt_s", "max_peeq", "contact_area_m2"]
 COL = {k: i for i, k in enumerate(HISTORY_COLUMNS)}
 
 
-def history_row(t, tip, tail, velocity, force, mass, energies: dict, contact: int, dt: float, peeq: float):
+def history_row(t, tip, tail, velocity, force, mass, energies: dict, contact: int, dt: float, peeq: float,
+                contact_area: float = 0.0):
     """One history row in the reported frame: x along the face, y depth into the target (mm from O).
 
     Args:
         tip, tail: world positions (m) of the nose tip and tail centre. velocity: centre-of-mass velocity.
         force: target force on the projectile (N, world). mass: projectile mass (kg).
+        contact: number of loaded points (nodes on a rigid wall); contact_area: loaded area (m^2).
         energies: kinetic, internal_work, external_work, elastic, plastic, heat, energy_error (J, -).
     """
     axis = (tip - tail) / np.linalg.norm(tip - tail)
@@ -35,7 +37,7 @@ def history_row(t, tip, tail, velocity, force, mass, energies: dict, contact: in
     row = [t, tip[0] * 1e3, -tip[1] * 1e3, tail[0] * 1e3, -tail[1] * 1e3, float(np.linalg.norm(velocity)), decel,
            velocity[0], -velocity[1], force[0], -force[1], float(np.linalg.norm(tip - tail)) * 1e3,
            energies["kinetic"], energies["internal_work"], energies["external_work"], energies["elastic"],
-           energies["plastic"], energies["heat"], energies["energy_error"], contact, dt, peeq]
+           energies["plastic"], energies["heat"], energies["energy_error"], contact, dt, peeq, contact_area]
     return row
 
 

@@ -86,8 +86,8 @@ class RigidRun:
         self.rows = []
         self.w_ext = 0.0
         self.ke0 = self.body.kinetic_energy(self.state)
-        self.last_force = np.zeros(3)
         self.loaded = 0
+        self.area = 0.0
 
     # ------------------------------------------------------------------------------------------------
     def force_fn(self, s: RigidState, x, v, n):
@@ -96,12 +96,14 @@ class RigidRun:
         idx = np.flatnonzero(tg.immersion(self.law, x, self.pts["area0"]) > 0.0)
         self.loaded = len(idx)
         if len(idx) == 0:
+            self.area = 0.0
             return f
         g = self.pts
         axis = self.axis(s)
         st = tg.SurfaceState(x[idx], v[idx], n[idx], g["area0"][idx], g["radius"][idx], g["R_meridian"][idx],
                              g["sin_phi0"][idx], axis)
-        fi, _ = tg.forces(self.law, st)
+        fi, sig = tg.forces(self.law, st)
+        self.area = float(g["area0"][idx][sig > 0.0].sum())
         if self.crater is not None:
             tip = self.body.to_world(s, self.tip_ref[None])[0]
             fi *= self.crater.scale(-tip[1], -float(fi.sum(axis=0) @ axis))
@@ -119,7 +121,8 @@ class RigidRun:
         err = abs(ke - self.ke0 - self.w_ext) / self.ke0
         en = dict(kinetic=ke, internal_work=0.0, external_work=self.w_ext, elastic=0.0, plastic=0.0, heat=0.0,
                   energy_error=err)
-        row = results.history_row(self.t, tip, tail, s.V, force, self.mass, en, self.loaded, self.dt, 0.0)
+        row = results.history_row(self.t, tip, tail, s.V, force, self.mass, en, self.loaded, self.dt, 0.0,
+                                  self.area)
         results.finite_row(row, self.steps, self.t)
         self.rows.append(row)
 

@@ -108,7 +108,7 @@ class Simulation:
                   elastic=e.elastic, plastic=e.plastic, heat=e.heat, energy_error=e.balance_error)
         row = results.history_row(s.t, s.node_value(self.tip, x), s.node_value(self.tail, x), self._momentum(),
                                   self.load.force, s.total_mass, en, self.load.contact_nodes, s.dt,
-                                  self._max_peeq())
+                                  self._max_peeq(), getattr(self.load, "area", 0.0))
         results.finite_row(row, s.step_count, s.t)
         self.rows.append(row)
         self.gauges.record()

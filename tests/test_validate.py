@@ -41,5 +41,10 @@ def test_run_names_the_experiment_errors(fepen_cli, tmp_path):
               "energy_error", "max_peeq", "mass_kg", "cells", "ranks", "versions"):
         assert k in s
     header = (tmp_path / "history.csv").read_text().splitlines()[0].split(",")
-    for k in ("t_s", "nose_x_mm", "nose_y_mm", "tail_x_mm", "tail_y_mm", "speed_m_s", "decel_g"):
+    for k in ("t_s", "nose_x_mm", "nose_y_mm", "tail_x_mm", "tail_y_mm", "speed_m_s", "decel_g", "contact_area_m2"):
         assert k in header
+    import numpy as np
+
+    h = np.genfromtxt(tmp_path / "history.csv", delimiter=",", names=True)
+    # loaded area: at most the nose's lateral area plus the shank side, at least some of the nose
+    assert 1e-4 < h["contact_area_m2"].max() < 6e-3
