@@ -130,6 +130,7 @@ class Simulation:
             bar = tqdm(total=round(hard_end * 1e6), unit="us", desc="fepen", leave=False)
         t_loop = time.perf_counter()
         outcome = "ended"
+        completed = False
         try:
             if sc.run.fields:
                 self._open_fields()
@@ -162,14 +163,15 @@ class Simulation:
             self.record()
             if self.fields is not None:
                 self._write_fields()
+            completed = True
         finally:
             if bar is not None:
                 bar.close()
             if self.fields is not None:
                 self.fields.close()
             t_out = time.perf_counter()
-            results.write_history(self.rows, self.out, self.comm)
-            if self.out is not None:
+            results.write_history(self.rows, self.out, self.comm)  # kept even when the run failed
+            if completed:
                 from fepen import analyses
 
                 self.gauges.write(self.out)
