@@ -215,8 +215,12 @@ class Simulation:
         self.fields = XDMFFile(self.comm, str(self.out / "fields.xdmf"), "w")
         self.fields.write_mesh(self.pm.mesh)
         W = fem.FunctionSpace(self.pm.mesh, ("DG", 0))
-        self._dg = {name: fem.Function(W, name=name) for name in
-                    ("von_mises_Pa", "axial_stress_Pa", "peeq", "temperature_K")}
+        names = ["von_mises_Pa", "axial_stress_Pa"]  # fields of switched-off physics are not written
+        if self.scene.effects.fidelity == "plastic":
+            names.append("peeq")
+            if self.scene.effects.thermal:
+                names.append("temperature_K")
+        self._dg = {name: fem.Function(W, name=name) for name in names}
         self._dg_cells = W.dofmap.list.array[: self.solver.n_cells]
 
     def _write_fields(self):
@@ -234,6 +238,8 @@ class Simulation:
                  + 2 * (sd[:, 3] * ax * ay + sd[:, 4] * ay * az + sd[:, 5] * ax * az)) + pm
         for name, values in (("von_mises_Pa", vm), ("axial_stress_Pa", axial), ("peeq", s.eps_p),
                              ("temperature_K", s.temp)):
+            if name not in self._dg:
+                continue
             f = self._dg[name]
             f.x.array[self._dg_cells] = values
             f.x.scatter_forward()

@@ -80,3 +80,17 @@ def test_fields_hold_every_field_at_every_output_time(tmp_path):
         assert np.abs(u[end][:]).max() > 5e-3  # 600 m/s x 20 us = 12 mm of travel
     xdmf = (tmp_path / "fields.xdmf").read_text()
     assert xdmf.count('Name="von_mises_Pa"') >= 3
+
+
+def test_switched_off_physics_writes_no_field(tmp_path):
+    """What is off costs nothing: an elastic run writes no PEEQ, an athermal plastic run no temperature."""
+    import h5py
+
+    for fid, thermal, absent, present in (("elastic", "true", {"peeq", "temperature_K"}, set()),
+                                          ("plastic", "false", {"temperature_K"}, {"peeq"})):
+        sc = scene.load(None, [f"effects.fidelity={fid}", f"effects.thermal={thermal}", "mesh.size=0.004",
+                               "run.end_time=1e-5", "run.output_interval=1e-5"])
+        Simulation(sc, tmp_path / fid, MPI.COMM_SELF).run()
+        with h5py.File(tmp_path / fid / "fields.h5", "r") as h5:
+            names = set(h5["Function"].keys())
+        assert not (absent & names) and present <= names and "von_mises_Pa" in names
