@@ -50,28 +50,6 @@ def reference_gradients(X: np.ndarray, dofs: np.ndarray):
     return grad0, np.abs(det) / 6.0, np.sign(det)
 
 
-@numba.njit(cache=True, inline="always", fastmath=_FAST, error_model="numpy")
-def _det(F):
-    return (F[0, 0] * (F[1, 1] * F[2, 2] - F[1, 2] * F[2, 1])
-            - F[0, 1] * (F[1, 0] * F[2, 2] - F[1, 2] * F[2, 0])
-            + F[0, 2] * (F[1, 0] * F[2, 1] - F[1, 1] * F[2, 0]))
-
-
-@numba.njit(cache=True, inline="always", fastmath=_FAST, error_model="numpy")
-def _inv(F, out):
-    d = _det(F)
-    out[0, 0] = (F[1, 1] * F[2, 2] - F[1, 2] * F[2, 1]) / d
-    out[0, 1] = (F[0, 2] * F[2, 1] - F[0, 1] * F[2, 2]) / d
-    out[0, 2] = (F[0, 1] * F[1, 2] - F[0, 2] * F[1, 1]) / d
-    out[1, 0] = (F[1, 2] * F[2, 0] - F[1, 0] * F[2, 2]) / d
-    out[1, 1] = (F[0, 0] * F[2, 2] - F[0, 2] * F[2, 0]) / d
-    out[1, 2] = (F[0, 2] * F[1, 0] - F[0, 0] * F[1, 2]) / d
-    out[2, 0] = (F[1, 0] * F[2, 1] - F[1, 1] * F[2, 0]) / d
-    out[2, 1] = (F[0, 1] * F[2, 0] - F[0, 0] * F[2, 1]) / d
-    out[2, 2] = (F[0, 0] * F[1, 1] - F[0, 1] * F[1, 0]) / d
-    return d
-
-
 @numba.njit(cache=True, fastmath=_FAST, error_model="numpy")
 def volumes_and_step(x, dofs, orient, vol0, mat, speed, nodal_vol, with_step=True):
     """Current cell volumes into nodal volumes; the smallest J; the stable step of the current mesh.

@@ -64,7 +64,7 @@ class Simulation:
         self.tip = self.solver.node_at((0.0, 0.0, 0.0))
         self.tail = self.solver.node_at((0.0, self.pm.shape.length, 0.0))
         R, v = placement(scene)
-        self.R, self.v0 = R, float(np.linalg.norm(v))
+        self.v0 = float(np.linalg.norm(v))
         self.concrete = scene.target.kind == "concrete"
         if self.concrete:
             from fepen import concrete, surface, target as tg
