@@ -3,7 +3,8 @@
 For each mesh size: the per-step time split (kinematics and nodal volumes, material update, internal-force
 assembly, boundary forces, vector updates), the full step over the bare internal-force assembly (the same
 compiled form assembled alone, coefficients pre-packed), cell-steps per second, and the stable step over
-(shortest altitude / dilatational speed).
+(shortest altitude / dilatational speed); with the C trial pass of the stress update (fepen.ckernel) and
+with the numba reference kernel.
 
     .venv/bin/python benchmarks/step_cost.py [sizes in mm ...]      (also under mpirun -n 2)
 """
@@ -15,12 +16,12 @@ import numpy as np
 from dolfinx import cpp as _cpp, la
 from mpi4py import MPI
 
-from fepen import explicit, materials as M, mesh, rigidwall, scene, tetra
+from fepen import ckernel, explicit, materials as M, mesh, rigidwall, scene, tetra
 
 STEPS = 300
 
 
-def measure(h_mm, comm):
+def measure(h_mm, comm, kernel):
     sc = scene.load(None, [f"mesh.size={h_mm * 1e-3}", "target.kind=rigid-wall", "impact.velocity=300",
                            "impact.obliquity_deg=0", "impact.attack_deg=0"])
     pm = mesh.create(sc, comm)
@@ -29,6 +30,9 @@ def measure(h_mm, comm):
                                 np.zeros(pm.mesh.topology.index_map(3).size_local, dtype=np.int64),
                                 sc.run.safety_factor)
     s.external = rigidwall.RigidWall(s)
+    if kernel == "numba":  # the numba reference kernel instead of the C trial pass
+        s._trial, s.kernel = None, "numba"
+    assert s.kernel == kernel, f"the {kernel} kernel is not available: {ckernel.why_not()}"
     s.set_initial(velocity=lambda X: np.tile([0.0, -300.0, 0.0], (len(X), 1)))
     for _ in range(20):  # compile and warm up
         s.step()
@@ -52,23 +56,24 @@ def measure(h_mm, comm):
     mat = M.from_scene(sc)
     c = float(tetra.dilatational_speed(mat.E, mat.nu, mat.density))
     h_over_c = info["shortest_altitude_m"] / c
-    return dict(h=h_mm, cells=info["cells"], full=full, bare=bare, split=split,
+    return dict(kernel=kernel, h=h_mm, cells=info["cells"], full=full, bare=bare, split=split,
                 cell_steps=info["cells"] / full, dt=s.dt0, dt_ratio=s.dt0 / h_over_c,
                 plastic=comm.allreduce(int((s.eps_p > 0).sum()), op=MPI.SUM))
 
 
 def main(sizes):
     comm = MPI.COMM_WORLD
-    rows = [measure(h, comm) for h in sizes]
+    kernels = ["C", "numba"] if ckernel.library() is not None else ["numba"]
+    rows = [measure(h, comm, k) for h in sizes for k in kernels]
     if comm.rank:
         return
     print(f"ranks: {comm.size}; {STEPS} steps after 20 warm-up steps; times per step in ms")
-    print(f"{'h_mm':>5} {'cells':>7} {'kinem':>6} {'mater':>6} {'assem':>6} {'bound':>6} {'update':>6} "
+    print(f"{'kernel':>6} {'h_mm':>5} {'cells':>7} {'kinem':>6} {'mater':>6} {'assem':>6} {'bound':>6} {'update':>6} "
           f"{'full':>6} {'bare':>6} {'full/bare':>9} {'Mcell-steps/s':>13} {'dt_ns':>6} {'dt/(h/c)':>8} "
           f"{'plastic_cells':>13}")
     for r in rows:
         sp = r["split"]
-        print(f"{r['h']:5.2f} {r['cells']:7d} {sp['kinematics'] * 1e3:6.3f} {sp['material'] * 1e3:6.3f} "
+        print(f"{r['kernel']:>6} {r['h']:5.2f} {r['cells']:7d} {sp['kinematics'] * 1e3:6.3f} {sp['material'] * 1e3:6.3f} "
               f"{sp['assembly'] * 1e3:6.3f} {sp['boundary'] * 1e3:6.3f} {sp['update'] * 1e3:6.3f} "
               f"{r['full'] * 1e3:6.3f} {r['bare'] * 1e3:6.3f} {r['full'] / r['bare']:9.2f} "
               f"{r['cell_steps'] / 1e6:13.2f} {r['dt'] * 1e9:6.1f} {r['dt_ratio']:8.3f} {r['plastic']:13d}")

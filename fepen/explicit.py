@@ -7,7 +7,8 @@
 M is the row-sum lumped mass: node a gets ρ_e V0_e / 4 from each of its cells (P1 tetrahedra: all masses
 positive). The internal force is the UFL form f_int = ∫_Ω0 P : ∇_X w dX with P = J σ F^{-T} held per cell
 (one quadrature point, the exact rule for P1) — the same as ∫_Ω(t) σ : ∇_x w dx on the current
-configuration. The stress update is fepen.kinematics (compiled), the laws fepen.materials.
+configuration. The stress update is fepen.kinematics (numba) with its elastic trial pass in C
+(fepen.ckernel, vectorised across cells), the laws fepen.materials.
 
 Energy bookkeeping (per step, owned dofs, trapezoidal in the forces):
     W_int += Δu · (f_int^n + f_int^{n+1}) / 2,   W_ext += Δu · (f_ext^n + f_ext^{n+1}) / 2
@@ -33,7 +34,7 @@ from dolfinx import cpp as _cpp
 from dolfinx import fem, la
 from mpi4py import MPI
 
-from fepen import kinematics, materials as M
+from fepen import ckernel, kinematics, materials as M
 from fepen.errors import SimulationError
 
 
@@ -143,7 +144,8 @@ class ExplicitSolver:
         self.total_mass = self.comm.allreduce(float(self.mass[: self.n_owned].sum()), op=MPI.SUM)
 
         # cell state
-        self.s = np.zeros((n_cells, 6))
+        self._sT = np.zeros((6, n_cells))  # component-major for the C trial pass
+        self.s = self._sT.T  # (n_cells, 6) view: xx, yy, zz, xy, yz, xz
         self.eps_p = np.zeros(n_cells)
         self.temp = np.array([m.params[M.TROOM] for m in materials])[self.mat].astype(float)
         self._totals = np.zeros(4)
@@ -159,6 +161,17 @@ class ExplicitSolver:
         key = next(iter(self._coeffs))
         self.P_packed = self._coeffs[key]
         assert self.P_packed.shape[1] == 9 and self.P_packed.shape[0] >= n_cells
+
+        # the stress update: the C trial pass + numba radial return, or the numba kernel alone (the
+        # reference; also the plain element's)
+        self._x = np.empty((self.n_nodes, 3))
+        self._trial = None
+        if self.nodal and ckernel.library() is not None:
+            self.grad0T = np.ascontiguousarray(self.grad0.reshape(n_cells, 12).T)
+            self.G_m = np.array([m.shear_modulus for m in materials])
+            self._trial = ckernel.TrialPass(self._x, self.Vel, self.dofs, self.mat, self.grad0T, self.G_m,
+                                            self.nodal_p, self._sT, self.sy0, self.P_packed)
+        self.kernel = "C" if self._trial is not None else "numba"
 
         # time and energy
         self.t = 0.0
@@ -224,7 +237,7 @@ class ExplicitSolver:
         import time
 
         t0 = time.perf_counter()
-        x = self.positions()
+        x = np.add(self.X, self.U, out=self._x)
         with_step = self.step_count % STEP_EVERY == 0
         jmin, worst, h_c = kinematics.volumes_and_step(x, self.dofs, self.orient, self.vol0, self.mat,
                                                        self.speed, self.nodal_vol, with_step)
@@ -239,9 +252,14 @@ class ExplicitSolver:
         t1 = time.perf_counter()
         if self.nodal:
             kinematics.nodal_pressures(self.nodal_vol, self.nodal_vol0, self.bulk, self.nodal_p)
-        kinematics.stress_update(x, self.Vel, dt, self.dofs, self.grad0, self.vol0, self.mat, self.params,
-                                 self.nodal_p, self.nodal, self.s, self.eps_p, self.temp, self.sy0,
-                                 self.P_packed, self._totals)
+        if self._trial is not None:
+            excess = self._trial(dt)
+            kinematics.plastic_pass(x, dt, self.dofs, self.grad0, self.vol0, self.mat, self.params, self.s,
+                                    self.eps_p, self.temp, self.sy0, self.P_packed, excess, self._totals)
+        else:
+            kinematics.stress_update(x, self.Vel, dt, self.dofs, self.grad0, self.vol0, self.mat,
+                                     self.params, self.nodal_p, self.nodal, self.s, self.eps_p, self.temp,
+                                     self.sy0, self.P_packed, self._totals)
         self._plastic += self._totals[0]
         self._heat += self._totals[1]
         t2 = time.perf_counter()

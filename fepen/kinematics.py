@@ -320,6 +320,76 @@ def stress_update(x, v, dt, dofs, grad0, vol0, mat, params, nodal_p, nodal, s, e
 
 
 @numba.njit(cache=True, fastmath=_FAST, error_model="numpy")
+def plastic_pass(x, dt, dofs, grad0, vol0, mat, params, s, eps_p, temp, sy0, P_out, excess, totals):
+    """Radial return of the cells whose elastic trial state (from the C trial pass, fepen.ckernel) exceeds
+    their static flow stress (excess > 0): their s, eps_p, temp, sy0 and P corrected in place, as
+    stress_update does in its own loop.
+
+    Args:
+        excess: q_trial² − σ_y² per cell (from the trial pass).
+        totals: (4,) output: plastic work, heat, (unused), largest plastic increment.
+        others: see stress_update.
+    """
+    totals[:] = 0.0
+    for e in range(dofs.shape[0]):
+        if not (excess[e] > 0.0):
+            continue
+        m = mat[e]
+        p = params[m]
+        G = p[M.E_] / (2.0 * (1.0 + p[M.NU]))
+        s0, s1, s2, s3, s4, s5 = s[e, 0], s[e, 1], s[e, 2], s[e, 3], s[e, 4], s[e, 5]
+        q = math.sqrt(1.5 * (s0 * s0 + s1 * s1 + s2 * s2 + 2.0 * (s3 * s3 + s4 * s4 + s5 * s5)))
+        d, sy, T_new = M.radial_return(q, eps_p[e], temp[e], dt, G, p)
+        if not (d > 0.0):
+            continue
+        scale = sy / q
+        for i in range(6):
+            s[e, i] *= scale
+        eps_p[e] += d
+        temp[e] = T_new
+        sy0[e] = M.yield_stress(eps_p[e], 0.0, T_new, p)
+        # P = (s + p I) C changes by (scale - 1) s C; C = cof F and J again (a few cells only)
+        F00 = F01 = F02 = F10 = F11 = F12 = F20 = F21 = F22 = 0.0
+        for a in range(4):
+            nd = dofs[e, a]
+            g0 = grad0[e, a, 0]
+            g1 = grad0[e, a, 1]
+            g2 = grad0[e, a, 2]
+            F00 += x[nd, 0] * g0
+            F01 += x[nd, 0] * g1
+            F02 += x[nd, 0] * g2
+            F10 += x[nd, 1] * g0
+            F11 += x[nd, 1] * g1
+            F12 += x[nd, 1] * g2
+            F20 += x[nd, 2] * g0
+            F21 += x[nd, 2] * g1
+            F22 += x[nd, 2] * g2
+        C00, C01, C02, C10, C11, C12, C20, C21, C22 = _cofactor(F00, F01, F02, F10, F11, F12, F20, F21, F22)
+        V = (F00 * C00 + F01 * C01 + F02 * C02) * vol0[e]
+        f = scale - 1.0
+        s0 *= f
+        s1 *= f
+        s2 *= f
+        s3 *= f
+        s4 *= f
+        s5 *= f
+        P_out[e, 0] += s0 * C00 + s3 * C10 + s5 * C20
+        P_out[e, 1] += s0 * C01 + s3 * C11 + s5 * C21
+        P_out[e, 2] += s0 * C02 + s3 * C12 + s5 * C22
+        P_out[e, 3] += s3 * C00 + s1 * C10 + s4 * C20
+        P_out[e, 4] += s3 * C01 + s1 * C11 + s4 * C21
+        P_out[e, 5] += s3 * C02 + s1 * C12 + s4 * C22
+        P_out[e, 6] += s5 * C00 + s4 * C10 + s2 * C20
+        P_out[e, 7] += s5 * C01 + s4 * C11 + s2 * C21
+        P_out[e, 8] += s5 * C02 + s4 * C12 + s2 * C22
+        totals[0] += sy * d * V
+        if p[M.THERMAL_ON] > 0.0:
+            totals[1] += p[M.BETA] * sy * d * V
+        if d > totals[3]:
+            totals[3] = d
+
+
+@numba.njit(cache=True, fastmath=_FAST, error_model="numpy")
 def static_flow_stress(mat, params, eps_p, temp, out):
     """σ_y(ε_p, ε̇ = 0, T) of every cell into out (inf for elastic materials)."""
     for e in range(len(mat)):

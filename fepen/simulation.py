@@ -254,7 +254,7 @@ class Simulation:
                  "time_split_s": {"mesh": self.mesh_s, "setup_jit": self.jit_s,
                                   "time_loop": loop_s - self.output_s, "output": self.output_s},
                  "mass_kg": s.total_mass, "cells": self.pm.mesh.topology.index_map(3).size_global,
-                 "ranks": self.comm.size}
+                 "ranks": self.comm.size, "stress_kernel": s.kernel}
         summary = results.summary(self.scene, self.rows, outcome, extra)
         output.write_json(self.out / "summary.json", summary, self.comm)
         return summary
