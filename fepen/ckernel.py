@@ -2,8 +2,8 @@
 
 Why C: the elastic trial pass (kinematics, objective rotation, trial stress, P) is the largest part of an
 explicit step after the force assembly. numba compiles it to scalar code (~45 ns per cell); gcc vectorises
-the same arithmetic across cells (AVX2/AVX-512) when the per-cell arrays are component-major, ~15 ns per
-cell. The numba kernel fepen.kinematics.stress_update stays the reference: it is used for the plain
+the same arithmetic across cells (AVX2/AVX-512) when the per-cell arrays are component-major (~15 ns per
+cell), and edge matrices stand in for streamed reference gradients (the pass is memory-bound on big meshes). The numba kernel fepen.kinematics.stress_update stays the reference: it is used for the plain
 (locking) element, when no C compiler is found, or when FEPEN_KERNEL=numba; a test checks that both give
 the same stresses to round-off.
 
@@ -85,8 +85,8 @@ def library():
         _why_not = f"C kernel not built ({detail.strip().splitlines()[-1] if detail.strip() else err})"
         return None
     vp, i32, dbl = ctypes.c_void_p, ctypes.c_int32, ctypes.c_double
-    lib.trial_pass.argtypes = [i32, vp, vp, dbl, vp, vp, vp, vp, vp, i32, vp, vp, vp, vp]
-    lib.trial_pass.restype = None
+    lib.trial_pass.argtypes = [i32, vp, vp, vp, dbl, vp, vp, vp, vp, vp, i32, vp, vp, vp, vp]
+    lib.trial_pass.restype = i32
     _lib = lib
     return lib
 
@@ -102,15 +102,16 @@ class TrialPass:
     as long as this object and never be reallocated).
 
     Args:
-        x, v: nodal positions and velocities (n_nodes, 3), C-contiguous float64.
+        x, v, X: current positions, velocities and reference positions of the nodes (n_nodes, 3),
+            C-contiguous float64.
         dofs: (n_cells, 4) node indices; mat: (n_cells,) material index.
-        grad0T: (12, n_cells) reference gradients, component-major (row 3a + k is ∂φ_a/∂X_k).
+        det_R: (n_cells,) det of the reference edge matrix (X1 − X0, X2 − X0, X3 − X0) = ±6 V0.
         G_m: shear modulus per material (Pa); nodal_p: (n_nodes, n_materials) nodal mean stress.
         sT: (6, n_cells) deviatoric stress, component-major (updated in place).
         sy0: (n_cells,) static flow stress. P_out: (≥ n_cells, 9) the packed coefficient of the form.
     """
 
-    def __init__(self, x, v, dofs, mat, grad0T, G_m, nodal_p, sT, sy0, P_out):
+    def __init__(self, x, v, X, dofs, mat, det_R, G_m, nodal_p, sT, sy0, P_out):
         lib = library()
         if lib is None:
             raise RuntimeError(why_not())
@@ -118,18 +119,19 @@ class TrialPass:
         self.n = n
         self._dofs = np.ascontiguousarray(dofs, dtype=np.int32)
         self._mat = np.ascontiguousarray(mat, dtype=np.int32)
-        self.excess = np.zeros(n)
-        for a in (x, v, grad0T, G_m, nodal_p, sT, sy0, P_out):
+        self._inv_det = 1.0 / np.asarray(det_R, dtype=float)
+        self.yielding = np.zeros(n, dtype=np.int32)
+        for a in (x, v, X, G_m, nodal_p, sT, sy0, P_out):
             assert a.dtype == np.float64 and a.flags.c_contiguous
-        assert grad0T.shape == (12, n) and sT.shape == (6, n) and P_out.shape[1] == 9
-        self._keep = (x, v, grad0T, G_m, nodal_p, sT, sy0, P_out)
+        assert sT.shape == (6, n) and P_out.shape[1] == 9 and x.shape == X.shape == v.shape
+        self._keep = (x, v, X, G_m, nodal_p, sT, sy0, P_out)
         addr = lambda a: a.ctypes.data  # noqa: E731
-        self._head = (n, addr(x), addr(v))
-        self._tail = (addr(self._dofs), addr(grad0T), addr(self._mat), addr(G_m), addr(nodal_p),
-                      nodal_p.shape[1], addr(sT), addr(sy0), addr(P_out), addr(self.excess))
+        self._head = (n, addr(x), addr(v), addr(X))
+        self._tail = (addr(self._dofs), addr(self._inv_det), addr(self._mat), addr(G_m), addr(nodal_p),
+                      nodal_p.shape[1], addr(sT), addr(sy0), addr(P_out), addr(self.yielding))
         self._lib = lib
 
     def __call__(self, dt: float) -> np.ndarray:
-        """Trial state of every cell over a step dt; returns excess = q_trial² − σ_y² per cell."""
-        self._lib.trial_pass(*self._head, dt, *self._tail)
-        return self.excess
+        """Trial state of every cell over a step dt; returns the cells over their flow stress."""
+        k = self._lib.trial_pass(*self._head, dt, *self._tail)
+        return self.yielding[:k]

@@ -167,10 +167,10 @@ class ExplicitSolver:
         self._x = np.empty((self.n_nodes, 3))
         self._trial = None
         if self.nodal and ckernel.library() is not None:
-            self.grad0T = np.ascontiguousarray(self.grad0.reshape(n_cells, 12).T)
             self.G_m = np.array([m.shear_modulus for m in materials])
-            self._trial = ckernel.TrialPass(self._x, self.Vel, self.dofs, self.mat, self.grad0T, self.G_m,
-                                            self.nodal_p, self._sT, self.sy0, self.P_packed)
+            self._trial = ckernel.TrialPass(self._x, self.Vel, self.X, self.dofs, self.mat,
+                                            6.0 * self.vol0 * self.orient, self.G_m, self.nodal_p, self._sT,
+                                            self.sy0, self.P_packed)
         self.kernel = "C" if self._trial is not None else "numba"
 
         # time and energy
@@ -253,9 +253,9 @@ class ExplicitSolver:
         if self.nodal:
             kinematics.nodal_pressures(self.nodal_vol, self.nodal_vol0, self.bulk, self.nodal_p)
         if self._trial is not None:
-            excess = self._trial(dt)
+            yielding = self._trial(dt)
             kinematics.plastic_pass(x, dt, self.dofs, self.grad0, self.vol0, self.mat, self.params, self.s,
-                                    self.eps_p, self.temp, self.sy0, self.P_packed, excess, self._totals)
+                                    self.eps_p, self.temp, self.sy0, self.P_packed, yielding, self._totals)
         else:
             kinematics.stress_update(x, self.Vel, dt, self.dofs, self.grad0, self.vol0, self.mat,
                                      self.params, self.nodal_p, self.nodal, self.s, self.eps_p, self.temp,

@@ -320,20 +320,18 @@ def stress_update(x, v, dt, dofs, grad0, vol0, mat, params, nodal_p, nodal, s, e
 
 
 @numba.njit(cache=True, fastmath=_FAST, error_model="numpy")
-def plastic_pass(x, dt, dofs, grad0, vol0, mat, params, s, eps_p, temp, sy0, P_out, excess, totals):
+def plastic_pass(x, dt, dofs, grad0, vol0, mat, params, s, eps_p, temp, sy0, P_out, cells, totals):
     """Radial return of the cells whose elastic trial state (from the C trial pass, fepen.ckernel) exceeds
-    their static flow stress (excess > 0): their s, eps_p, temp, sy0 and P corrected in place, as
-    stress_update does in its own loop.
+    their static flow stress: their s, eps_p, temp, sy0 and P corrected in place, as stress_update does in
+    its own loop.
 
     Args:
-        excess: q_trial² − σ_y² per cell (from the trial pass).
+        cells: indices of the cells over their flow stress (from the trial pass).
         totals: (4,) output: plastic work, heat, (unused), largest plastic increment.
         others: see stress_update.
     """
     totals[:] = 0.0
-    for e in range(dofs.shape[0]):
-        if not (excess[e] > 0.0):
-            continue
+    for e in cells:
         m = mat[e]
         p = params[m]
         G = p[M.E_] / (2.0 * (1.0 + p[M.NU]))

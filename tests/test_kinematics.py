@@ -60,7 +60,7 @@ def run_motion(X, dofs, positions, dt, s0, material, nodal=True, kernel="numba",
     K.volumes_and_step(X, dofs, orient, v0, mat, speed, nv0)
     xb, vb = np.empty_like(X), np.empty_like(X)
     if kernel == "C":
-        trial = ckernel.TrialPass(xb, vb, dofs, mat, np.ascontiguousarray(g.reshape(n, 12).T),
+        trial = ckernel.TrialPass(xb, vb, np.ascontiguousarray(X), dofs, mat, 6.0 * v0 * orient,
                                   np.array([material.shear_modulus]), npres, sT, sy0, P)
     for a, b in zip(positions[:-1], positions[1:]):
         xb[:] = b
