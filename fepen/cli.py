@@ -1,6 +1,7 @@
 """The ``fepen`` command (shared/contract.md).
 
     fepen run SCENE.toml [--out DIR] [--set KEY=VALUE ...]
+    fepen run --resume DIR
     fepen mesh SCENE.toml [--out DIR] [--set KEY=VALUE ...]
     fepen validate [SCENE.toml] [--out DIR] [--set KEY=VALUE ...]
     fepen keys
@@ -33,8 +34,10 @@ def _parser() -> argparse.ArgumentParser:
         p.add_argument("--set", dest="sets", action="append", default=[], metavar="KEY=VALUE",
                        help="override a dotted scene key; VALUE in TOML syntax, bare words are strings")
 
-    scene_args(sub.add_parser("run", help="one simulation: summary.json, history.csv, fields.xdmf, figures"),
-               "results/run")
+    run = sub.add_parser("run", help="one simulation: summary.json, history.csv, fields.xdmf, figures")
+    scene_args(run, "results/run")
+    run.add_argument("--resume", metavar="DIR",
+                     help="continue the killed run in DIR from its last checkpoint (same scene, same ranks)")
     scene_args(sub.add_parser("validate", help="the Table 1 sweep: validation.csv, validation.md, figures"),
                "results/validation")
     scene_args(sub.add_parser("mesh", help="build the projectile mesh only: mesh.json, mesh.xdmf, mesh.png"),
@@ -87,13 +90,27 @@ def cmd_run(args) -> int:
     from fepen import output, results, scene as fscene, shape, simulation
 
     comm = MPI.COMM_WORLD
-    sc = fscene.load(args.scene, args.sets)
+    state = None
+    if args.resume is not None:
+        from fepen import checkpoint
+
+        if args.scene is not None or args.sets:
+            raise InputError("--resume", "takes the scene of the run it continues (DIR/scene.toml): give no "
+                                         "scene file and no --set")
+        out = Path(args.resume)
+        if not (out / "scene.toml").exists():
+            raise InputError("--resume", f"{out} is not a results directory (no scene.toml)")
+        state = checkpoint.read_state(out, comm)
+        sc = fscene.load(out / "scene.toml")
+    else:
+        sc = fscene.load(args.scene, args.sets)
     shape.shape_from_scene(sc)
     simulation.check_supported(sc)
-    out = output.prepare(args.out, comm)
-    output.write_text(out / "scene.toml", fscene.to_toml(sc), comm)
+    if state is None:
+        out = output.prepare(args.out, comm)
+        output.write_text(out / "scene.toml", fscene.to_toml(sc), comm)
     try:
-        summary = simulation.run_scene(sc, out, comm, progress=True)
+        summary = simulation.run_scene(sc, out, comm, progress=True, resume=state)
     finally:
         if (out / "history.csv").exists():
             results.figures(out, sc, comm)

@@ -36,15 +36,21 @@ STOP_STEPS = 300
 
 
 def mass_properties(pm, scene, comm):
-    """Mass, reference centre and inertia about the centre of the meshed projectile (all ranks)."""
+    """Mass, reference centre and inertia about the centre of the meshed projectile (all ranks).
+
+    The cells are gathered and summed in their original (gmsh) order, so that the sums, and the whole
+    rigid trajectory, are bitwise the same on any number of ranks."""
     p = fmesh.cell_points(pm.mesh)
     rho = np.full(len(p), scene.projectile.material.density)
     if pm.charge:
         rho[fmesh.owned_cells_tagged(pm, geometry.CHARGE)] = scene.charge.material.density
+    key = pm.mesh.topology.original_cell_index[: len(p)]
+    parts = comm.allgather((np.asarray(key), p, rho))
+    key = np.concatenate([k for k, _, _ in parts])
+    order = np.argsort(key, kind="stable")
+    p = np.concatenate([q for _, q, _ in parts])[order]
+    rho = np.concatenate([r for _, _, r in parts])[order]
     m, first, second = tet_mass_properties(p, rho)
-    m = comm.allreduce(m, op=MPI.SUM)
-    first = comm.allreduce(first, op=MPI.SUM)
-    second = comm.allreduce(second, op=MPI.SUM)
     c, inertia = inertia_about_centre(m, first, second)
     return m, c, inertia
 

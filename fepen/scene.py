@@ -181,6 +181,8 @@ SCHEMA: dict[str, Key] = {
     "run.output_interval": _pos(5.0e-5, "s", 1.0),
     "run.safety_factor": _num(0.8, "", 0.0, 1.0, lo_open=True, doc="stable step = factor * h_min / c"),
     "run.fields": _flag(True, doc="write fields.xdmf"),
+    "run.checkpoint_interval": _num(1.0e-4, "s", 0.0, 1.0,
+                                    doc="simulated time between checkpoints (fepen run --resume DIR); 0: none"),
     "run.rigid_step": _pos(_ABSENT, "s", 1e-3, doc="RK4 step of the rigid fidelity; absent: min(0.1 D/v0, t_stop/300)"),
 }
 

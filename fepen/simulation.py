@@ -47,9 +47,10 @@ class Simulation:
         out: results directory (created).
         comm: MPI communicator.
         progress: show a tqdm bar on rank 0.
+        resume: the state.json of a checkpoint in ``out`` to continue from (fepen.checkpoint), or None.
     """
 
-    def __init__(self, scene, out, comm=MPI.COMM_WORLD, progress: bool = False):
+    def __init__(self, scene, out, comm=MPI.COMM_WORLD, progress: bool = False, resume: dict | None = None):
         from fepen import rigidwall
 
         self.scene, self.comm, self.progress = scene, comm, progress
@@ -86,6 +87,26 @@ class Simulation:
         self.output_s = 0.0
         self.rows: list[list[float]] = []
         self.fields = None
+        # the loop's clocks and event memory (checkpointed)
+        self.next_hist = self.next_out = self.next_ckpt = 0.0
+        self.touched, self.free_since, self._entered = False, None, False
+        self.wall_before = 0.0
+        self._resume = resume
+        if resume is not None:
+            from fepen import checkpoint
+
+            checkpoint.restore(self, resume)
+            self.wall_before = float(resume["wall_s"])
+
+    def loop_state(self) -> dict:
+        """The time loop's clocks and event memory (for checkpoints)."""
+        return {"next_hist": self.next_hist, "next_out": self.next_out, "next_ckpt": self.next_ckpt,
+                "touched": self.touched, "free_since": self.free_since, "entered": self._entered}
+
+    def set_loop_state(self, state: dict) -> None:
+        """Restore what loop_state returned."""
+        self.next_hist, self.next_out, self.next_ckpt = state["next_hist"], state["next_out"], state["next_ckpt"]
+        self.touched, self.free_since, self._entered = state["touched"], state["free_since"], state["entered"]
 
     # ------------------------------------------------------------------------------------------------
     def _momentum(self):
@@ -115,34 +136,49 @@ class Simulation:
         return row
 
     def run(self) -> dict:
-        """Advance to the end (run.end_time, or the rebound from the wall) and write the outputs."""
+        """Advance to the end (run.end_time, or a stop event) and write the outputs.
+
+        history.csv is rewritten (atomically) at every field output and checkpoint, fields as they come
+        (fepen.fields), a checkpoint every run.checkpoint_interval of simulated time (fepen.checkpoint)."""
+        from fepen import checkpoint
+
         s, sc = self.solver, self.scene
         end = sc.get("run.end_time")
         hard_end = end if end is not None else 5e-3
         hist_dt = min(sc.run.output_interval / 10.0, 1e-6)
         out_dt = sc.run.output_interval
-        next_hist, next_out = 0.0, 0.0
-        touched, free_since = False, None
+        ckpt_dt = sc.run.checkpoint_interval
+        if self._resume is None:
+            self.next_ckpt = ckpt_dt
         bar = None
         if self.progress and self.comm.rank == 0:
             from tqdm import tqdm
 
-            bar = tqdm(total=round(hard_end * 1e6), unit="us", desc="fepen", leave=False)
+            bar = tqdm(total=round(hard_end * 1e6), initial=round(s.t * 1e6), unit="us", desc="fepen",
+                       leave=False)
         t_loop = time.perf_counter()
         outcome = "ended"
         completed = False
         try:
             if sc.run.fields:
-                self._open_fields()
+                self._open_fields(self._resume["field_times_s"] if self._resume is not None else [])
             while s.t < hard_end:
-                if s.t >= next_hist:
+                if s.t >= self.next_hist:
                     self.record()
-                    next_hist += hist_dt
-                if self.fields is not None and s.t >= next_out:
+                    self.next_hist += hist_dt
+                if self.fields is not None and s.t >= self.next_out:
                     t_out = time.perf_counter()
                     self._write_fields()
+                    results.write_history(self.rows, self.out, self.comm)
                     self.output_s += time.perf_counter() - t_out
-                    next_out += out_dt
+                    self.next_out += out_dt
+                if ckpt_dt > 0.0 and s.t >= self.next_ckpt:
+                    t_out = time.perf_counter()
+                    while self.next_ckpt <= s.t:
+                        self.next_ckpt += ckpt_dt
+                    results.write_history(self.rows, self.out, self.comm)
+                    checkpoint.write(self, self.wall_before + time.perf_counter() - self.wall_t0)
+                    self.output_s += time.perf_counter() - t_out
                 s.step()
                 if bar is not None and s.step_count % 200 == 0:
                     bar.n = round(s.t * 1e6)
@@ -154,10 +190,10 @@ class Simulation:
                     outcome = "ended"
                     continue
                 if self.load.contact_nodes > 0:
-                    touched, free_since = True, None
-                elif touched and free_since is None:
-                    free_since = s.t
-                if end is None and free_since is not None and s.t - free_since > 20e-6:
+                    self.touched, self.free_since = True, None
+                elif self.touched and self.free_since is None:
+                    self.free_since = s.t
+                if end is None and self.free_since is not None and s.t - self.free_since > 20e-6:
                     outcome = "rebound"
                     break
             self.record()
@@ -167,9 +203,9 @@ class Simulation:
         finally:
             if bar is not None:
                 bar.close()
-            if self.fields is not None:
-                self.fields.close()
             t_out = time.perf_counter()
+            if self.fields is not None:
+                self.fields.consolidate()
             results.write_history(self.rows, self.out, self.comm)  # kept even when the run failed
             if completed:
                 from fepen import analyses
@@ -179,7 +215,12 @@ class Simulation:
                                           f"t = {self.solver.t * 1e6:.0f} us, max PEEQ {self._max_peeq():.3g}")
             self.output_s += time.perf_counter() - t_out
         loop_s = time.perf_counter() - t_loop
-        return self._summary(outcome, loop_s)
+        summary = self._summary(outcome, loop_s)
+        if self.comm.rank == 0 and (self.out / "checkpoint").exists():
+            import shutil
+
+            shutil.rmtree(self.out / "checkpoint")  # the run is complete: nothing left to resume
+        return summary
 
     def _penetration_event(self, s, end) -> str:
         """Stop events in the concrete target, checked every 20 steps: "embedded" (the centre of mass has
@@ -192,7 +233,7 @@ class Simulation:
         pts = self.surf.kinematics(x_all, s.Vel)[0]
         ymin = self.comm.allreduce(float(pts[:, 1].min()) if len(pts) else np.inf, op=MPI.MIN)
         ymax = self.comm.allreduce(float(pts[:, 1].max()) if len(pts) else -np.inf, op=MPI.MAX)
-        self._entered = getattr(self, "_entered", False) or ymin < 0.0
+        self._entered = self._entered or ymin < 0.0
         if not self._entered:
             return "running"
         vcm = self._momentum()
@@ -208,24 +249,18 @@ class Simulation:
         return "running"
 
     # ------------------------------------------------------------------------------------------------
-    def _open_fields(self):
-        from dolfinx import fem
-        from dolfinx.io import XDMFFile
-
-        self.fields = XDMFFile(self.comm, str(self.out / "fields.xdmf"), "w")
-        self.fields.write_mesh(self.pm.mesh)
-        W = fem.FunctionSpace(self.pm.mesh, ("DG", 0))
+    def _open_fields(self, times):
         names = ["von_mises_Pa", "axial_stress_Pa"]  # fields of switched-off physics are not written
         if self.scene.effects.fidelity == "plastic":
             names.append("peeq")
             if self.scene.effects.thermal:
                 names.append("temperature_K")
-        self._dg = {name: fem.Function(W, name=name) for name in names}
-        self._dg_cells = W.dofmap.list.array[: self.solver.n_cells]
+        from fepen.fields import FieldWriter
+
+        self.fields = FieldWriter(self.out, self.solver, ["displacement", "velocity"], names, times)
 
     def _write_fields(self):
         s = self.solver
-        t = s.t
         x = s.positions()
         tip, tail = s.node_value(self.tip, x), s.node_value(self.tail, x)
         axis = (tip - tail) / np.linalg.norm(tip - tail)
@@ -236,21 +271,13 @@ class Simulation:
         ax, ay, az = axis
         axial = (sd[:, 0] * ax * ax + sd[:, 1] * ay * ay + sd[:, 2] * az * az
                  + 2 * (sd[:, 3] * ax * ay + sd[:, 4] * ay * az + sd[:, 5] * ax * az)) + pm
-        for name, values in (("von_mises_Pa", vm), ("axial_stress_Pa", axial), ("peeq", s.eps_p),
-                             ("temperature_K", s.temp)):
-            if name not in self._dg:
-                continue
-            f = self._dg[name]
-            f.x.array[self._dg_cells] = values
-            f.x.scatter_forward()
-            self.fields.write_function(f, t)
-        self.fields.write_function(s.u, t)
-        self.fields.write_function(s.v, t)
+        self.fields.write(s.t, {"displacement": s.U, "velocity": s.Vel, "von_mises_Pa": vm,
+                                "axial_stress_Pa": axial, "peeq": s.eps_p, "temperature_K": s.temp})
 
     def _summary(self, outcome: str, loop_s: float) -> dict:
         s = self.solver
         extra = {"steps": s.step_count, "dt_s": s.dt_min, "end_time_s": s.t,
-                 "wall_s": time.perf_counter() - self.wall_t0,
+                 "wall_s": self.wall_before + time.perf_counter() - self.wall_t0,
                  "time_split_s": {"mesh": self.mesh_s, "setup_jit": self.jit_s,
                                   "time_loop": loop_s - self.output_s, "output": self.output_s},
                  "mass_kg": s.total_mass, "cells": self.pm.mesh.topology.index_map(3).size_global,
@@ -260,11 +287,13 @@ class Simulation:
         return summary
 
 
-def run_scene(scene, out, comm=MPI.COMM_WORLD, progress=False) -> dict:
-    """Run one scene into a results directory (the rigid or the deformable projectile); returns the summary."""
+def run_scene(scene, out, comm=MPI.COMM_WORLD, progress=False, resume: dict | None = None) -> dict:
+    """Run one scene into a results directory (the rigid or the deformable projectile); returns the summary.
+
+    resume: a checkpoint's state (fepen.checkpoint.read_state) to continue from (deformable runs)."""
     check_supported(scene)
     if scene.effects.fidelity == "rigid":
         from fepen.rigidrun import RigidRun
 
         return RigidRun(scene, out, comm).run()
-    return Simulation(scene, out, comm, progress).run()
+    return Simulation(scene, out, comm, progress, resume).run()
