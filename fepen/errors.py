@@ -20,3 +20,11 @@ class SimulationError(RuntimeError):
     The message says where (element, position) and when (step, time)."""
 
     exit_code = 3
+
+
+class BeyondMethod(SimulationError):
+    """The run reached a state the method does not model (a projectile that would fracture or erode):
+    fepen stops rather than report numbers. Exit code 3, message starting "beyond the method"."""
+
+    def __init__(self, message: str):
+        super().__init__(f"beyond the method: {message}")

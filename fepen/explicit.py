@@ -165,6 +165,7 @@ class ExplicitSolver:
         # the stress update: the C trial pass + numba radial return, or the numba kernel alone (the
         # reference; also the plain element's)
         self._x = np.empty((self.n_nodes, 3))
+        self._flag = np.zeros(1)
         self._trial = None
         if self.nodal and ckernel.library() is not None:
             self.G_m = np.array([m.shear_modulus for m in materials])
@@ -198,7 +199,7 @@ class ExplicitSolver:
 
     def stable_step(self) -> float:
         """Safety x min over cells of (shortest altitude / dilatational speed), current mesh, all ranks."""
-        jmin, worst, h_c = kinematics.volumes_and_step(self.positions(), self.dofs, self.orient, self.vol0,
+        jmin, worst, h_c, _ = kinematics.volumes_and_step(self.positions(), self.dofs, self.orient, self.vol0,
                                                        self.mat, self.speed, self.nodal_vol)
         return self.safety * self.comm.allreduce(h_c, op=MPI.MIN)
 
@@ -239,14 +240,26 @@ class ExplicitSolver:
         t0 = time.perf_counter()
         x = np.add(self.X, self.U, out=self._x)
         with_step = self.step_count % STEP_EVERY == 0
-        jmin, worst, h_c = kinematics.volumes_and_step(x, self.dofs, self.orient, self.vol0, self.mat,
-                                                       self.speed, self.nodal_vol, with_step)
-        if not (jmin > 0.0):
-            c = x[self.dofs[worst]].mean(axis=0)
-            gidx = self.mesh.topology.index_map(3).local_range[0] + worst
+        jmin, worst, h_c, self._step_cell = kinematics.volumes_and_step(
+            x, self.dofs, self.orient, self.vol0, self.mat, self.speed, self.nodal_vol, with_step)
+        bad = not (jmin > 0.0)
+        if self.comm.size > 1:  # every rank must stop together (and rank 0 must be able to say why)
+            self._flag[0] = 1.0 if bad else 0.0
+            self.comm.Allreduce(MPI.IN_PLACE, self._flag, op=MPI.MAX)
+            bad = self._flag[0] > 0.0
+        if bad:
+            local = (0 if not (jmin > 0.0) else 1, self.comm.rank)
+            _, owner = self.comm.allreduce(local, op=MPI.MIN)
+            info = None
+            if self.comm.rank == owner:
+                c = x[self.dofs[worst]].mean(axis=0)
+                c0 = self.X[self.dofs[worst]].mean(axis=0)
+                info = (self.mesh.topology.index_map(3).local_range[0] + worst, jmin, c, c0)
+            gidx, jw, c, c0 = self.comm.bcast(info, root=owner)
             raise SimulationError(
-                f"element {gidx} inverted (J = {jmin:.3g}) at step {self.step_count}, t = {self.t * 1e6:.3f} us, "
-                f"centre ({c[0] * 1e3:.2f}, {c[1] * 1e3:.2f}, {c[2] * 1e3:.2f}) mm")
+                f"element {gidx} inverted (J = {jw:.3g}) at step {self.step_count}, t = {self.t * 1e6:.3f} us, "
+                f"centre ({c[0] * 1e3:.2f}, {c[1] * 1e3:.2f}, {c[2] * 1e3:.2f}) mm; in the undeformed projectile "
+                f"{c0[1] * 1e3:.1f} mm behind the nose tip, radius {np.hypot(c0[0], c0[2]) * 1e3:.1f} mm")
         if self.nodal:
             self._ghost_sum(self._nvol)
         t1 = time.perf_counter()
@@ -308,9 +321,13 @@ class ExplicitSolver:
             return
         new = self.safety * self.comm.allreduce(h_c, op=MPI.MIN)
         if not (new > 1e-3 * self.dt0):
+            _, owner = self.comm.allreduce((h_c, self.comm.rank), op=MPI.MIN)
+            c = self.X[self.dofs[self._step_cell]].mean(axis=0) if self.comm.rank == owner else None
+            c = self.comm.bcast(c, root=owner)
             raise SimulationError(
                 f"stable step collapsed to {new:.3g} s (initial {self.dt0:.3g} s) at step {self.step_count}, "
-                f"t = {self.t * 1e6:.3f} us: an element is nearly flat")
+                f"t = {self.t * 1e6:.3f} us: an element is nearly flat, {c[1] * 1e3:.1f} mm behind the nose "
+                f"tip (radius {np.hypot(c[0], c[2]) * 1e3:.1f} mm) in the undeformed projectile")
         self.dt = new
         self.dt_min = min(self.dt_min, new)
 

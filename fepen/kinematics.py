@@ -63,12 +63,13 @@ def volumes_and_step(x, dofs, orient, vol0, mat, speed, nodal_vol, with_step=Tru
         with_step: also compute the shortest altitudes (else the third result is inf).
 
     Returns:
-        (min J, cell of min J, min over cells of shortest altitude / wave speed).
+        (min J, cell of min J, min over cells of shortest altitude / wave speed, cell of that minimum).
     """
     nodal_vol[:] = 0.0
     jmin = np.inf
     worst = -1
     dtmin = np.inf
+    dtcell = -1
     for e in range(dofs.shape[0]):
         # J = det(x1 - x0, x2 - x0, x3 - x0) / (6 V0): needs the positions only, not the gradients
         n0, n1, n2, n3 = dofs[e, 0], dofs[e, 1], dofs[e, 2], dofs[e, 3]
@@ -110,7 +111,8 @@ def volumes_and_step(x, dofs, orient, vol0, mat, speed, nodal_vol, with_step=Tru
             t = h / speed[m]
             if t < dtmin:
                 dtmin = t
-    return jmin, worst, dtmin
+                dtcell = e
+    return jmin, worst, dtmin, dtcell
 
 
 @numba.njit(cache=True, inline="always", fastmath=_FAST, error_model="numpy")

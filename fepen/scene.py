@@ -131,6 +131,9 @@ SCHEMA: dict[str, Key] = {
     "projectile.material.reference_strain_rate": _pos(1.0, "1/s", 1.0e9),
     "projectile.material.specific_heat": _pos(470.0, "J/(kg K)", 1.0e5),
     "projectile.material.taylor_quinney": _num(0.9, "", 0.0, 1.0),
+    "projectile.failure_strain": _num(0.5, "", 0.0, 100.0, lo_open=True,
+                                      doc="PEEQ beyond which the projectile would fracture or erode: a concrete-"
+                                          "target run stops, beyond the method (docs/theory.md)"),
     # --- explosive charge (Table 4) ---
     "charge.material.density": _num(1850.0, "kg/m^3", 100.0, 30000.0),
     "charge.material.youngs_modulus": _num(10.1e9, "Pa", 1.0e5, 1.0e13),

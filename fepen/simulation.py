@@ -132,8 +132,26 @@ class Simulation:
                                   self._max_peeq(), getattr(self.load, "area", 0.0))
         results.finite_row(row, s.step_count, s.t)
         self.rows.append(row)
+        if self.concrete and row[results.HISTORY_COLUMNS.index("max_peeq")] > self.scene.projectile.failure_strain:
+            self._beyond_method()
         self.gauges.record()
         return row
+
+    def _beyond_method(self):
+        """Stop: the equivalent plastic strain passed projectile.failure_strain (where, when)."""
+        from fepen.errors import BeyondMethod
+
+        s = self.solver
+        local = (float(s.eps_p.max()), self.comm.rank, int(np.argmax(s.eps_p))) if s.n_cells else (-1.0, 0, -1)
+        peeq, owner, cell = self.comm.allreduce(local, op=MPI.MAX)
+        where = s.X[s.dofs[cell]].mean(axis=0) if self.comm.rank == owner else None
+        where = self.comm.bcast(where, root=owner)
+        raise BeyondMethod(
+            f"the equivalent plastic strain reached {peeq:.3g} > projectile.failure_strain = "
+            f"{self.scene.projectile.failure_strain:g}, {where[1] * 1e3:.1f} mm behind the nose tip "
+            f"(radius {np.hypot(where[0], where[2]) * 1e3:.1f} mm), at t = {s.t * 1e6:.1f} us, step "
+            f"{s.step_count}: the projectile would fracture or erode, which projectile-target separation "
+            "does not model; no result is reported")
 
     def run(self) -> dict:
         """Advance to the end (run.end_time, or a stop event) and write the outputs.
