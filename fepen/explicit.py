@@ -345,8 +345,9 @@ class ExplicitSolver:
         return Energies(ke, sums[0], sums[1], sums[2], sums[3], sums[4], self.ke0 or 0.0)
 
     def _cell_J(self) -> np.ndarray:
-        p = self.positions()[self.dofs]
-        return np.linalg.det(np.einsum("eai,eaj->eij", p, self.grad0))
+        J = np.empty(self.n_cells)
+        kinematics.cell_jacobians(self.positions(), self.dofs, self.orient, self.vol0, J)
+        return J
 
     def _deviatoric_energy(self) -> float:
         G = np.array([m.shear_modulus for m in self.materials])[self.mat]

@@ -115,6 +115,18 @@ def volumes_and_step(x, dofs, orient, vol0, mat, speed, nodal_vol, with_step=Tru
     return jmin, worst, dtmin, dtcell
 
 
+@numba.njit(cache=True, fastmath=_FAST, error_model="numpy")
+def cell_jacobians(x, dofs, orient, vol0, out):
+    """J = V / V0 of every cell into out (for the energies; the same formula as volumes_and_step)."""
+    for e in range(dofs.shape[0]):
+        n0, n1, n2, n3 = dofs[e, 0], dofs[e, 1], dofs[e, 2], dofs[e, 3]
+        ax, ay, az = x[n1, 0] - x[n0, 0], x[n1, 1] - x[n0, 1], x[n1, 2] - x[n0, 2]
+        bx, by, bz = x[n2, 0] - x[n0, 0], x[n2, 1] - x[n0, 1], x[n2, 2] - x[n0, 2]
+        cx, cy, cz = x[n3, 0] - x[n0, 0], x[n3, 1] - x[n0, 1], x[n3, 2] - x[n0, 2]
+        six_v = ax * (by * cz - bz * cy) - ay * (bx * cz - bz * cx) + az * (bx * cy - by * cx)
+        out[e] = six_v / (6.0 * vol0[e]) * orient[e]
+
+
 @numba.njit(cache=True, inline="always", fastmath=_FAST, error_model="numpy")
 def _cofactor(a00, a01, a02, a10, a11, a12, a20, a21, a22):
     """Cofactor matrix (J A^-T) of a 3x3 matrix given by its entries, as a 9-tuple, row-major."""

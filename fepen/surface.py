@@ -18,6 +18,9 @@ from __future__ import annotations
 
 from dataclasses import dataclass
 
+import math
+
+import numba
 import numpy as np
 from mpi4py import MPI
 
@@ -33,6 +36,41 @@ def rotate_between(a: np.ndarray, b: np.ndarray, v: np.ndarray) -> np.ndarray:
     k = np.cross(a, b)
     kv = np.einsum("ij,ij->i", k, v)
     return c[:, None] * v + np.cross(k, v) + (kv / np.maximum(1.0 + c, 1e-12))[:, None] * k
+
+
+@numba.njit(cache=True, error_model="numpy")
+def _facet_kinematics(x_all, v_all, tri, n_flat0, N0, area0, flat0, x, v, area, n):
+    """Surface.kinematics in one compiled loop (the numpy version was a third of a penetration step):
+    centroid, mean velocity, stretched exact area, and the exact normal turned by the rotation taking
+    the flat reference normal to the current one (rotate_between, written out)."""
+    for i in range(tri.shape[0]):
+        i0, i1, i2 = tri[i, 0], tri[i, 1], tri[i, 2]
+        ax, ay, az = x_all[i1, 0] - x_all[i0, 0], x_all[i1, 1] - x_all[i0, 1], x_all[i1, 2] - x_all[i0, 2]
+        bx, by, bz = x_all[i2, 0] - x_all[i0, 0], x_all[i2, 1] - x_all[i0, 1], x_all[i2, 2] - x_all[i0, 2]
+        cx, cy, cz = 0.5 * (ay * bz - az * by), 0.5 * (az * bx - ax * bz), 0.5 * (ax * by - ay * bx)
+        a = math.sqrt(cx * cx + cy * cy + cz * cz)
+        bx, by, bz = cx / a, cy / a, cz / a  # current unit normal of the flat facet
+        px, py, pz = n_flat0[i, 0], n_flat0[i, 1], n_flat0[i, 2]
+        c = px * bx + py * by + pz * bz
+        kx, ky, kz = py * bz - pz * by, pz * bx - px * bz, px * by - py * bx
+        vx, vy, vz = N0[i, 0], N0[i, 1], N0[i, 2]
+        kv = (kx * vx + ky * vy + kz * vz) / max(1.0 + c, 1e-12)
+        n[i, 0] = c * vx + (ky * vz - kz * vy) + kv * kx
+        n[i, 1] = c * vy + (kz * vx - kx * vz) + kv * ky
+        n[i, 2] = c * vz + (kx * vy - ky * vx) + kv * kz
+        area[i] = area0[i] * (a / flat0[i])
+        for k in range(3):
+            x[i, k] = (x_all[i0, k] + x_all[i1, k] + x_all[i2, k]) / 3.0
+            v[i, k] = (v_all[i0, k] + v_all[i1, k] + v_all[i2, k]) / 3.0
+
+
+@numba.njit(cache=True)
+def _to_nodes(tri, f, out):
+    """out[tri[i, j]] += f[i] / 3 for each facet i and corner j, in facet order."""
+    for j in range(3):
+        for i in range(tri.shape[0]):
+            for k in range(3):
+                out[tri[i, j], k] += f[i, k] / 3.0
 
 
 def area_vectors(x: np.ndarray, tri: np.ndarray) -> np.ndarray:
@@ -94,17 +132,14 @@ class Surface:
         Returns:
             (x (f, 3), v (f, 3), area (f,), n (f, 3)).
         """
-        av = area_vectors(x_all, self.tri)
-        a = np.linalg.norm(av, axis=1)
-        n = rotate_between(self.n_flat0, av / a[:, None], self.N0)
-        x = x_all[self.tri].mean(axis=1)
-        v = v_all[self.tri].mean(axis=1)
-        return x, v, self.area0 * (a / self.flat0), n
+        f = len(self.tri)
+        x, v, n, area = np.empty((f, 3)), np.empty((f, 3)), np.empty((f, 3)), np.empty(f)
+        _facet_kinematics(x_all, v_all, self.tri, self.n_flat0, self.N0, self.area0, self.flat0, x, v, area, n)
+        return x, v, area, n
 
     def to_nodes(self, f: np.ndarray, out: np.ndarray) -> None:
         """Add the load points' forces (f, 3) to their nodes, one third each, into out (n_nodes, 3)."""
-        for j in range(3):
-            np.add.at(out, self.tri[:, j], f / 3.0)
+        _to_nodes(self.tri, f, out)
 
 
 def outer_surface(V, facet_tags, shape, tag: int = geometry.OUTER) -> Surface:

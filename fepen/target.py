@@ -20,6 +20,8 @@ See docs/theory.md §8 for the derivations and the choices the paper leaves open
 
 from __future__ import annotations
 
+import functools
+
 import math
 from dataclasses import dataclass
 
@@ -192,6 +194,12 @@ def tunnel_stress(law: TargetLaw, vn: np.ndarray, sigma_s) -> np.ndarray:
     return np.where(vn > 0.0, sigma_s + law.B * law.density * vn * vn, 0.0)
 
 
+@functools.lru_cache(maxsize=8)
+def _gauss_legendre(n: int):
+    """Gauss-Legendre nodes and weights on [-1, 1] (computed once: an eigenvalue problem)."""
+    return np.polynomial.legendre.leggauss(n)
+
+
 def crater_energy_ejects(law: TargetLaw, vn, L_e, radius, R_meridian, sin_phi0, n_gauss: int = 8):
     """The splash-streamline energy balance per unit surface area (docs/theory.md §8.3).
 
@@ -204,7 +212,7 @@ def crater_energy_ejects(law: TargetLaw, vn, L_e, radius, R_meridian, sin_phi0, 
     """
     rho = np.maximum(radius, 1e-12)
     l = (law.c_over_a - 1.0) * rho
-    xg, wg = np.polynomial.legendre.leggauss(n_gauss)
+    xg, wg = _gauss_legendre(n_gauss)
     integral = np.zeros_like(rho)
     for xi, wi in zip(xg, wg):
         w = 0.5 * l * (xi + 1.0)
