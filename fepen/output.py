@@ -51,3 +51,12 @@ def prepare(out: str | Path, comm: MPI.Comm = MPI.COMM_WORLD) -> Path:
         out.mkdir(parents=True, exist_ok=True)
     comm.barrier()
     return out
+
+
+def peak_memory_bytes(comm: MPI.Comm = MPI.COMM_WORLD) -> int:
+    """Peak resident memory of the run: the sum over ranks of each process's peak RSS (bytes)."""
+    import resource
+    import sys
+
+    rss = resource.getrusage(resource.RUSAGE_SELF).ru_maxrss  # KiB on Linux, bytes on macOS
+    return comm.allreduce(int(rss) * (1 if sys.platform == "darwin" else 1024), op=MPI.SUM)

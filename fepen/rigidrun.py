@@ -183,6 +183,7 @@ class RigidRun:
                  "wall_s": time.perf_counter() - self.t0,
                  "time_split_s": {"mesh": self.mesh_s, "time_loop": loop_s}, "mass_kg": self.mass,
                  "cells": self.pm.mesh.topology.index_map(3).size_global, "ranks": self.comm.size,
+                 "peak_memory_bytes": output.peak_memory_bytes(self.comm),
                  "load_points": len(self.pts["area0"]), "fidelity": "rigid"}
         summary = results.summary(self.scene, self.rows, outcome, extra)
         if self.out is not None:

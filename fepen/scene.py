@@ -182,7 +182,11 @@ SCHEMA: dict[str, Key] = {
     # --- run control ---
     "run.end_time": _pos(_ABSENT, "s", 1.0, doc="absent: until stopped, perforated or ricocheted"),
     "run.output_interval": _pos(5.0e-5, "s", 1.0),
-    "run.safety_factor": _num(0.8, "", 0.0, 1.0, lo_open=True, doc="stable step = factor * h_min / c"),
+    "run.safety_factor": _num(0.8, "", 0.0, 1.0, lo_open=True,
+                              doc="stable step = factor * (the estimate of run.stable_step)"),
+    "run.stable_step": _choice("altitude", "altitude", "eigenvalue",
+                               doc="altitude: min h/c (conservative); eigenvalue: 2/omega_max of the "
+                                   "discrete body (power iteration), tracked by h/c as it deforms"),
     "run.fields": _flag(True, doc="write fields.xdmf"),
     "run.checkpoint_interval": _num(1.0e-4, "s", 0.0, 1.0,
                                     doc="simulated time between checkpoints (fepen run --resume DIR); 0: none"),

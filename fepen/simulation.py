@@ -62,6 +62,8 @@ class Simulation:
         cellmat = np.zeros(self.pm.mesh.topology.index_map(3).size_local, dtype=np.int64)
         t0 = time.perf_counter()
         self.solver = explicit.ExplicitSolver(self.pm.mesh, mats, cellmat, scene.run.safety_factor)
+        if scene.run.stable_step == "eigenvalue":
+            self.solver.calibrate_step()
         self.tip = self.solver.node_at((0.0, 0.0, 0.0))
         self.tail = self.solver.node_at((0.0, self.pm.shape.length, 0.0))
         R, v = placement(scene)
@@ -299,7 +301,8 @@ class Simulation:
                  "time_split_s": {"mesh": self.mesh_s, "setup_jit": self.jit_s,
                                   "time_loop": loop_s - self.output_s, "output": self.output_s},
                  "mass_kg": s.total_mass, "cells": self.pm.mesh.topology.index_map(3).size_global,
-                 "ranks": self.comm.size, "stress_kernel": s.kernel}
+                 "ranks": self.comm.size, "stress_kernel": s.kernel, "step_gain": s.step_gain,
+                 "peak_memory_bytes": output.peak_memory_bytes(self.comm)}
         summary = results.summary(self.scene, self.rows, outcome, extra)
         output.write_json(self.out / "summary.json", summary, self.comm)
         return summary
