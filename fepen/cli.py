@@ -4,6 +4,7 @@
     fepen run --resume DIR
     fepen mesh SCENE.toml [--out DIR] [--set KEY=VALUE ...]
     fepen validate [SCENE.toml] [--out DIR] [--set KEY=VALUE ...]
+    fepen study accuracy-cost [--out DIR] [--ranks N] [--quick] [--fresh]
     fepen keys
 
 Bad input prints one line naming the key and what is allowed and exits with code 2, before anything is
@@ -42,6 +43,12 @@ def _parser() -> argparse.ArgumentParser:
                "results/validation")
     scene_args(sub.add_parser("mesh", help="build the projectile mesh only: mesh.json, mesh.xdmf, mesh.png"),
                "results/mesh")
+    st = sub.add_parser("study", help="accuracy-cost: what accuracy costs in time (study.md, pareto.png)")
+    st.add_argument("which", choices=["accuracy-cost"])
+    st.add_argument("--out", default="results/study", help="results directory (default results/study)")
+    st.add_argument("--ranks", type=int, default=2, help="MPI ranks of each run (default 2)")
+    st.add_argument("--quick", action="store_true", help="a small subset on coarse meshes (minutes)")
+    st.add_argument("--fresh", action="store_true", help="run again what DIR/runs already holds")
     sub.add_parser("keys", help="list every scene key with its default, unit and allowed values")
     return ap
 
@@ -134,6 +141,21 @@ def cmd_validate(args) -> int:
     return 0
 
 
+def cmd_study(args) -> int:
+    """The accuracy-cost study (each run its own process, on --ranks MPI ranks)."""
+    from mpi4py import MPI
+
+    from fepen import study
+
+    if MPI.COMM_WORLD.size > 1:
+        raise InputError("fepen study", "run it without mpirun: it starts its own MPI jobs (--ranks)")
+    if args.ranks < 1:
+        raise InputError("--ranks", f"must be at least 1, got {args.ranks}")
+    study.study(args.out, ranks=args.ranks, quick=args.quick, fresh=args.fresh, say=_say)
+    _say(f"written: {args.out}/study.csv, study.md, study.json, pareto.png")
+    return 0
+
+
 def cmd_keys(args) -> int:
     """Print the scene-key table (Markdown)."""
     from fepen import scene as fscene
@@ -142,7 +164,7 @@ def cmd_keys(args) -> int:
     return 0
 
 
-COMMANDS = {"run": cmd_run, "mesh": cmd_mesh, "validate": cmd_validate, "keys": cmd_keys}
+COMMANDS = {"run": cmd_run, "mesh": cmd_mesh, "validate": cmd_validate, "study": cmd_study, "keys": cmd_keys}
 
 
 def main(argv: list[str] | None = None) -> int:

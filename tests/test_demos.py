@@ -25,3 +25,14 @@ def test_mpi_shot_demo(tmp_path):
                        capture_output=True, text=True, env=dict(os.environ, PYTHONPATH=str(ROOT)), timeout=600)
     assert r.returncode == 0, r.stderr[-2000:]
     assert "'ranks': 2" in r.stdout and (tmp_path / "demo.png").stat().st_size > 5000
+
+
+def test_hard_cases_demo(tmp_path):
+    """demos/hard_cases/run_all.py on one case, a coarse mesh, 2 ranks: one table row, the ricochet."""
+    r = subprocess.run([sys.executable, "demos/hard_cases/run_all.py", "--cases", "ricochet_250_75", "--sizes",
+                        "0.006", "--ranks", "2", "--out", str(tmp_path), "--markdown", str(tmp_path / "t.md")],
+                       cwd=ROOT, capture_output=True, text=True, env=dict(os.environ, PYTHONPATH=str(ROOT)),
+                       timeout=600)
+    assert r.returncode == 0, r.stderr[-2000:]
+    rows = [ln for ln in (tmp_path / "t.md").read_text().splitlines() if ln.startswith("| ricochet")]
+    assert len(rows) == 1 and "| ricochet |" in rows[0].replace("ricochet_250_75", "")
