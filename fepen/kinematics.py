@@ -50,6 +50,16 @@ def reference_gradients(X: np.ndarray, dofs: np.ndarray):
     return grad0, np.abs(det) / 6.0, np.sign(det)
 
 
+@numba.njit(cache=True, inline="always", fastmath=_FAST, error_model="numpy")
+def _six_volume(x, dofs, e):
+    """det(x1 - x0, x2 - x0, x3 - x0) of cell e: six times its signed volume."""
+    n0, n1, n2, n3 = dofs[e, 0], dofs[e, 1], dofs[e, 2], dofs[e, 3]
+    ax, ay, az = x[n1, 0] - x[n0, 0], x[n1, 1] - x[n0, 1], x[n1, 2] - x[n0, 2]
+    bx, by, bz = x[n2, 0] - x[n0, 0], x[n2, 1] - x[n0, 1], x[n2, 2] - x[n0, 2]
+    cx, cy, cz = x[n3, 0] - x[n0, 0], x[n3, 1] - x[n0, 1], x[n3, 2] - x[n0, 2]
+    return ax * (by * cz - bz * cy) - ay * (bx * cz - bz * cx) + az * (bx * cy - by * cx)
+
+
 @numba.njit(cache=True, fastmath=_FAST, error_model="numpy")
 def volumes_and_step(x, dofs, orient, vol0, mat, speed, nodal_vol, with_step=True):
     """Current cell volumes into nodal volumes; the smallest J; the stable step of the current mesh.
@@ -72,12 +82,7 @@ def volumes_and_step(x, dofs, orient, vol0, mat, speed, nodal_vol, with_step=Tru
     dtcell = -1
     for e in range(dofs.shape[0]):
         # J = det(x1 - x0, x2 - x0, x3 - x0) / (6 V0): needs the positions only, not the gradients
-        n0, n1, n2, n3 = dofs[e, 0], dofs[e, 1], dofs[e, 2], dofs[e, 3]
-        ax, ay, az = x[n1, 0] - x[n0, 0], x[n1, 1] - x[n0, 1], x[n1, 2] - x[n0, 2]
-        bx, by, bz = x[n2, 0] - x[n0, 0], x[n2, 1] - x[n0, 1], x[n2, 2] - x[n0, 2]
-        cx, cy, cz = x[n3, 0] - x[n0, 0], x[n3, 1] - x[n0, 1], x[n3, 2] - x[n0, 2]
-        six_v = ax * (by * cz - bz * cy) - ay * (bx * cz - bz * cx) + az * (bx * cy - by * cx)
-        J = six_v / (6.0 * vol0[e]) * orient[e]
+        J = _six_volume(x, dofs, e) / (6.0 * vol0[e]) * orient[e]
         if not (J > jmin):
             if not (J >= jmin):  # also catches NaN
                 jmin = J
@@ -119,12 +124,7 @@ def volumes_and_step(x, dofs, orient, vol0, mat, speed, nodal_vol, with_step=Tru
 def cell_jacobians(x, dofs, orient, vol0, out):
     """J = V / V0 of every cell into out (for the energies; the same formula as volumes_and_step)."""
     for e in range(dofs.shape[0]):
-        n0, n1, n2, n3 = dofs[e, 0], dofs[e, 1], dofs[e, 2], dofs[e, 3]
-        ax, ay, az = x[n1, 0] - x[n0, 0], x[n1, 1] - x[n0, 1], x[n1, 2] - x[n0, 2]
-        bx, by, bz = x[n2, 0] - x[n0, 0], x[n2, 1] - x[n0, 1], x[n2, 2] - x[n0, 2]
-        cx, cy, cz = x[n3, 0] - x[n0, 0], x[n3, 1] - x[n0, 1], x[n3, 2] - x[n0, 2]
-        six_v = ax * (by * cz - bz * cy) - ay * (bx * cz - bz * cx) + az * (bx * cy - by * cx)
-        out[e] = six_v / (6.0 * vol0[e]) * orient[e]
+        out[e] = _six_volume(x, dofs, e) / (6.0 * vol0[e]) * orient[e]
 
 
 @numba.njit(cache=True, inline="always", fastmath=_FAST, error_model="numpy")

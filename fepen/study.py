@@ -25,9 +25,6 @@ import csv
 import io
 import json
 import os
-import subprocess
-import sys
-import time
 from pathlib import Path
 
 import numpy as np
@@ -84,19 +81,12 @@ def _run(cmd_sets: list[str], out: Path, ranks: int, fresh: bool) -> dict:
         old = json.loads(summary_path.read_text())
         if old.get("scene") == want and old.get("ranks") == ranks and "process_s" in old:
             return old
-    cmd = [sys.executable, "-m", "fepen", "run", "--out", str(out)]
+    args = ["run", "--out", out]
     for s in cmd_sets:
-        cmd += ["--set", s]
-    if ranks > 1:
-        cmd = ["mpirun", "-n", str(ranks), *cmd]
-    env = dict(os.environ, OMPI_ALLOW_RUN_AS_ROOT="1", OMPI_ALLOW_RUN_AS_ROOT_CONFIRM="1",
-               OMPI_MCA_rmaps_base_oversubscribe="1")
-    t0 = time.perf_counter()
-    r = subprocess.run(cmd, capture_output=True, text=True, env=env)
-    process_s = time.perf_counter() - t0
-    if r.returncode != 0:
-        lines = [ln for ln in r.stderr.splitlines() if ln.startswith("fepen:")]
-        return {"failed": lines[-1] if lines else r.stderr[-400:], "process_s": process_s}
+        args += ["--set", s]
+    code, process_s, message = output.run_fepen_process(args, ranks)
+    if code != 0:
+        return {"failed": message, "process_s": process_s}
     summary = json.loads(summary_path.read_text())
     summary["process_s"] = process_s
     summary_path.write_text(json.dumps(summary, indent=2) + "\n")

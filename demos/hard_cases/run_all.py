@@ -11,31 +11,21 @@ message instead. With --markdown the table is also written as Markdown (docs/har
 
 import argparse
 import json
-import os
-import subprocess
-import sys
-import time
 from pathlib import Path
+
+from fepen.output import run_fepen_process
 
 HERE = Path(__file__).resolve().parent
 
 
 def run(case: Path, size: float, ranks: int, out: Path) -> dict:
-    cmd = [sys.executable, "-m", "fepen", "run", str(case), "--out", str(out), "--set", f"mesh.size={size}",
-           "--set", "run.fields=false"]
-    if ranks > 1:
-        cmd = ["mpirun", "-n", str(ranks), *cmd]
-    env = dict(os.environ, OMPI_ALLOW_RUN_AS_ROOT="1", OMPI_ALLOW_RUN_AS_ROOT_CONFIRM="1",
-               OMPI_MCA_rmaps_base_oversubscribe="1")
-    t0 = time.perf_counter()
-    r = subprocess.run(cmd, capture_output=True, text=True, env=env)
-    wall = time.perf_counter() - t0
-    row = {"case": case.stem, "h_mm": size * 1e3, "exit": r.returncode, "process_s": wall}
-    if r.returncode == 0:
+    code, wall, message = run_fepen_process(["run", case, "--out", out, "--set", f"mesh.size={size}", "--set",
+                                             "run.fields=false"], ranks)
+    row = {"case": case.stem, "h_mm": size * 1e3, "exit": code, "process_s": wall}
+    if code == 0:
         row.update(json.loads((out / "summary.json").read_text()))
     else:
-        lines = [ln for ln in r.stderr.strip().splitlines() if ln.startswith("fepen:")]
-        row["message"] = lines[-1] if lines else r.stderr.strip()[-300:]
+        row["message"] = message
     return row
 
 
