@@ -139,6 +139,15 @@ class ExplicitSolver:
         np.add.at(mvec.array, self.dofs.ravel(), np.repeat(0.25 * rho * self.vol0, 4))
         self._ghost_sum(mvec)
         self.mass = mvec.array[: self.n_nodes].copy()
+        # the same per material (the bodies' masses, for their mass-averaged accelerations)
+        mvec_k = la.vector(imap, bs=nm)
+        arr = mvec_k.array.reshape(-1, nm)
+        for k in range(nm):
+            sel = self.mat == k
+            np.add.at(arr[:, k], self.dofs[sel].ravel(), np.repeat(0.25 * rho[sel] * self.vol0[sel], 4))
+        self._ghost_sum(mvec_k)
+        self.mass_by_material = arr[: self.n_nodes].copy()
+        self.body_mass = self.comm.allreduce(self.mass_by_material[: self.n_owned].sum(axis=0), op=MPI.SUM)
         if np.any(self.mass[: self.n_owned] <= 0.0):
             raise SimulationError("a node has no mass (an orphan node in the mesh)")
         self.total_mass = self.comm.allreduce(float(self.mass[: self.n_owned].sum()), op=MPI.SUM)
@@ -201,8 +210,9 @@ class ExplicitSolver:
 
     def stable_step(self) -> float:
         """Safety x min over cells of (shortest altitude / dilatational speed), current mesh, all ranks."""
+        # a scratch array: nodal_vol must keep the ghost-summed volumes of the last step (energies use them)
         jmin, worst, h_c, _ = kinematics.volumes_and_step(self.positions(), self.dofs, self.orient, self.vol0,
-                                                       self.mat, self.speed, self.nodal_vol)
+                                                       self.mat, self.speed, np.empty_like(self.nodal_vol))
         return self.safety * self.step_gain * self.comm.allreduce(h_c, op=MPI.MIN)
 
     def calibrate_step(self, iterations: int = 400, rtol: float = 1e-5) -> tuple[float, float]:
@@ -248,7 +258,7 @@ class ExplicitSolver:
             a[:] = 0.0
         self.eps_p[:] = 0.0
         _, _, h_c, _ = kinematics.volumes_and_step(self.positions(), self.dofs, self.orient, self.vol0, self.mat,
-                                                   self.speed, self.nodal_vol)
+                                                   self.speed, np.empty_like(self.nodal_vol))
         h_c = self.comm.allreduce(h_c, op=MPI.MIN)
         dt_crit = 2.0 / np.sqrt(lam)
         self.step_gain = dt_crit / h_c

@@ -20,6 +20,9 @@ HISTORY_COLUMNS = ["t_s", "nose_x_mm", "nose_y_mm", "tail_x_mm", "tail_y_mm", "s
                    "external_work_J", "elastic_J", "plastic_J", "heat_J", "energy_error", "contact_nodes",
                    "dt_s", "max_peeq", "contact_area_m2"]
 COL = {k: i for i, k in enumerate(HISTORY_COLUMNS)}
+#: appended with a charge: mass-averaged acceleration of each body along the axis (tail to nose), in g
+#: (negative while the projectile decelerates)
+CHARGE_COLUMNS = ["shell_acc_g", "charge_acc_g"]
 
 
 def history_row(t, tip, tail, velocity, force, mass, energies: dict, contact: int, dt: float, peeq: float,
@@ -41,13 +44,13 @@ def history_row(t, tip, tail, velocity, force, mass, energies: dict, contact: in
     return row
 
 
-def write_history(rows, out: Path, comm=MPI.COMM_WORLD) -> None:
-    """history.csv (rank 0, atomically)."""
+def write_history(rows, out: Path, comm=MPI.COMM_WORLD, columns=None) -> None:
+    """history.csv (rank 0, atomically); columns: HISTORY_COLUMNS (default), + CHARGE_COLUMNS with a charge."""
     if comm.rank != 0:
         return
     buf = io.StringIO()
     w = csv.writer(buf)
-    w.writerow(HISTORY_COLUMNS)
+    w.writerow(columns or HISTORY_COLUMNS)
     for r in rows:
         w.writerow([f"{v:.9g}" for v in r])
     output.write_text(Path(out) / "history.csv", buf.getvalue(), comm)

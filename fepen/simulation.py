@@ -35,8 +35,9 @@ def check_supported(scene) -> None:
     if rigid and scene.target.kind != "concrete":
         raise InputError("effects.fidelity", "'rigid' runs against target.kind = 'concrete'; a rigid "
                                              "projectile on a rigid wall has nothing to compute")
-    if scene.effects.charge:
-        raise InputError("effects.charge", "the charged projectile is not available in this version")
+    if scene.effects.charge and not rigid and scene.charge.contact != "tied":
+        raise InputError("charge.contact", "'frictional' shell-charge contact is not available in this version; "
+                                           "allowed: 'tied' (the charge bonded to the shell)")
 
 
 class Simulation:
@@ -60,6 +61,11 @@ class Simulation:
         self.out = output.prepare(out, comm)
         mats = [M.from_scene(scene)]
         cellmat = np.zeros(self.pm.mesh.topology.index_map(3).size_local, dtype=np.int64)
+        if self.pm.charge:  # material 1: the charge, tied to the shell through the shared interface nodes
+            from fepen import geometry
+
+            mats.append(M.charge_from_scene(scene))
+            cellmat[fmesh.owned_cells_tagged(self.pm, geometry.CHARGE)] = 1
         t0 = time.perf_counter()
         self.solver = explicit.ExplicitSolver(self.pm.mesh, mats, cellmat, scene.run.safety_factor)
         if scene.run.stable_step == "eigenvalue":
@@ -87,6 +93,7 @@ class Simulation:
 
         self.gauges = analyses.Gauges(self.solver, self.pm)
         self.output_s = 0.0
+        self.columns = results.HISTORY_COLUMNS + (results.CHARGE_COLUMNS if self.pm.charge else [])
         self.rows: list[list[float]] = []
         self.fields = None
         # the loop's clocks and event memory (checkpointed)
@@ -118,6 +125,17 @@ class Simulation:
         p = np.sum(s.mass[:n, None] * vel[:n], axis=0)
         return self.comm.allreduce(p, op=MPI.SUM) / s.total_mass
 
+    def _body_accelerations(self, axis) -> np.ndarray:
+        """Mass-averaged acceleration of the shell and of the charge along the axis (tail to nose), in g:
+        Σ_a m_a^(body) a_a · axis / m_body, with m_a^(body) the lumped mass node a takes from that body's
+        cells (interface nodes share theirs)."""
+        s = self.solver
+        n = s.n_owned
+        along = s.acc[:n] @ axis
+        local = np.array([float(s.mass_by_material[:n, k] @ along) for k in range(2)])
+        total = self.comm.allreduce(local, op=MPI.SUM)
+        return total / s.body_mass / results.G0
+
     def _max_peeq(self) -> float:
         s = self.solver
         return self.comm.allreduce(float(s.eps_p.max()) if s.n_cells else 0.0, op=MPI.MAX)
@@ -129,9 +147,11 @@ class Simulation:
         e = s.energies()
         en = dict(kinetic=e.kinetic, internal_work=e.internal_work, external_work=e.external_work,
                   elastic=e.elastic, plastic=e.plastic, heat=e.heat, energy_error=e.balance_error)
-        row = results.history_row(s.t, s.node_value(self.tip, x), s.node_value(self.tail, x), self._momentum(),
-                                  self.load.force, s.total_mass, en, self.load.contact_nodes, s.dt,
-                                  self._max_peeq(), getattr(self.load, "area", 0.0))
+        tip, tail = s.node_value(self.tip, x), s.node_value(self.tail, x)
+        row = results.history_row(s.t, tip, tail, self._momentum(), self.load.force, s.total_mass, en,
+                                  self.load.contact_nodes, s.dt, self._max_peeq(), getattr(self.load, "area", 0.0))
+        if self.pm.charge:
+            row += list(self._body_accelerations((tip - tail) / np.linalg.norm(tip - tail)))
         results.finite_row(row, s.step_count, s.t)
         self.rows.append(row)
         if self.concrete and row[results.HISTORY_COLUMNS.index("max_peeq")] > self.scene.projectile.failure_strain:
@@ -189,14 +209,14 @@ class Simulation:
                 if self.fields is not None and s.t >= self.next_out:
                     t_out = time.perf_counter()
                     self._write_fields()
-                    results.write_history(self.rows, self.out, self.comm)
+                    results.write_history(self.rows, self.out, self.comm, self.columns)
                     self.output_s += time.perf_counter() - t_out
                     self.next_out += out_dt
                 if ckpt_dt > 0.0 and s.t >= self.next_ckpt:
                     t_out = time.perf_counter()
                     while self.next_ckpt <= s.t:
                         self.next_ckpt += ckpt_dt
-                    results.write_history(self.rows, self.out, self.comm)
+                    results.write_history(self.rows, self.out, self.comm, self.columns)
                     checkpoint.write(self, self.wall_before + time.perf_counter() - self.wall_t0)
                     self.output_s += time.perf_counter() - t_out
                 s.step()
@@ -226,7 +246,7 @@ class Simulation:
             t_out = time.perf_counter()
             if self.fields is not None:
                 self.fields.consolidate()
-            results.write_history(self.rows, self.out, self.comm)  # kept even when the run failed
+            results.write_history(self.rows, self.out, self.comm, self.columns)  # kept even when the run failed
             if completed:
                 from fepen import analyses
 
