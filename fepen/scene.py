@@ -188,6 +188,9 @@ SCHEMA: dict[str, Key] = {
                                doc="altitude: min h/c (conservative); eigenvalue: 2/omega_max of the "
                                    "discrete body (power iteration), tracked by h/c as it deforms"),
     "run.fields": _flag(True, doc="write fields.xdmf"),
+    "run.acceleration_filter_hz": _num(1.0e4, "Hz", 0.0, 1.0e7,
+                                       doc="low-pass cut-off of the filtered accelerations (accelerations.csv); "
+                                           "0: none"),
     "run.checkpoint_interval": _num(1.0e-4, "s", 0.0, 1.0,
                                     doc="simulated time between checkpoints (fepen run --resume DIR); 0: none"),
     "run.rigid_step": _pos(_ABSENT, "s", 1e-3, doc="RK4 step of the rigid fidelity; absent: min(0.1 D/v0, t_stop/300)"),

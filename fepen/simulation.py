@@ -159,6 +159,30 @@ class Simulation:
         self.gauges.record()
         return row
 
+    def _write_accelerations(self):
+        """accelerations.csv: the target deceleration (and with a charge each body's axial acceleration),
+        raw and low-pass filtered (fepen.signals, run.acceleration_filter_hz); peaks into self.peaks."""
+        from fepen import signals
+
+        rows = np.array(self.rows)
+        t = rows[:, 0]
+        names = ["decel_g"] + (results.CHARGE_COLUMNS if self.pm.charge else [])
+        cut = self.scene.run.acceleration_filter_hz
+        cols, header = [t], ["t_s"]
+        self.peaks = {}
+        for name in names:
+            raw = rows[:, self.columns.index(name)]
+            filt = signals.lowpass(t, raw, cut)
+            cols += [raw, filt]
+            header += [name, name.replace("_g", "_filtered_g")]
+            k = int(np.argmax(np.abs(filt)))
+            depth = rows[k, self.columns.index("nose_y_mm")]
+            self.peaks[name.replace("_g", "")] = {"filtered_g": float(filt[k]), "t_s": float(t[k]),
+                                                   "nose_depth_mm": float(depth),
+                                                   "raw_peak_g": float(raw[np.argmax(np.abs(raw))])}
+        body = "\n".join(",".join(f"{v:.9g}" for v in r) for r in np.column_stack(cols))
+        output.write_text(self.out / "accelerations.csv", ",".join(header) + "\n" + body + "\n", self.comm)
+
     def _beyond_method(self):
         """Stop: the equivalent plastic strain passed projectile.failure_strain (where, when)."""
         from fepen.errors import BeyondMethod
@@ -251,6 +275,7 @@ class Simulation:
                 from fepen import analyses
 
                 self.gauges.write(self.out)
+                self._write_accelerations()
                 analyses.deformed_picture(self.solver, self.out / "deformed.png",
                                           f"t = {self.solver.t * 1e6:.0f} us, max PEEQ {self._max_peeq():.3g}")
             self.output_s += time.perf_counter() - t_out
@@ -322,7 +347,9 @@ class Simulation:
                                   "time_loop": loop_s - self.output_s, "output": self.output_s},
                  "mass_kg": s.total_mass, "cells": self.pm.mesh.topology.index_map(3).size_global,
                  "ranks": self.comm.size, "stress_kernel": s.kernel, "step_gain": s.step_gain,
-                 "peak_memory_bytes": output.peak_memory_bytes(self.comm)}
+                 "peak_memory_bytes": output.peak_memory_bytes(self.comm),
+                 "peak_accelerations": getattr(self, "peaks", None),
+                 "acceleration_filter_hz": self.scene.run.acceleration_filter_hz}
         summary = results.summary(self.scene, self.rows, outcome, extra)
         output.write_json(self.out / "summary.json", summary, self.comm)
         return summary
