@@ -147,3 +147,77 @@ def deformed_picture(solver, path: Path, title: str = "") -> None:
     plotter.add_text(f"{title}\nPEEQ colour scale: black 0 ... yellow {hi:.3g}", font_size=10, color="black")
     plotter.screenshot(str(path))
     plotter.close()
+
+
+class ChargeSections:
+    """Axial and shear stress of the charge at points of three cross-sections and along the axis
+    (physics.md §7), recorded over time into ``charge_sections.csv``.
+
+    Sections (reference axial position z from the nose tip): the charge's front face (its nose end, 0.5 mm
+    inside), the nose/cylinder interface of the projectile (z = nose length; the charge's front when the
+    cavity starts behind it), and half the charge length. On each, points at 0, 1/3, 2/3 and 0.9 of the
+    local cavity radius in the plane of incidence (+x); along the axis, five points from front to rear.
+    Each point is read from the charge cell whose reference centre is nearest. Axial stress σ_aa =
+    a·σ·a with a the current axis (tail to nose); shear τ = a·σ·r with r the cell's current radial unit
+    vector (Pa; compression negative).
+
+    Args:
+        solver: the ExplicitSolver. pm: its ProjectileMesh (with a charge). charge_material: its index.
+    """
+
+    def __init__(self, solver, pm, charge_material: int = 1):
+        self.solver, self.comm = solver, solver.comm
+        shape = pm.shape
+        secs = shape.cavity_sections()
+        z_front, z_rear = secs[0][0], secs[-1][1]
+
+        def radius_at(z):
+            return next((r for a, b, r in secs if a <= z <= b), secs[-1][2])
+
+        self.points = []
+        for label, z in (("front", z_front + 5e-4), ("nose_end", max(shape.nose_length, z_front + 5e-4)),
+                         ("mid", 0.5 * (z_front + z_rear))):
+            for frac in (0.0, 1 / 3, 2 / 3, 0.9):
+                self.points.append((f"{label}_r{round(100 * frac)}", np.array([frac * radius_at(z), z, 0.0])))
+        for k, z in enumerate(np.linspace(z_front + 5e-4, z_rear - 5e-4, 5)):
+            self.points.append((f"axis{k}", np.array([0.0, z, 0.0])))
+        centres = solver.X[solver.dofs].mean(axis=1)
+        mine = np.flatnonzero(solver.mat == charge_material)
+        self.cells = []
+        for _, p in self.points:  # the nearest charge cell, on one rank
+            if len(mine):
+                d = np.linalg.norm(centres[mine] - p, axis=1)
+                k = int(np.argmin(d))
+                best = (float(d[k]), self.comm.rank)
+            else:
+                best, k = (np.inf, self.comm.rank), -1
+            winner = self.comm.allreduce(best, op=MPI.MIN)
+            self.cells.append(int(mine[k]) if winner[1] == self.comm.rank else -1)
+        self.columns = ["t_s"] + [f"{n}_{q}_Pa" for n, _ in self.points for q in ("axial", "shear")]
+        self.rows = []
+
+    def record(self, tip: np.ndarray, tail: np.ndarray) -> None:
+        """One row: the stresses at every point (collective); tip, tail: current nose tip and tail centre."""
+        s = self.solver
+        x = s.positions()
+        axis = (tip - tail) / np.linalg.norm(tip - tail)
+        vals = np.zeros(2 * len(self.cells))
+        for i, c in enumerate(self.cells):
+            if c < 0:
+                continue
+            sd = s.s[c]
+            pm = float(np.mean(s.nodal_p[s.dofs[c], s.mat[c]]))
+            sig = np.array([[sd[0], sd[3], sd[5]], [sd[3], sd[1], sd[4]], [sd[5], sd[4], sd[2]]]) + pm * np.eye(3)
+            centre = x[s.dofs[c]].mean(axis=0)
+            r = (centre - tail) - ((centre - tail) @ axis) * axis  # from the axis line to the cell
+            nr = np.linalg.norm(r)
+            r = r / nr if nr > 1e-9 else np.cross(axis, [0.0, 0.0, 1.0])
+            vals[2 * i] = axis @ sig @ axis
+            vals[2 * i + 1] = axis @ sig @ r
+        self.rows.append([s.t, *self.comm.allreduce(vals, op=MPI.SUM)])
+
+    def write(self, out: Path) -> None:
+        """charge_sections.csv (rank 0)."""
+        if self.comm.rank == 0:
+            np.savetxt(Path(out) / "charge_sections.csv", np.array(self.rows), delimiter=",",
+                       header=",".join(self.columns), comments="", fmt="%.9g")

@@ -55,6 +55,8 @@ def write(sim, wall_s: float) -> None:
     if comm.rank == 0:
         arrays["rows"] = np.array(sim.rows, dtype=float)
         arrays["gauge_rows"] = np.array(sim.gauges.rows, dtype=float)
+        if sim.sections is not None:
+            arrays["section_rows"] = np.array(sim.sections.rows, dtype=float)
         arrays["load"] = np.array([*sim.load.force, sim.load.contact_nodes, getattr(sim.load, "area", 0.0)])
     _atomic_savez(d / f"step{step:09d}-rank{comm.rank}.npz", **arrays)
     comm.barrier()
@@ -99,7 +101,10 @@ def restore(sim, state: dict) -> None:
         rows = z["rows"] if comm.rank == 0 else None
         gauge_rows = z["gauge_rows"] if comm.rank == 0 else None
         load = z["load"] if comm.rank == 0 else None
-    rows, gauge_rows, load = comm.bcast((rows, gauge_rows, load), root=0)
+        section_rows = z["section_rows"] if comm.rank == 0 and "section_rows" in z else None
+    rows, gauge_rows, load, section_rows = comm.bcast((rows, gauge_rows, load, section_rows), root=0)
+    if sim.sections is not None and section_rows is not None:
+        sim.sections.rows = [list(r) for r in section_rows]
     for k, v in zip(SCALARS, scalars):
         setattr(s, k, int(v) if k == "step_count" else float(v))
     sim.rows = [list(r) for r in rows]

@@ -92,6 +92,7 @@ class Simulation:
         from fepen import analyses
 
         self.gauges = analyses.Gauges(self.solver, self.pm)
+        self.sections = analyses.ChargeSections(self.solver, self.pm) if self.pm.charge else None
         self.output_s = 0.0
         self.columns = results.HISTORY_COLUMNS + (results.CHARGE_COLUMNS if self.pm.charge else [])
         self.rows: list[list[float]] = []
@@ -152,6 +153,7 @@ class Simulation:
                                   self.load.contact_nodes, s.dt, self._max_peeq(), getattr(self.load, "area", 0.0))
         if self.pm.charge:
             row += list(self._body_accelerations((tip - tail) / np.linalg.norm(tip - tail)))
+            self.sections.record(tip, tail)
         results.finite_row(row, s.step_count, s.t)
         self.rows.append(row)
         if self.concrete and row[results.HISTORY_COLUMNS.index("max_peeq")] > self.scene.projectile.failure_strain:
@@ -275,6 +277,8 @@ class Simulation:
                 from fepen import analyses
 
                 self.gauges.write(self.out)
+                if self.sections is not None:
+                    self.sections.write(self.out)
                 self._write_accelerations()
                 analyses.deformed_picture(self.solver, self.out / "deformed.png",
                                           f"t = {self.solver.t * 1e6:.0f} us, max PEEQ {self._max_peeq():.3g}")

@@ -72,3 +72,19 @@ def test_lowpass_keeps_the_pulse_and_removes_the_ringing():
     assert np.max(np.abs(out - pulse)[inner]) < 0.01 * 6e4
     assert abs(t[np.argmax(out)] - 5e-4) < 5e-6
     assert np.max(np.abs(lowpass(t, ring, 1e4))[inner]) < 0.01 * 2e4
+
+
+def test_charge_section_stresses_follow_the_inertia_of_the_fill():
+    """charge_sections.csv: while the projectile decelerates, the charge is pushed against the front of the
+    cavity: along the axis its mean axial stress is compressive and falls in magnitude from front to rear,
+    and at the front it stays below the inertia of a free charge column, rho_c |a_c| L_charge (the tied
+    walls carry part of it in shear), and above a tenth of it."""
+    summary, rows, sim = charged_run(MPI.COMM_SELF)
+    d = np.genfromtxt(sim.out / "charge_sections.csv", delimiter=",", names=True)
+    late = d["t_s"] > 5e-5
+    axial = np.array([d[f"axis{k}_axial_Pa"][late].mean() for k in range(5)])
+    assert np.all(axial < 0) and np.all(np.diff(np.abs(axial)) < 0)
+    a_c = abs(rows[rows[:, 0] > 5e-5, sim.columns.index("charge_acc_g")].mean()) * 9.80665
+    column = 1850.0 * a_c * sim.pm.shape.cavity_length
+    assert 0.1 * column < abs(axial[0]) < column
+    assert len(d.dtype.names) == 1 + 2 * (3 * 4 + 5)
