@@ -31,6 +31,22 @@ def surface_cells(pm, n_cells: int) -> np.ndarray:
     return np.array(sorted(c for c in cells if c < n_cells), dtype=np.int64)
 
 
+def nearest_cell(centres: np.ndarray, candidates: np.ndarray, point: np.ndarray, comm) -> int:
+    """The candidate cell whose centre is nearest to point, over all ranks (collective).
+
+    Returns:
+        Its local index on the one rank that owns it (ties: the lowest rank), -1 on the others.
+    """
+    if len(candidates):
+        d = np.linalg.norm(centres[candidates] - point, axis=1)
+        k = int(np.argmin(d))
+        best = (float(d[k]), comm.rank)
+    else:
+        best, k = (np.inf, comm.rank), -1
+    winner = comm.allreduce(best, op=MPI.MIN)
+    return int(candidates[k]) if winner[1] == comm.rank else -1
+
+
 class Gauges:
     """The eight strain-gauge cells and the surface cells of the hazard map of an ExplicitSolver.
 
@@ -46,16 +62,7 @@ class Gauges:
         self.surface_y = centres[self.surface, 1]  # reference axial position from the nose
         self.targets = [(frac, name, np.array([0.0, frac * L, 0.0]) + a * d)
                         for frac in (1 / 3, 1 / 2) for name, d in zip(GAUGE_NAMES, GAUGE_DIRECTIONS)]
-        self.cells = []
-        for _, _, p in self.targets:  # the owned surface cell nearest to each gauge point, on one rank
-            if len(self.surface):
-                d = np.linalg.norm(centres[self.surface] - p, axis=1)
-                k = int(np.argmin(d))
-                best = (float(d[k]), self.comm.rank)
-            else:
-                best, k = (np.inf, self.comm.rank), -1
-            winner = self.comm.allreduce(best, op=MPI.MIN)
-            self.cells.append(int(self.surface[k]) if winner[1] == self.comm.rank else -1)
+        self.cells = [nearest_cell(centres, self.surface, p, self.comm) for _, _, p in self.targets]
         self.columns = ["t_s"] + [f"{name}_{round(frac * 100)}pctL" for frac, name, _ in self.targets]
         self.rows = []
 
@@ -183,16 +190,7 @@ class ChargeSections:
             self.points.append((f"axis{k}", np.array([0.0, z, 0.0])))
         centres = solver.X[solver.dofs].mean(axis=1)
         mine = np.flatnonzero(solver.mat == charge_material)
-        self.cells = []
-        for _, p in self.points:  # the nearest charge cell, on one rank
-            if len(mine):
-                d = np.linalg.norm(centres[mine] - p, axis=1)
-                k = int(np.argmin(d))
-                best = (float(d[k]), self.comm.rank)
-            else:
-                best, k = (np.inf, self.comm.rank), -1
-            winner = self.comm.allreduce(best, op=MPI.MIN)
-            self.cells.append(int(mine[k]) if winner[1] == self.comm.rank else -1)
+        self.cells = [nearest_cell(centres, mine, p, self.comm) for _, p in self.points]
         self.columns = ["t_s"] + [f"{n}_{q}_Pa" for n, _ in self.points for q in ("axial", "shear")]
         self.rows = []
 

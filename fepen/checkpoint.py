@@ -20,6 +20,7 @@ import os
 from pathlib import Path
 
 import numpy as np
+from mpi4py import MPI
 
 from fepen.errors import InputError
 
@@ -92,7 +93,7 @@ def restore(sim, state: dict) -> None:
     d = Path(sim.out) / "checkpoint"
     with np.load(d / f"step{state['step']:09d}-rank{comm.rank}.npz") as z:
         same = z["X"].shape == s.X.shape and np.array_equal(z["X"], s.X)
-        if not comm.allreduce(same, op=__import__("mpi4py").MPI.LAND):
+        if not comm.allreduce(same, op=MPI.LAND):
             raise InputError("--resume", "the mesh rebuilt from scene.toml differs from the checkpointed one "
                                          "(another fepen or gmsh version, or another partition)")
         for k in ARRAYS:

@@ -133,20 +133,17 @@ class ExplicitSolver:
                                     self.nodal_vol0)
         self._ghost_sum(self._nvol0)
 
-        # lumped mass: rho_e V0_e / 4 to each node
+        # lumped mass: rho_e V0_e / 4 to each node, per material (the bodies' masses, for their
+        # mass-averaged accelerations) and in all
         rho = np.array([m.density for m in materials])[self.mat]
-        mvec = la.vector(imap, bs=1)
-        np.add.at(mvec.array, self.dofs.ravel(), np.repeat(0.25 * rho * self.vol0, 4))
-        self._ghost_sum(mvec)
-        self.mass = mvec.array[: self.n_nodes].copy()
-        # the same per material (the bodies' masses, for their mass-averaged accelerations)
-        mvec_k = la.vector(imap, bs=nm)
-        arr = mvec_k.array.reshape(-1, nm)
+        mvec = la.vector(imap, bs=nm)
+        arr = mvec.array.reshape(-1, nm)
         for k in range(nm):
             sel = self.mat == k
             np.add.at(arr[:, k], self.dofs[sel].ravel(), np.repeat(0.25 * rho[sel] * self.vol0[sel], 4))
-        self._ghost_sum(mvec_k)
+        self._ghost_sum(mvec)
         self.mass_by_material = arr[: self.n_nodes].copy()
+        self.mass = self.mass_by_material.sum(axis=1)
         self.body_mass = self.comm.allreduce(self.mass_by_material[: self.n_owned].sum(axis=0), op=MPI.SUM)
         if np.any(self.mass[: self.n_owned] <= 0.0):
             raise SimulationError("a node has no mass (an orphan node in the mesh)")

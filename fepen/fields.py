@@ -32,10 +32,6 @@ def _time_name(t: float) -> str:
     return repr(float(t)).replace(".", "_") if t != 0 else "0"
 
 
-def _replace(tmp: Path, path: Path) -> None:
-    os.replace(tmp, path)
-
-
 class FieldWriter:
     """fields.xdmf + fields.h5 of a run.
 
@@ -91,7 +87,7 @@ class FieldWriter:
         with h5py.File(tmp, "w") as h5:
             for name, data in datasets.items():
                 h5.create_dataset(name, data=data)
-        _replace(tmp, path)
+        os.replace(tmp, path)
 
     def write(self, t: float, values: dict[str, np.ndarray]) -> None:
         """Write one output time (collective).
@@ -120,12 +116,12 @@ class FieldWriter:
         tmp = path.with_name(path.name + f".tmp{os.getpid()}")
         with h5py.File(tmp, "w") as h5:
             for name in ("geometry", "topology"):
-                h5[f"/Mesh/mesh/{name}"] = h5py.ExternalLink(f"fields.d/mesh.h5", f"/{name}")
+                h5[f"/Mesh/mesh/{name}"] = h5py.ExternalLink("fields.d/mesh.h5", f"/{name}")
             for k, t in enumerate(self.times):
                 for name in self.nodal + self.cell:
                     h5[f"/Function/{name}/{_time_name(t)}"] = h5py.ExternalLink(
                         f"fields.d/{self._step_file(k).name}", f"/{name}")
-        _replace(tmp, path)
+        os.replace(tmp, path)
         self._write_xdmf()
 
     def _write_xdmf(self) -> None:
@@ -158,7 +154,7 @@ class FieldWriter:
         path = self.out / "fields.xdmf"
         tmp = path.with_name(path.name + f".tmp{os.getpid()}")
         tmp.write_text("\n".join(lines))
-        _replace(tmp, path)
+        os.replace(tmp, path)
 
     def consolidate(self) -> None:
         """Copy every output time into a self-contained fields.h5 (atomic) and remove fields.d (rank 0;
@@ -176,6 +172,6 @@ class FieldWriter:
                     with h5py.File(self._step_file(k), "r") as src:
                         for name in self.nodal + self.cell:
                             dst.create_dataset(f"/Function/{name}/{_time_name(t)}", data=src[name][()])
-            _replace(tmp, path)
+            os.replace(tmp, path)
             shutil.rmtree(self.dir)
         self.comm.barrier()

@@ -29,20 +29,12 @@ from fepen import geometry
 SUBDIVISION = 4  # facet patch areas: 4 x 4 sub-triangles projected on the exact surface
 
 
-def rotate_between(a: np.ndarray, b: np.ndarray, v: np.ndarray) -> np.ndarray:
-    """Apply to v the smallest rotation taking unit a to unit b (row-wise; Rodrigues without angles):
-    R v = (a·b) v + (a×b)×v + ((a×b)·v)(a×b)/(1 + a·b)."""
-    c = np.einsum("ij,ij->i", a, b)
-    k = np.cross(a, b)
-    kv = np.einsum("ij,ij->i", k, v)
-    return c[:, None] * v + np.cross(k, v) + (kv / np.maximum(1.0 + c, 1e-12))[:, None] * k
-
-
 @numba.njit(cache=True, error_model="numpy")
 def _facet_kinematics(x_all, v_all, tri, n_flat0, N0, area0, flat0, x, v, area, n):
     """Surface.kinematics in one compiled loop (the numpy version was a third of a penetration step):
-    centroid, mean velocity, stretched exact area, and the exact normal turned by the rotation taking
-    the flat reference normal to the current one (rotate_between, written out)."""
+    centroid, mean velocity, stretched exact area, and the exact normal N0 turned by the smallest rotation
+    taking the flat reference normal a to the current one b (Rodrigues without angles):
+    R v = (a·b) v + (a×b)×v + ((a×b)·v)(a×b)/(1 + a·b)."""
     for i in range(tri.shape[0]):
         i0, i1, i2 = tri[i, 0], tri[i, 1], tri[i, 2]
         ax, ay, az = x_all[i1, 0] - x_all[i0, 0], x_all[i1, 1] - x_all[i0, 1], x_all[i1, 2] - x_all[i0, 2]
