@@ -27,7 +27,8 @@ from fepen.errors import InputError
 #: solver arrays saved per rank (nodal arrays include ghost nodes)
 ARRAYS = ("U", "Vel", "acc", "fint", "fext", "s", "eps_p", "temp", "sy0")
 #: solver scalars, saved per rank (the work and dissipation sums are each rank's own)
-SCALARS = ("t", "step_count", "dt", "dt_prev", "dt0", "dt_min", "_w_int", "_w_ext", "_plastic", "_heat", "ke0")
+SCALARS = ("t", "step_count", "dt", "dt_prev", "dt0", "dt_min", "_w_int", "_w_ext", "_plastic", "_heat", "ke0",
+           "_w_if_n", "_w_if_t")
 
 
 def _atomic_savez(path: Path, **arrays) -> None:

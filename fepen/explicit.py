@@ -12,7 +12,8 @@ configuration. The stress update is fepen.kinematics (numba) with its elastic tr
 
 Energy bookkeeping (per step, owned dofs, trapezoidal in the forces):
     W_int += Δu · (f_int^n + f_int^{n+1}) / 2,   W_ext += Δu · (f_ext^n + f_ext^{n+1}) / 2
-    balance error = |KE + W_int − KE_0 − W_ext| / max(KE_0, |W_ext|, KE)
+    balance error = |KE + W_int − KE_0 − W_ext − W_if| / max(KE_0, |W_ext|, KE)
+W_if is the work of the shell–charge contact forces (fepen.interface; 0 without a split interface).
 W_int splits into the stored elastic energy (nodal volumetric K/2 (ln J)^2 plus deviatoric s:s/(4G)) and
 the plastic dissipation ∫ σ_y dε_p (of which the Taylor–Quinney share is heat).
 
@@ -49,12 +50,16 @@ class Energies:
     plastic: float
     heat: float
     initial_kinetic: float
+    interface_normal_work: float = 0.0
+    friction: float = 0.0
 
     @property
     def balance_error(self) -> float:
-        """Relative energy-balance error."""
+        """Relative energy-balance error: KE + W_int − KE_0 − W_ext − W_interface, with W_interface the
+        work of the shell–charge contact forces (normal work − friction dissipation; fepen.interface)."""
         scale = max(self.initial_kinetic, abs(self.external_work), self.kinetic, 1e-300)
-        return abs(self.kinetic + self.internal_work - self.initial_kinetic - self.external_work) / scale
+        w_if = self.interface_normal_work - self.friction
+        return abs(self.kinetic + self.internal_work - self.initial_kinetic - self.external_work - w_if) / scale
 
 
 @dataclass
@@ -83,6 +88,9 @@ class ExplicitSolver:
         nodal_pressure: averaged nodal pressure (True) or the plain tetrahedron (False).
         external: callable(solver) -> None that adds external nodal forces into ``solver.fext`` (owned
             nodes, shape (n_nodes, 3) view); may be None.
+
+    ``interface``: a callable(solver) set after construction (fepen.interface.ShellChargeContact), called
+    once a^n is known and Δt_{n+1/2} chosen, to add constraint forces of the coming step to ``acc``.
     """
 
     def __init__(self, mesh, materials: list[M.Material], cell_material: np.ndarray, safety: float = 0.8,
@@ -193,6 +201,9 @@ class ExplicitSolver:
         self._w_ext = 0.0
         self._plastic = 0.0
         self._heat = 0.0
+        self._w_if_n = 0.0  # work of the interface's normal and tangential forces (fepen.interface)
+        self._w_if_t = 0.0
+        self.interface = None
         self.ke0 = None
         self.times = StepTimes()
 
@@ -281,6 +292,8 @@ class ExplicitSolver:
         self.ke0 = self.kinetic_energy(self.Vel)
         self.dt = self.stable_step()
         self.dt0 = self.dt_min = self.dt
+        if self.interface is not None:
+            self.interface(self)
 
     def kinetic_energy(self, vel: np.ndarray) -> float:
         """Σ ½ m v² over owned nodes, all ranks."""
@@ -377,8 +390,15 @@ class ExplicitSolver:
         self.step_count += 1
         self.dt_prev = dt
         self.times.update += time.perf_counter() - t0
-        if self.step_count % STEP_EVERY != 1:
-            return
+        if self.step_count % STEP_EVERY == 1:
+            self._new_step(h_c)
+        if self.interface is not None:
+            t0 = time.perf_counter()
+            self.interface(self)
+            self.times.boundary += time.perf_counter() - t0
+
+    def _new_step(self, h_c: float) -> None:
+        """The next Δt from this rank's h/c (all ranks agree), or SimulationError if it collapsed."""
         new = self.safety * self.step_gain * self.comm.allreduce(h_c, op=MPI.MIN)
         if not (new > 1e-3 * self.dt0):
             _, owner = self.comm.allreduce((h_c, self.comm.rank), op=MPI.MIN)
@@ -400,9 +420,9 @@ class ExplicitSolver:
         if not self.nodal:
             vol = self._element_volumetric_energy()
         dev = self._deviatoric_energy()
-        sums = c.allreduce(np.array([self._w_int, self._w_ext, vol + dev, self._plastic, self._heat]),
-                           op=MPI.SUM)
-        return Energies(ke, sums[0], sums[1], sums[2], sums[3], sums[4], self.ke0 or 0.0)
+        sums = c.allreduce(np.array([self._w_int, self._w_ext, vol + dev, self._plastic, self._heat,
+                                     self._w_if_n, self._w_if_t]), op=MPI.SUM)
+        return Energies(ke, sums[0], sums[1], sums[2], sums[3], sums[4], self.ke0 or 0.0, sums[5], -sums[6])
 
     def _cell_J(self) -> np.ndarray:
         J = np.empty(self.n_cells)

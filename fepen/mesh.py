@@ -8,6 +8,12 @@ When the scene asks for a mass, the cavity is sized on the exact geometry first 
 mesh itself: the faceted surfaces of a tetrahedral mesh hold less volume than the exact solid (about
 h^2 / (6 R^2) relative), which at 4 mm would cost about 3 g. Each correction moves the cavity's length by
 the mass error over the mass per unit length of the cavity; two or three meshes reach +-0.25 g.
+
+A charge in frictional contact with the shell (``split_interface``) needs two surfaces where the tied mesh
+has one: every node of the CAVITY wall is doubled, the charge's cells take the copies (its side of the wall
+is tagged CHARGE_FACE), and the partition keeps each copy within reach of its twin (a cell touching the
+wall is ghosted on the ranks that own the cells around its twins), so that every rank holds both nodes of
+each pair it owns a node of (fepen.interface).
 """
 
 from __future__ import annotations
@@ -47,9 +53,10 @@ class ProjectileMesh:
     Attributes:
         mesh: the dolfinx mesh (tetrahedra, SI units, body frame of fepen.shape).
         cell_tags: SHELL / CHARGE cell markers.
-        facet_tags: OUTER / CAVITY facet markers.
+        facet_tags: OUTER / CAVITY facet markers (and CHARGE_FACE, the charge's side of a split wall).
         shape: the exact geometry meshed (cavity length as corrected on the mesh).
         charge: whether the cavity is meshed as the charge.
+        split: whether the charge has nodes of its own on the cavity wall (frictional contact).
         mesh_s: wall time spent meshing on rank 0 (0 when read from the cache).
         cached: whether the mesh came from the cache.
     """
@@ -61,6 +68,7 @@ class ProjectileMesh:
     charge: bool
     mesh_s: float
     cached: bool
+    split: bool = False
 
 
 def cache_dir() -> Path:
@@ -130,19 +138,19 @@ def _mesh_on_root(shape: Shape, opts, charge: bool, mass, rho_s, rho_c, use_cach
     return current, seconds, False
 
 
-def create(scene, comm: MPI.Comm = MPI.COMM_WORLD, use_cache: bool = True) -> ProjectileMesh:
+def create(scene, comm: MPI.Comm = MPI.COMM_WORLD, use_cache: bool = True, split_interface=None) -> ProjectileMesh:
     """Build (or read from the cache) and distribute the projectile mesh of a scene.
 
     Args:
         scene: a resolved fepen Scene.
         comm: the communicator to distribute over; gmsh runs on its rank 0.
         use_cache: read/write meshes/cache.
+        split_interface: give the charge its own nodes on the cavity wall; default: when the scene's
+            deformable charge is in frictional contact (charge.contact = "frictional").
 
     Returns:
         The ProjectileMesh.
     """
-    from dolfinx.io import gmshio
-
     shape = shape_from_scene(scene)  # raises InputError on impossible geometry, on every rank
     charge = bool(scene.effects.charge)
     opts = geometry.MeshOptions(scene.mesh.size, scene.get("mesh.nose_size"), scene.mesh.optimize)
@@ -153,21 +161,115 @@ def create(scene, comm: MPI.Comm = MPI.COMM_WORLD, use_cache: bool = True) -> Pr
     if comm.rank == 0:
         result = _mesh_on_root(shape, opts, charge, mass, rho_s, rho_c, use_cache)
     shape, seconds, cached = comm.bcast(result, root=0)
-    # gmshio.model_to_mesh offers no partitioner argument: hand it the deterministic one for this call
-    from dolfinx import cpp as _cpp
-
-    default = gmshio.create_mesh
-    gmshio.create_mesh = lambda c, cells, x, domain: default(
-        c, cells, x, domain, partitioner=_cpp.mesh.create_cell_partitioner(band_partitioner))
-    try:
-        mesh, ct, ft = gmshio.model_to_mesh(_gmsh_model(comm), comm, 0, gdim=3)
-    finally:
-        gmshio.create_mesh = default
+    if split_interface is None:
+        split_interface = (charge and scene.charge.contact == "frictional"
+                           and scene.effects.fidelity != "rigid")
+    split = bool(split_interface and charge)
+    mesh, ct, ft = _model_to_mesh(comm, split)
     if comm.rank == 0:
         import gmsh
 
         gmsh.clear()
-    return ProjectileMesh(mesh, ct, ft, shape, charge, seconds, cached)
+    return ProjectileMesh(mesh, ct, ft, shape, charge, seconds, cached, split)
+
+
+#: rank 0, during a partition: extra links between cells (the twins' neighbourhoods of a split wall)
+_EXTRA_LINKS = None
+
+
+def split_wall(n_nodes, cells, cell_values, facets, facet_values):
+    """Double the nodes of the CAVITY wall: the charge's cells take new copies (numbered after the
+    existing nodes) and the copied wall facets are tagged CHARGE_FACE.
+
+    Args:
+        n_nodes: number of nodes (gmsh may keep nodes that no cell uses: copies go after all of them).
+        cells: (n_cells, 4) node indices; cell_values: SHELL / CHARGE per cell.
+        facets: (n_facets, 3) node indices of the tagged facets; facet_values: their tags.
+
+    Returns:
+        (cells, facets, facet_values, wall nodes (the originals; their copies are n_nodes + i in that
+        order), links: (k, 2) pairs of cells, a shell cell and a charge cell around the same wall node).
+    """
+    wall = np.unique(facets[facet_values == geometry.CAVITY])
+    twin = np.arange(n_nodes, dtype=np.int64)
+    twin[wall] = n_nodes + np.arange(len(wall))
+    cells = cells.copy()
+    charge = cell_values == geometry.CHARGE
+    cells[charge] = twin[cells[charge]]
+    new = twin[facets[facet_values == geometry.CAVITY]]
+    facets = np.vstack([facets, new])
+    facet_values = np.concatenate([facet_values, np.full(len(new), geometry.CHARGE_FACE, dtype=facet_values.dtype)])
+    # cells around each wall node, on either side (the charge's through the copies)
+    original = np.concatenate([np.arange(n_nodes), wall])  # node index -> original node
+    on_wall = np.zeros(n_nodes, dtype=bool)
+    on_wall[wall] = True
+    c_idx = np.repeat(np.arange(len(cells)), 4)
+    node = original[cells.ravel()]
+    keep = on_wall[node]
+    c_idx, node, side = c_idx[keep], node[keep], charge[c_idx[keep]]
+    links = []
+    order = np.argsort(node, kind="stable")
+    c_idx, node, side = c_idx[order], node[order], side[order]
+    cuts = np.flatnonzero(np.diff(node)) + 1
+    for cs, sd in zip(np.split(c_idx, cuts), np.split(side, cuts)):
+        sh, ch = np.unique(cs[~sd]), np.unique(cs[sd])
+        links.append(np.stack(np.meshgrid(sh, ch, indexing="ij"), axis=-1).reshape(-1, 2))
+    links = np.unique(np.concatenate(links), axis=0) if links else np.zeros((0, 2), dtype=np.int64)
+    return cells, facets, facet_values, wall, links
+
+
+def _model_to_mesh(comm, split: bool):
+    """dolfinx.io.gmshio.model_to_mesh for tetrahedra, distributed with band_partitioner, the wall split
+    when asked (split_wall). Returns (mesh, cell tags, facet tags)."""
+    global _EXTRA_LINKS
+    from dolfinx import cpp as _cpp
+    from dolfinx.io import gmshio
+    from dolfinx.mesh import meshtags_from_entities
+
+    TET, TRI = 4, 2  # gmsh element types
+    if comm.rank == 0:
+        import gmsh
+
+        model = gmsh.model
+        x = gmshio.extract_geometry(model)
+        topo = gmshio.extract_topology_and_markers(model)
+        cells = np.asarray(topo[TET]["topology"], dtype=np.int64)
+        cell_values = np.asarray(topo[TET]["cell_data"], dtype=np.int32)
+        facets = np.asarray(topo[TRI]["topology"], dtype=np.int64)
+        facet_values = np.asarray(topo[TRI]["cell_data"], dtype=np.int32)
+        if split:
+            cells, facets, facet_values, wall, links = split_wall(len(x), cells, cell_values, facets, facet_values)
+            x = np.vstack([x, x[wall]])
+            from scipy.sparse import coo_matrix
+
+            n = len(cells)
+            ones = np.ones(2 * len(links))
+            _EXTRA_LINKS = coo_matrix((ones, (np.concatenate([links[:, 0], links[:, 1]]),
+                                              np.concatenate([links[:, 1], links[:, 0]]))), shape=(n, n)).tocsr()
+    else:
+        x = np.zeros((0, 3))
+        cells = np.zeros((0, 4), dtype=np.int64)
+        cell_values = np.zeros(0, dtype=np.int32)
+        facets = np.zeros((0, 3), dtype=np.int64)
+        facet_values = np.zeros(0, dtype=np.int32)
+    domain = gmshio.ufl_mesh(TET, 3)
+    cells = cells[:, gmshio.cell_perm_array(_cpp.mesh.CellType.tetrahedron, 4)]
+    try:
+        mesh = gmshio.create_mesh(comm, cells, x, domain,
+                                  partitioner=_cpp.mesh.create_cell_partitioner(band_partitioner))
+    finally:
+        _EXTRA_LINKS = None
+    tdim = 3
+    local, values = _cpp.io.distribute_entity_data(mesh._mesh, tdim, cells, cell_values)
+    mesh.topology.create_connectivity(tdim, 0)
+    ct = meshtags_from_entities(mesh, tdim, _cpp.graph.AdjacencyList_int32(local), values.astype(np.int32))
+    ct.name = "Cell tags"
+    facets = facets[:, gmshio.cell_perm_array(_cpp.mesh.CellType.triangle, 3)]
+    local, values = _cpp.io.distribute_entity_data(mesh._mesh, tdim - 1, facets, facet_values)
+    mesh.topology.create_connectivity(tdim - 1, tdim)
+    ft = meshtags_from_entities(mesh, tdim - 1, _cpp.graph.AdjacencyList_int32(local), values.astype(np.int32))
+    ft.name = "Facet tags"
+    return mesh, ct, ft
 
 
 def band_partitioner(comm, nparts: int, graph, ghosting: bool):
@@ -178,7 +280,8 @@ def band_partitioner(comm, nparts: int, graph, ghosting: bool):
     cell for cell). Here: cells in breadth-first order from a pseudo-peripheral cell (the end of a
     breadth-first sweep from cell 0: the nose tip or the tail of a slender body), cut into nparts runs of
     equal length; each rank gets a band of the projectile, whose interfaces are cross-sections. With
-    ghosting, a cell is also sent to the ranks owning its facet neighbours.
+    ghosting, a cell is also sent to the ranks owning its facet neighbours. A split wall (split_wall) adds
+    its links to the graph: the bands cross both bodies, and a cell is also ghosted where its links are.
 
     Args:
         comm: communicator; graph: this rank's rows of the dual graph (global cell indices);
@@ -203,6 +306,10 @@ def band_partitioner(comm, nparts: int, graph, ghosting: bool):
         part = np.zeros(n, dtype=np.int32)
         if n:
             g = csr_matrix((np.ones(len(indices)), indices, indptr), shape=(n, n))
+            if _EXTRA_LINKS is not None and _EXTRA_LINKS.shape == (n, n):
+                g = (g + _EXTRA_LINKS).tocsr()
+                g.sort_indices()
+                indptr, indices = g.indptr.astype(np.int64), g.indices.astype(np.int64)
             start = int(breadth_first_order(g, 0, directed=False, return_predecessors=False)[-1])
             order = breadth_first_order(g, start, directed=False, return_predecessors=False)
             if len(order) < n:  # a disconnected mesh: the rest in index order
@@ -222,14 +329,6 @@ def band_partitioner(comm, nparts: int, graph, ghosting: bool):
             lo += size
     data, offs = comm.scatter(dest, root=0)
     return _cpp.graph.AdjacencyList_int32(data, offs)
-
-
-def _gmsh_model(comm):
-    if comm.rank == 0:
-        import gmsh
-
-        return gmsh.model
-    return None
 
 
 def cell_points(mesh) -> np.ndarray:

@@ -23,6 +23,10 @@ COL = {k: i for i, k in enumerate(HISTORY_COLUMNS)}
 #: appended with a charge: mass-averaged acceleration of each body along the axis (tail to nose), in g
 #: (negative while the projectile decelerates)
 CHARGE_COLUMNS = ["shell_acc_g", "charge_acc_g"]
+#: appended with a charge in frictional contact (fepen.interface): friction dissipation, the largest gap,
+#: interpenetration and slip over the wall's node pairs, the fractions of pairs open and sliding
+INTERFACE_COLUMNS = ["friction_J", "interface_gap_max_mm", "interface_penetration_max_mm", "interface_slip_max_mm",
+                     "interface_free_fraction", "interface_sliding_fraction"]
 
 
 def history_row(t, tip, tail, velocity, force, mass, energies: dict, contact: int, dt: float, peeq: float,

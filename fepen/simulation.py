@@ -35,9 +35,6 @@ def check_supported(scene) -> None:
     if rigid and scene.target.kind != "concrete":
         raise InputError("effects.fidelity", "'rigid' runs against target.kind = 'concrete'; a rigid "
                                              "projectile on a rigid wall has nothing to compute")
-    if scene.effects.charge and not rigid and scene.charge.contact != "tied":
-        raise InputError("charge.contact", "'frictional' shell-charge contact is not available in this version; "
-                                           "allowed: 'tied' (the charge bonded to the shell)")
 
 
 class Simulation:
@@ -61,7 +58,7 @@ class Simulation:
         self.out = output.prepare(out, comm)
         mats = [M.from_scene(scene)]
         cellmat = np.zeros(self.pm.mesh.topology.index_map(3).size_local, dtype=np.int64)
-        if self.pm.charge:  # material 1: the charge, tied to the shell through the shared interface nodes
+        if self.pm.charge:  # material 1: the charge, tied through shared wall nodes or in contact (split)
             from fepen import geometry
 
             mats.append(M.charge_from_scene(scene))
@@ -70,6 +67,12 @@ class Simulation:
         self.solver = explicit.ExplicitSolver(self.pm.mesh, mats, cellmat, scene.run.safety_factor)
         if scene.run.stable_step == "eigenvalue":
             self.solver.calibrate_step()
+        self.contact = None
+        if self.pm.split:
+            from fepen.interface import ShellChargeContact
+
+            self.contact = ShellChargeContact(self.solver, self.pm.facet_tags, scene.charge.friction)
+            self.solver.interface = self.contact
         self.tip = self.solver.node_at((0.0, 0.0, 0.0))
         self.tail = self.solver.node_at((0.0, self.pm.shape.length, 0.0))
         R, v = placement(scene)
@@ -94,7 +97,8 @@ class Simulation:
         self.gauges = analyses.Gauges(self.solver, self.pm)
         self.sections = analyses.ChargeSections(self.solver, self.pm) if self.pm.charge else None
         self.output_s = 0.0
-        self.columns = results.HISTORY_COLUMNS + (results.CHARGE_COLUMNS if self.pm.charge else [])
+        self.columns = (results.HISTORY_COLUMNS + (results.CHARGE_COLUMNS if self.pm.charge else [])
+                        + (results.INTERFACE_COLUMNS if self.contact is not None else []))
         self.rows: list[list[float]] = []
         self.fields = None
         # the loop's clocks and event memory (checkpointed)
@@ -154,6 +158,10 @@ class Simulation:
         if self.pm.charge:
             row += list(self._body_accelerations((tip - tail) / np.linalg.norm(tip - tail)))
             self.sections.record(tip, tail)
+        if self.contact is not None:
+            i = self.contact.summary()
+            row += [e.friction, i["gap_max_mm"], i["penetration_max_mm"], i["slip_max_mm"], i["free_fraction"],
+                    i["sliding_fraction"]]
         results.finite_row(row, s.step_count, s.t)
         self.rows.append(row)
         if self.concrete and row[results.HISTORY_COLUMNS.index("max_peeq")] > self.scene.projectile.failure_strain:

@@ -134,13 +134,17 @@ class Surface:
         _to_nodes(self.tri, f, out)
 
 
-def outer_surface(V, facet_tags, shape, tag: int = geometry.OUTER) -> Surface:
-    """The facet load points of the owned facets carrying ``tag``.
+def oriented_facets(V, facet_tags, tag: int) -> np.ndarray:
+    """The owned facets carrying ``tag``, as node triples (block indices of V) ordered so that their area
+    vectors point out of the cell they bound.
 
     Args:
         V: the P1 vector function space of the solver (its block indices are the nodes).
         facet_tags: the mesh's facet MeshTags.
-        shape: the exact fepen.shape.Shape the mesh was built from (body frame = reference frame).
+        tag: the facet tag.
+
+    Returns:
+        (n_facets, 3) int64 node indices.
     """
     mesh = V.mesh
     tdim = mesh.topology.dim
@@ -163,6 +167,20 @@ def outer_surface(V, facet_tags, shape, tag: int = geometry.OUTER) -> Surface:
         p = X[tri[i]]
         if np.dot(np.cross(p[1] - p[0], p[2] - p[0]), p.mean(axis=0) - X[opp]) < 0:
             tri[i, [1, 2]] = tri[i, [2, 1]]
+    return tri
+
+
+def outer_surface(V, facet_tags, shape, tag: int = geometry.OUTER) -> Surface:
+    """The facet load points of the owned facets carrying ``tag``.
+
+    Args:
+        V: the P1 vector function space of the solver (its block indices are the nodes).
+        facet_tags: the mesh's facet MeshTags.
+        shape: the exact fepen.shape.Shape the mesh was built from (body frame = reference frame).
+    """
+    imap = V.dofmap.index_map
+    X = V.tabulate_dof_coordinates()[: imap.size_local + imap.num_ghosts]
+    tri = oriented_facets(V, facet_tags, tag)
     av = area_vectors(X, tri)
     flat = np.linalg.norm(av, axis=1)
     nflat = av / np.maximum(flat, 1e-300)[:, None]

@@ -1,11 +1,11 @@
-"""The charged projectile, tied variant (issue 7 in progress): shell and charge as two materials of one
-mesh, bonded through their shared interface nodes; the bodies' mass-averaged accelerations in history.csv."""
+"""The charged projectile, tied variant: shell and charge as two materials of one mesh, bonded through
+their shared interface nodes; the bodies' mass-averaged accelerations in history.csv. (The frictional
+interface: tests/test_interface.py.)"""
 
 import numpy as np
 import pytest
 from mpi4py import MPI
 
-from conftest import run_fepen
 from fepen import scene
 from fepen.simulation import Simulation
 
@@ -41,12 +41,6 @@ def test_tied_charge_accelerations_balance_the_target_force(tmp_path):
     assert summary["energy_error"] < 1e-3
     header = (sim.out / "history.csv").read_text().splitlines()[0].split(",")
     assert header[-2:] == ["shell_acc_g", "charge_acc_g"]
-
-
-def test_frictional_charge_is_not_available_yet(tmp_path):
-    r = run_fepen("run", "--set", "effects.charge=true", "--set", "charge.contact=frictional", "--out", tmp_path)
-    assert r.returncode == 2 and "charge.contact" in r.stderr and "tied" in r.stderr
-    assert "Traceback" not in r.stderr
 
 
 @pytest.mark.mpi

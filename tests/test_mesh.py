@@ -63,7 +63,7 @@ def test_tags_surfaces_and_tracked_points():
 
 
 def test_charge_is_its_own_volume():
-    sc, pm, info = build("mesh.size=0.003", "effects.charge=true", comm=MPI.COMM_SELF)
+    sc, pm, info = build("mesh.size=0.003", "effects.charge=true", "charge.contact=tied", comm=MPI.COMM_SELF)
     sh = pm.shape
     # faceting of the 4-6 mm radius charge at 3 mm loses about h^2 / (6 R^2) ~ 4 % of its volume
     facet = 0.003**2 / (6 * 0.004**2)
@@ -119,3 +119,34 @@ def test_same_mesh_on_every_rank_count():
     assert dist["shortest_altitude_m"] == pytest.approx(alone["shortest_altitude_m"], rel=1e-12)
     assert dist["ranks"] == MPI.COMM_WORLD.size
     assert math.isclose(surface_area(pm, geometry.OUTER), pm.shape.outer_area(), rel_tol=1e-2)
+
+
+@pytest.mark.parametrize("ranks", ["self", pytest.param("world", marks=pytest.mark.mpi)])
+def test_split_wall_gives_the_charge_its_own_surface(ranks):
+    """charge.contact = frictional: the same cells, but the cavity wall is two coincident exterior surfaces
+    (CAVITY on the shell, CHARGE_FACE on the charge) of the exact wall's area, the charge holding a copy of
+    each wall node; on any rank count every owned wall node has its twin on the same rank."""
+    comm = MPI.COMM_SELF if ranks == "self" else MPI.COMM_WORLD
+    _, tied, tinfo = build("mesh.size=0.004", "effects.charge=true", "charge.contact=tied", comm=comm)
+    _, split, info = build("mesh.size=0.004", "effects.charge=true", "charge.contact=frictional", comm=comm)
+    assert split.split and not tied.split
+    assert info["cells"] == tinfo["cells"] and info["mass_kg"] == pytest.approx(tinfo["mass_kg"], rel=1e-12)
+    area = split.shape.cavity_area()
+    assert surface_area(split, geometry.CAVITY) == pytest.approx(area, rel=3e-2)
+    assert surface_area(split, geometry.CHARGE_FACE) == pytest.approx(surface_area(split, geometry.CAVITY), rel=1e-12)
+    assert surface_area(split, geometry.CAVITY, interior=True) == 0.0
+    wall = comm.allreduce(len(np.unique(np.concatenate(
+        [np.zeros(0, dtype=np.int64)] + [split.mesh.topology.connectivity(2, 0).links(f)
+                                           for f in split.facet_tags.find(geometry.CAVITY)
+                                           if f < split.mesh.topology.index_map(2).size_local]))), op=MPI.SUM)
+    assert info["nodes"] - tinfo["nodes"] >= 0.9 * wall  # (facets on two ranks share nodes: a lower bound)
+    from fepen import explicit, materials as M
+    from fepen.interface import ShellChargeContact
+
+    sc = scene.load(None, ["mesh.size=0.004", "effects.charge=true"])
+    cm = np.zeros(split.mesh.topology.index_map(3).size_local, dtype=np.int64)
+    cm[mesh.owned_cells_tagged(split, geometry.CHARGE)] = 1
+    solver = explicit.ExplicitSolver(split.mesh, [M.from_scene(sc), M.charge_from_scene(sc)], cm)
+    contact = ShellChargeContact(solver, split.facet_tags, 0.1)  # raises if a twin is missing
+    assert contact.n_pairs == info["nodes"] - tinfo["nodes"]
+    assert np.max(np.abs(solver.X[contact.pa] - solver.X[contact.pb])) < 1e-12
