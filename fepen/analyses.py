@@ -182,8 +182,10 @@ class ChargeSections:
             return next((r for a, b, r in secs if a <= z <= b), secs[-1][2])
 
         self.points = []
-        for label, z in (("front", z_front + 5e-4), ("nose_end", max(shape.nose_length, z_front + 5e-4)),
-                         ("mid", 0.5 * (z_front + z_rear))):
+        #: the three sections' reference distances behind the nose tip (m)
+        self.sections = {"front": z_front + 5e-4, "nose_end": max(shape.nose_length, z_front + 5e-4),
+                         "mid": 0.5 * (z_front + z_rear)}
+        for label, z in self.sections.items():
             for frac in (0.0, 1 / 3, 2 / 3, 0.9):
                 self.points.append((f"{label}_r{round(100 * frac)}", np.array([frac * radius_at(z), z, 0.0])))
         for k, z in enumerate(np.linspace(z_front + 5e-4, z_rear - 5e-4, 5)):

@@ -40,12 +40,14 @@ class FieldWriter:
         solver: the ExplicitSolver (its mesh, index maps and reference positions).
         nodal: names of nodal vector fields, in writing order.
         cell: names of cell scalar fields, in writing order.
+        nodal_scalar: names of nodal scalar fields, written after the cell fields.
         times: output times already written (when resuming a run; later step files are deleted).
     """
 
-    def __init__(self, out: Path, solver, nodal: list[str], cell: list[str], times: list[float] = ()):
+    def __init__(self, out: Path, solver, nodal: list[str], cell: list[str], times: list[float] = (),
+                 nodal_scalar: list[str] = ()):
         self.out, self.comm = Path(out), solver.comm
-        self.nodal, self.cell = list(nodal), list(cell)
+        self.nodal, self.cell, self.nodal_scalar = list(nodal), list(cell), list(nodal_scalar)
         self.times = list(times)
         self.dir = self.out / "fields.d"
         imap = solver.V.dofmap.index_map
@@ -71,6 +73,11 @@ class FieldWriter:
                     f.unlink()
             self._write_index()
 
+    @property
+    def names(self) -> list[str]:
+        """Every field name, in writing order."""
+        return self.nodal + self.cell + self.nodal_scalar
+
     # ------------------------------------------------------------------------------------------------
     def _gather(self, local: np.ndarray):
         parts = self.comm.gather(np.ascontiguousarray(local), root=0)
@@ -94,10 +101,11 @@ class FieldWriter:
 
         Args:
             t: time (s).
-            values: name -> owned nodal (n_owned, 3) or cell (n_cells,) array, for every name given.
+            values: name -> nodal (n_owned, 3), cell (n_cells,) or nodal scalar (n_owned,) array (longer
+                arrays are cut), for every name given.
         """
         data = {}
-        for name in self.nodal:
+        for name in self.nodal + self.nodal_scalar:
             data[name] = self._gather(values[name][: self._n_owned])
         for name in self.cell:
             data[name] = self._gather(values[name][: self._n_cells])
@@ -118,7 +126,7 @@ class FieldWriter:
             for name in ("geometry", "topology"):
                 h5[f"/Mesh/mesh/{name}"] = h5py.ExternalLink("fields.d/mesh.h5", f"/{name}")
             for k, t in enumerate(self.times):
-                for name in self.nodal + self.cell:
+                for name in self.names:
                     h5[f"/Function/{name}/{_time_name(t)}"] = h5py.ExternalLink(
                         f"fields.d/{self._step_file(k).name}", f"/{name}")
         os.replace(tmp, path)
@@ -137,12 +145,15 @@ class FieldWriter:
                  "      </Geometry>", "    </Grid>"]
         ref = ("        <xi:include xpointer=\"xpointer(/Xdmf/Domain/Grid[@GridType='Uniform'][1]"
                "/*[self::Topology or self::Geometry])\" />")
-        for name in self.nodal + self.cell:
-            nodal = name in self.nodal
+        for name in self.names:
             lines.append(f'    <Grid Name={quoteattr(name)} GridType="Collection" CollectionType="Temporal">')
             for t in self.times:
-                dims = f"{nn} 3" if nodal else f"{nc} 1"
-                kind, centre = ("Vector", "Node") if nodal else ("Scalar", "Cell")
+                if name in self.nodal:
+                    dims, kind, centre = f"{nn} 3", "Vector", "Node"
+                elif name in self.cell:
+                    dims, kind, centre = f"{nc} 1", "Scalar", "Cell"
+                else:
+                    dims, kind, centre = f"{nn} 1", "Scalar", "Node"
                 lines += [f'      <Grid Name={quoteattr(name)} GridType="Uniform">', ref,
                           f'        <Time Value="{float(t)!r}" />',
                           f'        <Attribute Name={quoteattr(name)} AttributeType="{kind}" Center="{centre}">',
@@ -170,7 +181,7 @@ class FieldWriter:
                         dst.create_dataset(f"/Mesh/mesh/{name}", data=src[name][()])
                 for k, t in enumerate(self.times):
                     with h5py.File(self._step_file(k), "r") as src:
-                        for name in self.nodal + self.cell:
+                        for name in self.names:
                             dst.create_dataset(f"/Function/{name}/{_time_name(t)}", data=src[name][()])
             os.replace(tmp, path)
             shutil.rmtree(self.dir)

@@ -220,6 +220,17 @@ class ShellChargeContact:
         t = d - g[:, None] * n
         return g, np.linalg.norm(t, axis=1)
 
+    def nodal_gap_and_slip(self) -> dict:
+        """Gap and slip (m) as nodal scalars, at both nodes of each pair, zero off the wall (field output)."""
+        g, slip = self.gap_and_slip()
+        out = {}
+        for name, v in (("interface_gap_m", g), ("interface_slip_m", slip)):
+            a = np.zeros(self.solver.n_nodes)
+            a[self.pa] = v
+            a[self.pb] = v
+            out[name] = a
+        return out
+
     def summary(self) -> dict:
         """Global figures of the interface now: largest gap, interpenetration and slip (mm), the fraction of
         pairs open, stuck and sliding, and the resultant force on the charge (N, world)."""

@@ -193,6 +193,16 @@ class Simulation:
         body = "\n".join(",".join(f"{v:.9g}" for v in r) for r in np.column_stack(cols))
         output.write_text(self.out / "accelerations.csv", ",".join(header) + "\n" + body + "\n", self.comm)
 
+    def _charge_report(self):
+        """The charge's pictures (fepen.slices), maps and cross-sections at the output time nearest the
+        charge's peak (filtered) acceleration; what they show goes into summary.json ("charge")."""
+        from fepen import slices
+
+        report = None
+        if self.comm.rank == 0:
+            report = slices.charge_report(self.out, self.sections.sections, self.peaks["charge_acc"]["t_s"])
+        self.charge = self.comm.bcast(report, root=0)
+
     def _beyond_method(self):
         """Stop: the equivalent plastic strain passed projectile.failure_strain (where, when)."""
         from fepen.errors import BeyondMethod
@@ -288,6 +298,8 @@ class Simulation:
                 if self.sections is not None:
                     self.sections.write(self.out)
                 self._write_accelerations()
+                if self.pm.charge:
+                    self._charge_report()
                 analyses.deformed_picture(self.solver, self.out / "deformed.png",
                                           f"t = {self.solver.t * 1e6:.0f} us, max PEEQ {self._max_peeq():.3g}")
             self.output_s += time.perf_counter() - t_out
@@ -332,9 +344,12 @@ class Simulation:
             names.append("peeq")
             if self.scene.effects.thermal:
                 names.append("temperature_K")
+        if self.pm.charge:
+            names.append("body")  # 1 shell, 2 charge: for ParaView's Threshold
+        scalars = ["interface_gap_m", "interface_slip_m"] if self.contact is not None else []
         from fepen.fields import FieldWriter
 
-        self.fields = FieldWriter(self.out, self.solver, ["displacement", "velocity"], names, times)
+        self.fields = FieldWriter(self.out, self.solver, ["displacement", "velocity"], names, times, scalars)
 
     def _write_fields(self):
         s = self.solver
@@ -348,8 +363,11 @@ class Simulation:
         ax, ay, az = axis
         axial = (sd[:, 0] * ax * ax + sd[:, 1] * ay * ay + sd[:, 2] * az * az
                  + 2 * (sd[:, 3] * ax * ay + sd[:, 4] * ay * az + sd[:, 5] * ax * az)) + pm
-        self.fields.write(s.t, {"displacement": s.U, "velocity": s.Vel, "von_mises_Pa": vm,
-                                "axial_stress_Pa": axial, "peeq": s.eps_p, "temperature_K": s.temp})
+        values = {"displacement": s.U, "velocity": s.Vel, "von_mises_Pa": vm, "axial_stress_Pa": axial,
+                  "peeq": s.eps_p, "temperature_K": s.temp, "body": s.mat + 1.0}
+        if self.contact is not None:
+            values.update(self.contact.nodal_gap_and_slip())
+        self.fields.write(s.t, values)
 
     def _summary(self, outcome: str, loop_s: float) -> dict:
         s = self.solver
@@ -361,6 +379,7 @@ class Simulation:
                  "ranks": self.comm.size, "stress_kernel": s.kernel, "step_gain": s.step_gain,
                  "peak_memory_bytes": output.peak_memory_bytes(self.comm),
                  "peak_accelerations": getattr(self, "peaks", None),
+                 "charge": getattr(self, "charge", None),
                  "acceleration_filter_hz": self.scene.run.acceleration_filter_hz}
         summary = results.summary(self.scene, self.rows, outcome, extra)
         output.write_json(self.out / "summary.json", summary, self.comm)
