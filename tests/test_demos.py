@@ -4,6 +4,8 @@ import os
 import subprocess
 import sys
 
+import pytest
+
 from conftest import ROOT
 
 
@@ -36,3 +38,22 @@ def test_hard_cases_demo(tmp_path):
     assert r.returncode == 0, r.stderr[-2000:]
     rows = [ln for ln in (tmp_path / "t.md").read_text().splitlines() if ln.startswith("| ricochet")]
     assert len(rows) == 1 and "| ricochet |" in rows[0].replace("ricochet_250_75", "")
+
+
+def test_charge_demo_tied_against_frictional(tmp_path):
+    """demos/charge/charge_800.py --quick on 2 ranks: both contacts run, every picture is written, and the
+    comparison shows what the contact changes: the frictional charge, free to slide and to open at its
+    rear, rings harder (a higher raw peak acceleration) than the bonded one; the shells' peaks agree
+    within 3 %; friction dissipates energy, the wall opens and slides but never interpenetrates."""
+    import json
+
+    r = subprocess.run([sys.executable, "demos/charge/charge_800.py", "--quick", "--ranks", "2", "--out", str(tmp_path),
+                        "--docs", str(tmp_path / "img")], capture_output=True, text=True, cwd=ROOT,
+                       env=dict(os.environ, PYTHONPATH=str(ROOT)), timeout=900)
+    assert r.returncode == 0, r.stderr
+    tied, fric = json.loads((tmp_path / "comparison.json").read_text())
+    assert fric["charge_raw_peak_g"] < 1.1 * tied["charge_raw_peak_g"] < 0
+    assert fric["shell_peak_g"] == pytest.approx(tied["shell_peak_g"], rel=3e-2)
+    assert fric["friction_J"] > 0 and fric["slip_max_mm"] > 0.01 and fric["gap_max_mm"] > 0.01
+    assert fric["penetration_max_mm"] < 0.01 * 4.0
+    assert len(list((tmp_path / "img").glob("charge-*.png"))) == 8
