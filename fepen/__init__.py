@@ -4,4 +4,30 @@ Only the projectile is meshed (FEniCSx/dolfinx 0.5); the concrete acts through a
 resistance law applied node by node on the deformed projectile surface.
 """
 
+import os
+import sys
+from pathlib import Path
+
 __version__ = "0.1.0"
+
+
+def _numba_cache_per_rank() -> None:
+    """Under mpirun, give each rank its own numba cache (``~/.cache/fepen/numba/rankN``).
+
+    numba's on-disk cache is not safe against processes compiling and writing the same entries at once
+    (numba issues #4807, #10128: segmentation faults); the ranks of a run whose cache is cold or stale
+    (a fresh clone, an edited kernel) would do exactly that. A serial run keeps numba's default (the
+    __pycache__ beside the sources). NUMBA_CACHE_DIR, if set, is left alone.
+    """
+    env = os.environ
+    rank = env.get("OMPI_COMM_WORLD_RANK", env.get("PMI_RANK"))
+    size = env.get("OMPI_COMM_WORLD_SIZE", env.get("PMI_SIZE"))
+    if rank is None or size in (None, "1") or "NUMBA_CACHE_DIR" in env:
+        return
+    folder = Path(env.get("XDG_CACHE_HOME") or Path.home() / ".cache") / "fepen" / "numba" / f"rank{rank}"
+    env["NUMBA_CACHE_DIR"] = str(folder)
+    if "numba" in sys.modules:  # imported before fepen: dispatchers made from now on read the config
+        sys.modules["numba"].config.CACHE_DIR = str(folder)
+
+
+_numba_cache_per_rank()
