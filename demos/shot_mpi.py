@@ -42,7 +42,7 @@ def main():
     with h5py.File(out / "fields.h5", "r") as h5:
         topo = h5["Mesh/mesh/topology"][:]
         geom = h5["Mesh/mesh/geometry"][:]
-        last = sorted(h5["Function/displacement"].keys(), key=lambda k: float(k.replace("_", ".")))[-1]
+        last = sorted(h5["Function/displacement"].keys(), key=lambda k: float(k.replace('_', '.')))[-1]
         u = h5["Function/displacement"][last][:]
         peeq = h5["Function/peeq"][last][:].ravel()
     n = len(topo)
@@ -53,7 +53,7 @@ def main():
     plotter.set_background("white")
     plotter.add_mesh(grid, scalars="PEEQ", cmap="inferno", show_scalar_bar=False)
     plotter.view_vector((0.0, 0.0, 1.0), viewup=(0.0, 1.0, 0.0))
-    plotter.add_text(f"{args.shot}: t = {float(last.replace("_", ".")) * 1e6:.0f} us, PEEQ 0 ... {peeq.max():.3g} (black ... yellow)",
+    plotter.add_text(f"{args.shot}: t = {float(last.replace('_', '.')) * 1e6:.0f} us, PEEQ 0 ... {peeq.max():.3g} (black ... yellow)",
                      font_size=10, color="black")
     plotter.screenshot(str(out / "demo.png"))
     plotter.close()

@@ -18,8 +18,13 @@ SETS = ["--set", "mesh.size=0.004", "--set", "run.end_time=1.2e-4", "--set", "ru
         "--set", "run.checkpoint_interval=1.5e-5", "--set", 'impact.shot="C7"']
 
 
-def start(out, ranks):
-    cmd = [sys.executable, "-m", "fepen", "run", *SETS, "--out", str(out)]
+#: the charged projectile, its charge sliding in frictional contact (the interface's work and the
+#: contact accelerations must be restored too)
+CHARGED = ["--set", "effects.charge=true", "--set", 'charge.contact="frictional"']
+
+
+def start(out, ranks, extra=()):
+    cmd = [sys.executable, "-m", "fepen", "run", *SETS, *extra, "--out", str(out)]
     if ranks > 1:
         cmd = ["mpirun", "-n", str(ranks), *cmd]
     env = dict(os.environ, OMPI_ALLOW_RUN_AS_ROOT="1", OMPI_ALLOW_RUN_AS_ROOT_CONFIRM="1",
@@ -65,12 +70,12 @@ def check_valid_fields(out):
     return sum(1 for g in root.iter("Grid") if g.get("Name") == "displacement" and g.get("GridType") == "Uniform")
 
 
-@pytest.mark.parametrize("ranks", [1, 2])
-def test_killed_run_resumes_to_the_same_results(tmp_path, ranks):
+@pytest.mark.parametrize("ranks,extra", [(1, []), (2, []), (2, CHARGED)], ids=["1", "2", "2-charged"])
+def test_killed_run_resumes_to_the_same_results(tmp_path, ranks, extra):
     whole, cut = tmp_path / "whole", tmp_path / "cut"
-    done = run_fepen("run", *SETS, "--out", whole, ranks=ranks)
+    done = run_fepen("run", *SETS, *extra, "--out", whole, ranks=ranks)
     assert done.returncode == 0, done.stderr
-    proc = start(cut, ranks)
+    proc = start(cut, ranks, extra)
     t_ckpt = kill_after_checkpoints(proc, cut)
     # what the killed run left is valid up to its last output time
     n_out = check_valid_fields(cut)
