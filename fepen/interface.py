@@ -44,8 +44,7 @@ def pair_forces(x, vel, acc, mass, pa, pb, normal, dt, dt_avg, mu, force, fn, st
         x, vel, acc: current positions, v^{n−1/2}, a^n without contact (n_nodes, 3).
         mass: lumped nodal masses (n_nodes,). pa, pb: shell and charge node of each pair (k,).
         normal: unit normal of each pair, out of the charge (k, 3).
-        dt: Δt_{n+1/2}; dt_avg: (Δt_{n−1/2} + Δt_{n+1/2}) / 2; mu: Coulomb friction coefficient
-            (a negative mu: tied, both directions and any tangential force).
+        dt: Δt_{n+1/2}; dt_avg: (Δt_{n−1/2} + Δt_{n+1/2}) / 2; mu: Coulomb friction coefficient (≥ 0).
         force: (k, 3) output, the force on a (−force on b). fn: (k,) output, F_N.
         state: (k,) output, 0 open, 1 stuck, 2 sliding.
     """
@@ -59,7 +58,7 @@ def pair_forces(x, vel, acc, mass, pa, pb, normal, dt, dt_avg, mu, force, fn, st
         rn = rx * nx + ry * ny + rz * nz
         g = (x[a, 0] - x[b, 0]) * nx + (x[a, 1] - x[b, 1]) * ny + (x[a, 2] - x[b, 2]) * nz
         gp = g + dt * rn
-        if gp >= 0.0 and mu >= 0.0:
+        if gp >= 0.0:
             force[i, 0] = force[i, 1] = force[i, 2] = 0.0
             fn[i] = 0.0
             state[i] = 0
@@ -69,7 +68,7 @@ def pair_forces(x, vel, acc, mass, pa, pb, normal, dt, dt_avg, mu, force, fn, st
         sx, sy, sz = -tx / (dt_avg * inv), -ty / (dt_avg * inv), -tz / (dt_avg * inv)
         s = math.sqrt(sx * sx + sy * sy + sz * sz)
         cap = mu * f_n
-        if mu < 0.0 or s <= cap:
+        if s <= cap:
             state[i] = 1
         else:
             k = cap / s
