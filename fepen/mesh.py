@@ -237,6 +237,12 @@ def _model_to_mesh(comm, split: bool):
         cell_values = np.asarray(topo[TET]["cell_data"], dtype=np.int32)
         facets = np.asarray(topo[TRI]["topology"], dtype=np.int64)
         facet_values = np.asarray(topo[TRI]["cell_data"], dtype=np.int32)
+        # number the nodes the cells use 0..n-1: a model just meshed keeps unused nodes, and dolfinx's
+        # distribute_entity_data reads node indices as positions among the used ones (beyond: a crash)
+        used = np.unique(cells)
+        renumber = np.full(len(x), -1, dtype=np.int64)
+        renumber[used] = np.arange(len(used))
+        x, cells, facets = x[used], renumber[cells], renumber[facets]
         if split:
             cells, facets, facet_values, wall, links = split_wall(len(x), cells, cell_values, facets, facet_values)
             x = np.vstack([x, x[wall]])

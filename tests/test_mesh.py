@@ -150,3 +150,6 @@ def test_split_wall_gives_the_charge_its_own_surface(ranks):
     contact = ShellChargeContact(solver, split.facet_tags, 0.1)  # raises if a twin is missing
     assert contact.n_pairs == info["nodes"] - tinfo["nodes"]
     assert np.max(np.abs(solver.X[contact.pa] - solver.X[contact.pb])) < 1e-12
+    # a model just meshed (not read back from the cache) keeps nodes no cell uses: the same mesh results
+    fresh = mesh.create(scene.load(None, ["mesh.size=0.004", "effects.charge=true"]), comm, use_cache=False)
+    assert fresh.mesh.geometry.index_map().size_global == info["nodes"]
