@@ -71,18 +71,19 @@ def test_pair_work_of_sliding_is_the_friction_dissipation():
 
 
 # ---- the charge carried by the shell -------------------------------------------------------------------
-def test_uniformly_decelerated_charge_loads_the_shell_with_its_inertia():
+@pytest.mark.parametrize("ranks", [1, 2])
+def test_uniformly_decelerated_charge_loads_the_shell_with_its_inertia(ranks):
     """demos/charge/carried_charge.py (no target; a body force on the shell alone decelerates the whole
     projectile at 5,000 g, ramped over 300 us, held 200 us; the charge is carried by the contact only).
     Averaged over the hold, the wall's force on the charge is m_charge × a within 1 % and axial, decelerating
     (front end and step ring) and under set-back (shell base); with μ = 0 the lateral walls carry under 1 %
     of it, with μ = 0.1 their friction carries part; the end away from the load has opened; the wall never
-    interpenetrates by 1 % of the element size; energy balance within 1e-6."""
+    interpenetrates by 1 % of the element size; energy balance within 1e-6. On 1 and 2 ranks."""
     import json
 
     from conftest import ROOT, run_python
 
-    r = run_python(ROOT / "demos" / "charge" / "carried_charge.py", "--json")
+    r = run_python(ROOT / "demos" / "charge" / "carried_charge.py", "--json", ranks=ranks)
     assert r.returncode == 0, r.stderr
     cases = {c["case"]: c for c in map(json.loads, r.stdout.splitlines())}
     assert len(cases) == 3

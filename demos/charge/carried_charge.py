@@ -52,7 +52,9 @@ def carry(friction: float, sign: float, size: float = 0.004, accel_g: float = 50
     s.external = body_force
     s.set_initial()
     yp = contact.X_pairs[:, 1]
-    front, rear = yp < yp.min() + 0.25 * size, yp > yp.max() - 0.25 * size
+    lo = comm.allreduce(float(yp.min(initial=np.inf)), op=MPI.MIN)  # the cavity's ends, over all ranks
+    hi = comm.allreduce(float(yp.max(initial=-np.inf)), op=MPI.MAX)
+    front, rear = yp < lo + 0.25 * size, yp > hi - 0.25 * size
     far = rear if sign > 0 else front
     lateral = np.abs(contact.normals()[:, 1]) < 0.3  # the cylindrical walls (not their edges)
     forces, on_lateral, worst = [], [], 0.0
