@@ -177,13 +177,14 @@ class ShellChargeContact:
         self._work = np.zeros(2)
         self.X_pairs = s.X[self.pb]
 
-    def normals(self) -> np.ndarray:
-        """Unit normals out of the charge at the pairs, current configuration."""
+    def normals(self, x=None) -> np.ndarray:
+        """Unit normals out of the charge at the pairs, current configuration (x: the current positions,
+        if at hand)."""
         from dolfinx import la
 
         s = self.solver
         self.nodal_n[:] = 0.0
-        _wall_normals(s.positions(), self.tri, self.nodal_n)
+        _wall_normals(s.positions() if x is None else x, self.tri, self.nodal_n)
         self._nvec.scatter_reverse(la.ScatterMode.add)
         self._nvec.scatter_forward()
         nn = self.nodal_n[self.pb]
@@ -193,8 +194,8 @@ class ShellChargeContact:
         """Add the contact forces of the coming step to solver.acc (owned nodes), then refresh the ghosts."""
         s = solver
         dt, dt_avg = s.dt, 0.5 * (s.dt_prev + s.dt)
-        self.normal = self.normals()
-        x = s.positions()
+        x = s._x  # X + U, as the solver's last force evaluation left it
+        self.normal = self.normals(x)
         pair_forces(x, s.Vel, s.acc, s.mass, self.pa, self.pb, self.normal, dt, dt_avg, self.mu,
                     self.force, self.fn, self.state)
         self._work[:] = 0.0
