@@ -2,7 +2,8 @@
 #   make run    installs what is missing, runs the default scene (Table 1 shot C3, plastic projectile in the
 #               concrete target, default mesh) on $(NP) ranks into results/C3, the same shot with the rigid
 #               projectile into results/C3-rigid, and the mesh with its picture into results/C3-mesh
-#   make test   installs what is missing, then runs every test: serially, then the MPI ones on 2 ranks
+#   make test   installs what is missing, lints, runs the fast unit lane, the system tests, then the MPI
+#               ones on 2 ranks
 PY := .venv/bin/python
 NP ?= 2
 # OpenMPI refuses to start as root unless told; CI and these machines run as root.
@@ -11,7 +12,7 @@ export OMPI_ALLOW_RUN_AS_ROOT_CONFIRM := 1
 export OMPI_MCA_rmaps_base_oversubscribe := 1
 export OMP_NUM_THREADS := 1
 
-.PHONY: setup run test test-serial test-mpi bench clean
+.PHONY: setup run test lint bench clean
 
 setup:
 	@bash tools/bootstrap.sh
@@ -22,8 +23,13 @@ run: setup
 	$(PY) -m fepen mesh scenes/default.toml --out results/C3-mesh
 
 test: setup
-	$(PY) -m pytest -q tests
+	$(PY) -m ruff check --no-cache fepen tests demos benchmarks tools
+	$(PY) -m pytest -q tests/unit
+	$(PY) -m pytest -q tests/system
 	mpirun -n $(NP) $(PY) -m pytest -q -m mpi -p no:cacheprovider tests
+
+lint: setup
+	$(PY) -m ruff check --no-cache fepen tests demos benchmarks tools
 
 bench: setup
 	$(PY) benchmarks/mesh_cost.py

@@ -9,7 +9,7 @@ import time
 from mpi4py import MPI
 
 from fepen import scene
-from fepen.rigidrun import RigidRun
+from fepen.runs.rigid import RigidRun
 
 
 def main(name="C3", repeats=3):

@@ -3,7 +3,7 @@
 For each mesh size: the per-step time split (kinematics and nodal volumes, material update, internal-force
 assembly, boundary forces, vector updates), the full step over the bare internal-force assembly (the same
 compiled form assembled alone, coefficients pre-packed), cell-steps per second, and the stable step over
-(shortest altitude / dilatational speed); with the C trial pass of the stress update (fepen.ckernel) and
+(shortest altitude / dilatational speed); with the C trial pass of the stress update (fepen.solver.ckernel) and
 with the numba reference kernel.
 
     .venv/bin/python benchmarks/step_cost.py [sizes in mm ...]      (also under mpirun -n 2)
@@ -13,10 +13,13 @@ import sys
 import time
 
 import numpy as np
-from dolfinx import cpp as _cpp, la
 from mpi4py import MPI
 
-from fepen import ckernel, explicit, materials as M, mesh, rigidwall, scene, tetra
+from fepen import scene
+from fepen.geometry import tetra
+from fepen.runs import setup
+from fepen.solver import ckernel, explicit
+from fepen.solver import rigid_wall as rigidwall
 
 STEPS = 300
 
@@ -24,15 +27,10 @@ STEPS = 300
 def measure(h_mm, comm, kernel):
     sc = scene.load(None, [f"mesh.size={h_mm * 1e-3}", "target.kind=rigid-wall", "impact.velocity=300",
                            "impact.obliquity_deg=0", "impact.attack_deg=0"])
-    pm = mesh.create(sc, comm)
-    info = mesh.metrics(pm, sc)
-    s = explicit.ExplicitSolver(pm.mesh, [M.from_scene(sc)],
-                                np.zeros(pm.mesh.topology.index_map(3).size_local, dtype=np.int64),
-                                sc.run.safety_factor)
+    pm = setup.mesh(sc, comm)
+    info = setup.mesh_metrics(pm, sc)
+    s = setup.solver(sc, pm, kernel=kernel)
     s.external = rigidwall.RigidWall(s)
-    if kernel == "numba":  # the numba reference kernel instead of the C trial pass
-        s._trial, s.kernel = None, "numba"
-    assert s.kernel == kernel, f"the {kernel} kernel is not available: {ckernel.why_not()}"
     s.set_initial(velocity=lambda X: np.tile([0.0, -300.0, 0.0], (len(X), 1)))
     for _ in range(20):  # compile and warm up
         s.step()
@@ -45,15 +43,13 @@ def measure(h_mm, comm, kernel):
     full = (time.perf_counter() - t0) / STEPS
     t0 = time.perf_counter()
     for _ in range(STEPS):
-        s.fint[:] = 0.0
-        _cpp.fem.assemble_vector(s.fint_fn.x.array, s.form, s._consts, s._coeffs)
-        s.fint_fn.x.scatter_reverse(la.ScatterMode.add)
+        s.assemble_internal_force()
     comm.barrier()
     bare = (time.perf_counter() - t0) / STEPS
     tm = s.times
     split = {k: comm.allreduce(getattr(tm, k), op=MPI.MAX) / STEPS
              for k in ("kinematics", "material", "assembly", "boundary", "update")}
-    mat = M.from_scene(sc)
+    mat = setup.projectile_material(sc)
     c = float(tetra.dilatational_speed(mat.E, mat.nu, mat.density))
     h_over_c = info["shortest_altitude_m"] / c
     return dict(kernel=kernel, h=h_mm, cells=info["cells"], full=full, bare=bare, split=split,
@@ -73,7 +69,8 @@ def main(sizes):
           f"{'plastic_cells':>13}")
     for r in rows:
         sp = r["split"]
-        print(f"{r['kernel']:>6} {r['h']:5.2f} {r['cells']:7d} {sp['kinematics'] * 1e3:6.3f} {sp['material'] * 1e3:6.3f} "
+        print(f"{r['kernel']:>6} {r['h']:5.2f} {r['cells']:7d} {sp['kinematics'] * 1e3:6.3f} "
+              f"{sp['material'] * 1e3:6.3f} "
               f"{sp['assembly'] * 1e3:6.3f} {sp['boundary'] * 1e3:6.3f} {sp['update'] * 1e3:6.3f} "
               f"{r['full'] * 1e3:6.3f} {r['bare'] * 1e3:6.3f} {r['full'] / r['bare']:9.2f} "
               f"{r['cell_steps'] / 1e6:13.2f} {r['dt'] * 1e9:6.1f} {r['dt_ratio']:8.3f} {r['plastic']:13d}")

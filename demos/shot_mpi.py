@@ -53,7 +53,8 @@ def main():
     plotter.set_background("white")
     plotter.add_mesh(grid, scalars="PEEQ", cmap="inferno", show_scalar_bar=False)
     plotter.view_vector((0.0, 0.0, 1.0), viewup=(0.0, 1.0, 0.0))
-    plotter.add_text(f"{args.shot}: t = {float(last.replace('_', '.')) * 1e6:.0f} us, PEEQ 0 ... {peeq.max():.3g} (black ... yellow)",
+    plotter.add_text(f"{args.shot}: t = {float(last.replace('_', '.')) * 1e6:.0f} us, "
+                     f"PEEQ 0 ... {peeq.max():.3g} (black ... yellow)",
                      font_size=10, color="black")
     plotter.screenshot(str(out / "demo.png"))
     plotter.close()

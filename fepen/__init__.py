@@ -2,13 +2,19 @@
 
 Only the projectile is meshed (FEniCSx/dolfinx 0.5); the concrete acts through a cavity-expansion
 resistance law applied node by node on the deformed projectile surface.
+
+The API (docs/api.md): ``fepen.Scene``, ``fepen.run(scene, out=None, comm=None) -> Result``,
+``fepen.load(results_dir) -> Result``, ``fepen.resume(results_dir)``. The layers, bottom up: ``laws``
+(plain arrays), ``geometry``, ``solver`` (dolfinx), ``io``, ``post``, ``runs``, ``studies``.
 """
 
 import os
 import sys
 from pathlib import Path
 
-__version__ = "0.1.0"
+from fepen.version import __version__
+
+__all__ = ["Scene", "Result", "run", "load", "resume", "InputError", "SimulationError", "__version__"]
 
 
 def _numba_cache_per_rank() -> None:
@@ -31,3 +37,16 @@ def _numba_cache_per_rank() -> None:
 
 
 _numba_cache_per_rank()
+
+
+def __getattr__(name):
+    """The API, imported on first use: ``import fepen`` stays cheap (no dolfinx, no MPI)."""
+    if name in ("Scene", "Result", "run", "load", "resume"):
+        from fepen import api
+
+        return getattr(api, name)
+    if name in ("InputError", "SimulationError"):
+        from fepen import errors
+
+        return getattr(errors, name)
+    raise AttributeError(f"module 'fepen' has no attribute {name!r}")

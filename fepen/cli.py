@@ -1,4 +1,4 @@
-"""The ``fepen`` command (shared/contract.md).
+"""The ``fepen`` command (docs/scenes.md, docs/results.md).
 
     fepen run SCENE.toml [--out DIR] [--set KEY=VALUE ...]
     fepen run --resume DIR
@@ -15,7 +15,6 @@ from __future__ import annotations
 
 import argparse
 import sys
-from pathlib import Path
 
 from fepen.errors import InputError, SimulationError
 
@@ -65,17 +64,20 @@ def cmd_mesh(args) -> int:
     from dolfinx.io import XDMFFile
     from mpi4py import MPI
 
-    from fepen import figures, mesh, output, scene as fscene, shape
+    from fepen import scene as fscene
+    from fepen.io import files
+    from fepen.post import figures
+    from fepen.runs import setup
 
     comm = MPI.COMM_WORLD
     sc = fscene.load(args.scene, args.sets)
-    shape.shape_from_scene(sc)  # geometry errors before anything is written
-    pm = mesh.create(sc, comm)
-    info = mesh.metrics(pm, sc)
-    out = output.prepare(args.out, comm)
-    info["versions"] = output.versions()
-    output.write_json(out / "mesh.json", info, comm)
-    output.write_text(out / "scene.toml", fscene.to_toml(sc), comm)
+    setup.projectile_shape(sc)  # geometry errors before anything is written
+    pm = setup.mesh(sc, comm)
+    info = setup.mesh_metrics(pm, sc)
+    out = files.prepare(args.out, comm)
+    info["versions"] = files.versions()
+    files.write_json(out / "mesh.json", info, comm)
+    files.write_text(out / "scene.toml", fscene.to_toml(sc), comm)
     with XDMFFile(comm, str(out / "mesh.xdmf"), "w") as xdmf:
         xdmf.write_mesh(pm.mesh)
         pm.mesh.topology.create_connectivity(2, 3)
@@ -92,46 +94,27 @@ def cmd_mesh(args) -> int:
 
 def cmd_run(args) -> int:
     """Run one scene."""
-    from mpi4py import MPI
+    from fepen import api
 
-    from fepen import output, results, scene as fscene, shape, simulation
-
-    comm = MPI.COMM_WORLD
-    state = None
     if args.resume is not None:
-        from fepen import checkpoint
-
         if args.scene is not None or args.sets:
             raise InputError("--resume", "takes the scene of the run it continues (DIR/scene.toml): give no "
                                          "scene file and no --set")
-        out = Path(args.resume)
-        if not (out / "scene.toml").exists():
-            raise InputError("--resume", f"{out} is not a results directory (no scene.toml)")
-        state = checkpoint.read_state(out, comm)
-        sc = fscene.load(out / "scene.toml")
+        result = api.resume(args.resume, progress=True)
     else:
-        sc = fscene.load(args.scene, args.sets)
-    shape.shape_from_scene(sc)
-    simulation.check_supported(sc)
-    if state is None:
-        out = output.prepare(args.out, comm)
-        output.write_text(out / "scene.toml", fscene.to_toml(sc), comm)
-    try:
-        summary = simulation.run_scene(sc, out, comm, progress=True, resume=state)
-    finally:
-        if (out / "history.csv").exists():
-            results.figures(out, sc, comm)
+        result = api.run(api.Scene(args.scene, sets=args.sets), out=args.out, progress=True)
+    summary, out = result.summary, result.out
     keys = ("outcome", "Hx_mm", "Hy_mm", "Tx_mm", "Ty_mm", "length_mm", "residual_speed_m_s", "max_peeq",
             "energy_error", "steps", "dt_s", "wall_s")
     _say(*(f"{k} = {summary[k]:.6g}" if isinstance(summary[k], float) else f"{k} = {summary[k]}"
            for k in keys), f"written: {out}/summary.json, history.csv, history.png"
-         + (", fields.xdmf" if sc.run.fields and sc.effects.fidelity != "rigid" else ""))
+         + (", fields.xdmf" if result.fields is not None else ""))
     return 0
 
 
 def cmd_validate(args) -> int:
     """The eight Table 1 shots."""
-    from fepen import validate
+    from fepen.studies import validate
 
     rows = validate.validate(args.scene, args.sets, args.out)
     _say(*(f"{r['shot']}: Hx {r['Hx_mm']:.1f}/{r['Hx_exp_mm']:g} Hy {r['Hy_mm']:.1f}/{r['Hy_exp_mm']:g} "
@@ -145,13 +128,13 @@ def cmd_study(args) -> int:
     """The accuracy-cost study (each run its own process, on --ranks MPI ranks)."""
     from mpi4py import MPI
 
-    from fepen import study
+    from fepen.studies import accuracy_cost
 
     if MPI.COMM_WORLD.size > 1:
         raise InputError("fepen study", "run it without mpirun: it starts its own MPI jobs (--ranks)")
     if args.ranks < 1:
         raise InputError("--ranks", f"must be at least 1, got {args.ranks}")
-    study.study(args.out, ranks=args.ranks, quick=args.quick, fresh=args.fresh, say=_say)
+    accuracy_cost.study(args.out, ranks=args.ranks, quick=args.quick, fresh=args.fresh, say=_say)
     _say(f"written: {args.out}/study.csv, study.md, study.json, pareto.png")
     return 0
 

@@ -1,6 +1,6 @@
 """The paper's Table 1: eight shots of the 23.6 mm steel projectile into 40 MPa concrete.
 
-Shipped as fepen/data/table1.csv (a copy of shared/data/table1.csv). Displacements are magnitudes in mm
+Shipped as fepen/data/table1.csv. Displacements are magnitudes in mm
 of the nose tip (Hx, Hy) and tail centre (Tx, Ty) from the impact point at the end of penetration.
 """
 

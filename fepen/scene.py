@@ -1,6 +1,6 @@
 """Scenes: one TOML file in, typed and validated settings with every default filled in.
 
-The key names are the public interface of fepen (shared/contract.md). Every key is declared once in
+The key names are the public interface of fepen (docs/scenes.md). Every key is declared once in
 ``SCHEMA`` below with its type, default, unit and allowed range; nothing else is accepted. Bad input raises
 :class:`fepen.errors.InputError` naming the key and what is allowed, before any solver work starts.
 
@@ -142,7 +142,7 @@ SCHEMA: dict[str, Key] = {
     "charge.material.tangent_modulus": _num(600.0e6, "Pa", 0.0, 1.0e12),
     "charge.friction": _num(0.1, "", 0.0, 2.0),
     "charge.contact": _choice("frictional", "frictional", "tied", doc="shell-charge interface"),
-    # --- target (Table 3, section 4 of physics.md) ---
+    # --- target (Table 3; the law: docs/paper.md §4) ---
     "target.kind": _choice("concrete", "concrete", "rigid-wall"),
     "target.compressive_strength": _num(40.0e6, "Pa", 1.0e5, 1.0e10),
     "target.density": _num(2400.0, "kg/m^3", 100.0, 30000.0),
@@ -232,13 +232,62 @@ class Section:
 
 
 class Scene(Section):
-    """A resolved scene: every key validated, every default filled in.
+    """A resolved scene: every key validated, every default filled in, read-only.
 
-    ``scene.explicit`` is the set of dotted keys the user gave (file or --set)."""
+    Args:
+        source: None (the default scene), a TOML file (str or Path), TOML text (a str holding a newline or
+            an ``=``), a nested dict ({"impact": {"velocity": 700.0}}) or a flat one of dotted keys, or
+            another Scene.
+        sets: overrides applied after the source, in order: ``KEY=VALUE`` strings as ``--set`` takes them
+            (VALUE in TOML syntax, bare words are strings), or a dict of dotted keys.
 
-    def __init__(self, values: dict[str, Any], explicit: set[str]):
-        super().__init__(values)
-        object.__setattr__(self, "explicit", frozenset(explicit))
+    Raises:
+        InputError: naming the key and what is allowed.
+
+    ``scene.explicit`` is the set of dotted keys the user gave.
+    """
+
+    def __init__(self, source=None, sets=()):
+        given = _given(source)
+        items = sets.items() if isinstance(sets, dict) else (parse_set(item) for item in sets)
+        for key, value in items:
+            given[key] = value
+        resolved = resolve(given)
+        object.__setattr__(self, "_values", object.__getattribute__(resolved, "_values"))
+        object.__setattr__(self, "explicit", resolved.explicit)
+
+    @classmethod
+    def _resolved(cls, values: dict[str, Any], explicit: set[str]) -> Scene:
+        out = object.__new__(cls)
+        Section.__init__(out, values)
+        object.__setattr__(out, "explicit", frozenset(explicit))
+        return out
+
+    def with_sets(self, sets) -> Scene:
+        """A new Scene: this one's given keys with more overrides (as ``sets`` above)."""
+        return Scene(self, sets)
+
+    def __repr__(self) -> str:
+        given = {k: self.get(k) for k in sorted(self.explicit)}
+        return f"fepen.Scene({given})"
+
+
+def _given(source) -> dict[str, Any]:
+    """The flat {dotted key: value} a user gave, from any Scene source."""
+    if source is None:
+        return {}
+    if isinstance(source, Scene):
+        return {k: source.get(k) for k in source.explicit}
+    if isinstance(source, dict):
+        return _flatten(source)
+    if isinstance(source, Path) or (isinstance(source, str) and "\n" not in source and "=" not in source):
+        return read_toml(source)
+    if isinstance(source, str):
+        try:
+            return _flatten(tomllib.loads(source))
+        except tomllib.TOMLDecodeError as err:
+            raise InputError("SCENE", f"the scene text is not valid TOML: {err}") from None
+    raise InputError("SCENE", f"expected a TOML file, TOML text, a dict or a Scene, got {type(source).__name__}")
 
 
 def _flatten(tree: dict, prefix: str = "") -> dict[str, Any]:
@@ -326,7 +375,7 @@ def resolve(given: dict[str, Any]) -> Scene:
         for part in parts[:-1]:
             node = node.setdefault(part, {})
         node[parts[-1]] = value
-    return Scene(tree, set(given))
+    return Scene._resolved(tree, set(given))
 
 
 def _resolve_shot(flat: dict, given: dict) -> None:
@@ -343,7 +392,7 @@ def _resolve_shot(flat: dict, given: dict) -> None:
 
 
 def _check_consistency(flat: dict, given: dict) -> None:
-    """Checks that involve several keys. Geometry is checked in full by fepen.geometry."""
+    """Checks that involve several keys. Geometry is checked in full by fepen.geometry.gmsh_model."""
     if "projectile.cavity_length" in given:
         if "projectile.mass" in given:
             raise InputError("projectile.mass", "give projectile.mass or projectile.cavity_length, not both")
@@ -376,11 +425,7 @@ def load(path: str | Path | None = None, sets: list[str] | tuple[str, ...] = ())
     Returns:
         The resolved Scene.
     """
-    given = read_toml(path) if path is not None else {}
-    for item in sets:
-        key, value = parse_set(item)
-        given[key] = value
-    return resolve(given)
+    return Scene(Path(path) if path is not None else None, sets)
 
 
 def to_toml(scene: Section) -> str:

@@ -20,9 +20,13 @@ import json
 import numpy as np
 from mpi4py import MPI
 
-from fepen import explicit, geometry, materials as M, mesh as fmesh, scene
-from fepen.interface import ShellChargeContact
-from fepen.results import G0
+from fepen import scene
+from fepen.geometry import mesh as fmesh
+from fepen.geometry import tags
+from fepen.io.results import G0
+from fepen.runs import setup
+from fepen.solver import explicit
+from fepen.solver.shell_charge import ShellChargeContact
 
 CASES = [("decelerating, mu = 0", 0.0, 1.0), ("decelerating, mu = 0.1", 0.1, 1.0), ("set-back, mu = 0.1", 0.1, -1.0)]
 
@@ -32,10 +36,10 @@ def carry(friction: float, sign: float, size: float = 0.004, accel_g: float = 50
     """One case; returns its figures (every rank)."""
     sc = scene.load(None, ["effects.charge=true", "charge.contact=frictional", f"mesh.size={size}",
                            f"charge.friction={friction}"])
-    pm = fmesh.create(sc, comm)
+    pm = setup.mesh(sc, comm)
     cm = np.zeros(pm.mesh.topology.index_map(3).size_local, dtype=np.int64)
-    cm[fmesh.owned_cells_tagged(pm, geometry.CHARGE)] = 1
-    s = explicit.ExplicitSolver(pm.mesh, [M.from_scene(sc), M.charge_from_scene(sc)], cm)
+    cm[fmesh.owned_cells_tagged(pm, tags.CHARGE)] = 1
+    s = explicit.ExplicitSolver(pm.mesh, [setup.projectile_material(sc), setup.charge_material(sc)], cm)
     contact = ShellChargeContact(s, pm.facet_tags, friction)
     s.interface = contact
     m_shell, m_charge = s.body_mass

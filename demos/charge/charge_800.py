@@ -27,7 +27,7 @@ CONTACTS = ("tied", "frictional")
 
 
 def run(contact: str, out: Path, ranks: int, sets: list[str]) -> dict:
-    from fepen.output import run_fepen_process
+    from fepen.studies.processes import run_fepen_process
 
     args = ["run", str(HERE / "charge_800.toml"), "--out", str(out), "--set", f'charge.contact="{contact}"']
     for s in sets:

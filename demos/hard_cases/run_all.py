@@ -13,7 +13,7 @@ import argparse
 import json
 from pathlib import Path
 
-from fepen.output import run_fepen_process
+from fepen.studies.processes import run_fepen_process
 
 HERE = Path(__file__).resolve().parent
 

@@ -1,0 +1,146 @@
+"""fepen's Python API: a scene in, a Result out, the same run as ``fepen run`` (docs/api.md).
+
+    scene = fepen.Scene("scenes/default.toml", sets=["effects.fidelity=rigid"])
+    result = fepen.run(scene, out="results/C3-rigid")
+    result.summary["Hy_mm"], result.history["nose_y_mm"][-1]
+    again = fepen.load("results/C3-rigid")
+
+Under ``mpirun -n N python script.py`` every rank calls ``fepen.run`` with the same arguments (or a
+communicator), as the command does.
+"""
+
+from __future__ import annotations
+
+import json
+import tempfile
+from dataclasses import dataclass, field
+from pathlib import Path
+
+import numpy as np
+
+from fepen.errors import InputError
+from fepen.scene import Scene
+
+__all__ = ["Scene", "Result", "run", "load", "resume"]
+
+
+@dataclass
+class Result:
+    """A results directory as Python objects.
+
+    Attributes:
+        out: the results directory.
+        summary: the content of summary.json (SI units or the unit in each key's name).
+        scene: the resolved Scene of the run.
+        fields: fields.xdmf when the run wrote fields, else None.
+        figures: the pictures the run wrote, by name ("history", "hazard", "deformed", ...).
+    """
+
+    out: Path
+    summary: dict
+    scene: Scene
+    fields: Path | None = None
+    figures: dict = field(default_factory=dict)
+    _history: np.ndarray | None = field(default=None, repr=False)
+
+    @property
+    def history(self) -> np.ndarray:
+        """history.csv as a numpy structured array: ``history["nose_y_mm"]`` (columns: docs/results.md)."""
+        if self._history is None:
+            data = np.genfromtxt(self.out / "history.csv", delimiter=",", names=True, deletechars="")
+            self._history = np.atleast_1d(data)
+        return self._history
+
+    @property
+    def history_frame(self):
+        """history.csv as a pandas DataFrame (needs pandas)."""
+        try:
+            import pandas as pd
+        except ImportError as err:  # pragma: no cover - depends on the machine
+            raise ImportError("Result.history_frame needs pandas; Result.history is the same as a numpy "
+                              "structured array") from err
+        return pd.DataFrame(self.history)
+
+    def __repr__(self) -> str:
+        s = self.summary
+        return (f"fepen.Result({str(self.out)!r}, outcome={s.get('outcome')!r}, Hx_mm={s.get('Hx_mm'):.6g}, "
+                f"Hy_mm={s.get('Hy_mm'):.6g})")
+
+
+def load(results_dir) -> Result:
+    """The Result of a finished run's directory (summary.json, scene.toml, history.csv).
+
+    Raises:
+        InputError: when the directory holds no finished run.
+    """
+    out = Path(results_dir)
+    if not (out / "summary.json").is_file():
+        raise InputError("results_dir", f"{out} holds no finished run (no summary.json)")
+    summary = json.loads((out / "summary.json").read_text())
+    scene = Scene(out / "scene.toml") if (out / "scene.toml").is_file() else Scene(summary.get("scene"))
+    fields = out / "fields.xdmf"
+    figures = {p.stem: p for p in sorted(out.glob("*.png"))}
+    return Result(out, summary, scene, fields if fields.is_file() else None, figures)
+
+
+def _comm(comm):
+    from mpi4py import MPI
+
+    return MPI.COMM_WORLD if comm is None else comm
+
+
+def run(scene, out=None, comm=None, progress: bool = False) -> Result:
+    """Run one scene, as ``fepen run`` does, and return its Result.
+
+    Args:
+        scene: a Scene, or anything Scene() takes (a TOML file, TOML text, a dict).
+        out: the results directory; None: a new temporary directory (Result.out names it).
+        comm: the MPI communicator of the run; None: COMM_WORLD.
+        progress: a progress bar on rank 0.
+
+    Returns:
+        The Result.
+
+    Raises:
+        InputError: bad input, before anything is meshed or written.
+        SimulationError: the simulation could not go on (what, where, when); what it wrote is kept.
+    """
+    from fepen import scene as fscene
+    from fepen.io import files
+    from fepen.post import figures
+    from fepen.runs import run_scene, setup
+
+    comm = _comm(comm)
+    sc = scene if isinstance(scene, Scene) else Scene(scene)
+    setup.check_supported(sc)
+    if out is None:
+        out = comm.bcast(tempfile.mkdtemp(prefix="fepen-") if comm.rank == 0 else None, root=0)
+    out = files.prepare(out, comm)
+    files.write_text(out / "scene.toml", fscene.to_toml(sc), comm)
+    try:
+        run_scene(sc, out, comm, progress=progress)
+    finally:
+        if (out / "history.csv").exists():
+            figures.history_figure(out, sc, comm)
+    comm.barrier()
+    return load(out)
+
+
+def resume(results_dir, comm=None, progress: bool = False) -> Result:
+    """Continue a killed deformable run from its last checkpoint (same number of ranks); its Result."""
+    from fepen.post import figures
+    from fepen.runs import checkpoint, run_scene
+
+    comm = _comm(comm)
+    out = Path(results_dir)
+    if not (out / "scene.toml").exists():
+        raise InputError("--resume", f"{out} is not a results directory (no scene.toml)")
+    state = checkpoint.read_state(out, comm)
+    sc = Scene(out / "scene.toml")
+    try:
+        run_scene(sc, out, comm, progress=progress, resume=state)
+    finally:
+        if (out / "history.csv").exists():
+            figures.history_figure(out, sc, comm)
+    comm.barrier()
+    return load(out)

@@ -1,0 +1,386 @@
+"""The projectile mesh in dolfinx: built on rank 0 with gmsh (cached), distributed in deterministic bands
+along the projectile, its cavity sized to a mass on the mesh, its wall split for a sliding charge
+(docs/theory.md §2, §11, §13).
+"""
+
+from __future__ import annotations
+
+import functools
+import hashlib
+import json
+import math
+import os
+import time
+from dataclasses import asdict, dataclass, replace
+from pathlib import Path
+
+import numpy as np
+from mpi4py import MPI
+
+from fepen.geometry import gmsh_model, tags, tetra
+from fepen.geometry.shape import Shape
+
+#: mesh-mass tolerance of the cavity sizing (kg)
+MASS_TOLERANCE = 2.5e-4
+
+
+def _code_hash() -> str:
+    """Hash of the source that shapes meshes: a change to it rebuilds cached meshes."""
+    from fepen.geometry import shape as _shape
+
+    h = hashlib.sha256()
+    for mod in (gmsh_model, _shape):
+        h.update(Path(mod.__file__).read_bytes())
+    return h.hexdigest()[:12]
+
+
+@dataclass
+class ProjectileMesh:
+    """A distributed projectile mesh with its tags and the shape it was built from.
+
+    Attributes:
+        mesh: the dolfinx mesh (tetrahedra, SI units, body frame of fepen.geometry.shape).
+        cell_tags: SHELL / CHARGE cell markers.
+        facet_tags: OUTER / CAVITY facet markers (and CHARGE_FACE, the charge's side of a split wall).
+        shape: the exact geometry meshed (cavity length as corrected on the mesh).
+        charge: whether the cavity is meshed as the charge.
+        split: whether the charge has nodes of its own on the cavity wall (frictional contact).
+        mesh_s: wall time spent meshing on rank 0 (0 when read from the cache).
+        cached: whether the mesh came from the cache.
+    """
+
+    mesh: object
+    cell_tags: object
+    facet_tags: object
+    shape: Shape
+    charge: bool
+    mesh_s: float
+    cached: bool
+    split: bool = False
+
+
+def cache_dir() -> Path:
+    """Where meshes are cached: $FEPEN_MESH_CACHE, else meshes/cache in the source tree if writable, else
+    ~/.cache/fepen/meshes."""
+    env = os.environ.get("FEPEN_MESH_CACHE")
+    if env:
+        return Path(env)
+    here = Path(__file__).resolve().parents[1] / "meshes"
+    if here.is_dir() and os.access(here, os.W_OK):
+        return here / "cache"
+    return Path.home() / ".cache" / "fepen" / "meshes"
+
+
+def _key(shape: Shape, opts: gmsh_model.MeshOptions, charge: bool, mass, rho_s, rho_c) -> str:
+    import gmsh
+
+    blob = json.dumps([asdict(shape), asdict(opts), charge, mass, rho_s, rho_c, gmsh.__version__,
+                       _code_hash()], sort_keys=True)
+    return hashlib.sha256(blob.encode()).hexdigest()[:20]
+
+
+def _gmsh_mass(rho_s: float, rho_c: float | None) -> float:
+    m = rho_s * gmsh_model.tet_volumes(tags.SHELL).sum()
+    if rho_c is not None:
+        m += rho_c * gmsh_model.tet_volumes(tags.CHARGE).sum()
+    return m
+
+
+def _mesh_on_root(shape: Shape, opts, charge: bool, mass, rho_s, rho_c, use_cache: bool):
+    """Rank 0: leave the meshed model in gmsh. Returns (final shape, meshing seconds, from cache)."""
+    import gmsh
+
+    if not gmsh.isInitialized():
+        gmsh.initialize(interruptible=False)
+    gmsh.option.setNumber("General.Terminal", 0)
+    gmsh.clear()
+    folder = cache_dir()
+    key = _key(shape, opts, charge, mass, rho_s, rho_c)
+    msh, side = folder / f"{key}.msh", folder / f"{key}.json"
+    if use_cache and msh.is_file() and side.is_file():
+        meta = json.loads(side.read_text())
+        gmsh.open(str(msh))
+        return Shape(**meta["shape"]), 0.0, True
+
+    t0 = time.perf_counter()
+    current = shape
+    for _ in range(5):
+        gmsh.clear()
+        gmsh_model.build_best(current, opts, charge)
+        if mass is None or not current.has_cavity:
+            break
+        error = _gmsh_mass(rho_s, rho_c) - mass
+        if abs(error) <= MASS_TOLERANCE:
+            break
+        r = 0.5 * current.cavity_diameter
+        step = error / ((rho_s - (rho_c or 0.0)) * math.pi * r * r)
+        current = replace(current, cavity_length=current.cavity_length + step)
+        current.check()
+    seconds = time.perf_counter() - t0
+    if use_cache:
+        folder.mkdir(parents=True, exist_ok=True)
+        tmp = folder / f"{key}.{os.getpid()}.msh"
+        gmsh.write(str(tmp))
+        os.replace(tmp, msh)
+        side.write_text(json.dumps({"shape": asdict(current), "mesh_s": seconds}))
+    return current, seconds, False
+
+
+def create(shape: Shape, opts: gmsh_model.MeshOptions, comm: MPI.Comm = MPI.COMM_WORLD, charge: bool = False,
+           mass: float | None = None, shell_density: float = 7850.0, charge_density: float | None = None,
+           split: bool = False, use_cache: bool = True) -> ProjectileMesh:
+    """Build (or read from the cache) and distribute a projectile mesh.
+
+    Args:
+        shape: the checked exact geometry (its cavity length a first guess when ``mass`` is given).
+        opts: element sizes and optimiser.
+        comm: the communicator to distribute over; gmsh runs on its rank 0.
+        charge: mesh the cavity as the charge (volume tag CHARGE).
+        mass: total mass to reach on the mesh by correcting the cavity length (kg), or None.
+        shell_density, charge_density: densities for that mass (kg/m^3).
+        split: give the charge its own nodes on the cavity wall (frictional contact; needs ``charge``).
+        use_cache: read/write the mesh cache.
+
+    Returns:
+        The ProjectileMesh.
+    """
+    rho_c = charge_density if charge else None
+    result = None
+    if comm.rank == 0:
+        result = _mesh_on_root(shape, opts, charge, mass, shell_density, rho_c, use_cache)
+    shape, seconds, cached = comm.bcast(result, root=0)
+    split = bool(split and charge)
+    mesh, ct, ft = _model_to_mesh(comm, split)
+    if comm.rank == 0:
+        import gmsh
+
+        gmsh.clear()
+    return ProjectileMesh(mesh, ct, ft, shape, charge, seconds, cached, split)
+
+
+def split_wall(n_nodes, cells, cell_values, facets, facet_values):
+    """Double the nodes of the CAVITY wall: the charge's cells take new copies (numbered after the
+    existing nodes) and the copied wall facets are tagged CHARGE_FACE.
+
+    Args:
+        n_nodes: number of nodes (gmsh may keep nodes that no cell uses: copies go after all of them).
+        cells: (n_cells, 4) node indices; cell_values: SHELL / CHARGE per cell.
+        facets: (n_facets, 3) node indices of the tagged facets; facet_values: their tags.
+
+    Returns:
+        (cells, facets, facet_values, wall nodes (the originals; their copies are n_nodes + i in that
+        order), links: (k, 2) pairs of cells, a shell cell and a charge cell around the same wall node).
+    """
+    wall = np.unique(facets[facet_values == tags.CAVITY])
+    twin = np.arange(n_nodes, dtype=np.int64)
+    twin[wall] = n_nodes + np.arange(len(wall))
+    cells = cells.copy()
+    charge = cell_values == tags.CHARGE
+    cells[charge] = twin[cells[charge]]
+    new = twin[facets[facet_values == tags.CAVITY]]
+    facets = np.vstack([facets, new])
+    facet_values = np.concatenate([facet_values, np.full(len(new), tags.CHARGE_FACE, dtype=facet_values.dtype)])
+    # cells around each wall node, on either side (the charge's through the copies)
+    original = np.concatenate([np.arange(n_nodes), wall])  # node index -> original node
+    on_wall = np.zeros(n_nodes, dtype=bool)
+    on_wall[wall] = True
+    c_idx = np.repeat(np.arange(len(cells)), 4)
+    node = original[cells.ravel()]
+    keep = on_wall[node]
+    c_idx, node, side = c_idx[keep], node[keep], charge[c_idx[keep]]
+    links = []
+    order = np.argsort(node, kind="stable")
+    c_idx, node, side = c_idx[order], node[order], side[order]
+    cuts = np.flatnonzero(np.diff(node)) + 1
+    for cs, sd in zip(np.split(c_idx, cuts), np.split(side, cuts)):
+        sh, ch = np.unique(cs[~sd]), np.unique(cs[sd])
+        links.append(np.stack(np.meshgrid(sh, ch, indexing="ij"), axis=-1).reshape(-1, 2))
+    links = np.unique(np.concatenate(links), axis=0) if links else np.zeros((0, 2), dtype=np.int64)
+    return cells, facets, facet_values, wall, links
+
+
+def _model_to_mesh(comm, split: bool):
+    """dolfinx.io.gmshio.model_to_mesh for tetrahedra, distributed with band_partitioner, the wall split
+    when asked (split_wall). Returns (mesh, cell tags, facet tags)."""
+    from dolfinx import cpp as _cpp
+    from dolfinx.io import gmshio
+    from dolfinx.mesh import meshtags_from_entities
+
+    TET, TRI = 4, 2  # gmsh element types
+    links = None  # rank 0, a split wall: extra links between cells for the partitioner
+    if comm.rank == 0:
+        import gmsh
+
+        model = gmsh.model
+        x = gmshio.extract_geometry(model)
+        topo = gmshio.extract_topology_and_markers(model)
+        cells = np.asarray(topo[TET]["topology"], dtype=np.int64)
+        cell_values = np.asarray(topo[TET]["cell_data"], dtype=np.int32)
+        facets = np.asarray(topo[TRI]["topology"], dtype=np.int64)
+        facet_values = np.asarray(topo[TRI]["cell_data"], dtype=np.int32)
+        # number the nodes the cells use 0..n-1: a model just meshed keeps unused nodes, and dolfinx's
+        # distribute_entity_data reads node indices as positions among the used ones (beyond: a crash)
+        used = np.unique(cells)
+        renumber = np.full(len(x), -1, dtype=np.int64)
+        renumber[used] = np.arange(len(used))
+        x, cells, facets = x[used], renumber[cells], renumber[facets]
+        if split:
+            cells, facets, facet_values, wall, links = split_wall(len(x), cells, cell_values, facets, facet_values)
+            x = np.vstack([x, x[wall]])
+            from scipy.sparse import coo_matrix
+
+            n = len(cells)
+            ones = np.ones(2 * len(links))
+            links = coo_matrix((ones, (np.concatenate([links[:, 0], links[:, 1]]),
+                                              np.concatenate([links[:, 1], links[:, 0]]))), shape=(n, n)).tocsr()
+    else:
+        x = np.zeros((0, 3))
+        cells = np.zeros((0, 4), dtype=np.int64)
+        cell_values = np.zeros(0, dtype=np.int32)
+        facets = np.zeros((0, 3), dtype=np.int64)
+        facet_values = np.zeros(0, dtype=np.int32)
+    domain = gmshio.ufl_mesh(TET, 3)
+    cells = cells[:, gmshio.cell_perm_array(_cpp.mesh.CellType.tetrahedron, 4)]
+    partitioner = functools.partial(band_partitioner, extra_links=links)
+    mesh = gmshio.create_mesh(comm, cells, x, domain, partitioner=_cpp.mesh.create_cell_partitioner(partitioner))
+    tdim = 3
+    local, values = _cpp.io.distribute_entity_data(mesh._mesh, tdim, cells, cell_values)
+    mesh.topology.create_connectivity(tdim, 0)
+    ct = meshtags_from_entities(mesh, tdim, _cpp.graph.AdjacencyList_int32(local), values.astype(np.int32))
+    ct.name = "Cell tags"
+    facets = facets[:, gmshio.cell_perm_array(_cpp.mesh.CellType.triangle, 3)]
+    local, values = _cpp.io.distribute_entity_data(mesh._mesh, tdim - 1, facets, facet_values)
+    mesh.topology.create_connectivity(tdim - 1, tdim)
+    ft = meshtags_from_entities(mesh, tdim - 1, _cpp.graph.AdjacencyList_int32(local), values.astype(np.int32))
+    ft.name = "Facet tags"
+    return mesh, ct, ft
+
+
+def band_partitioner(comm, nparts: int, graph, ghosting: bool, extra_links=None):
+    """A deterministic partition of the cells' dual graph into nparts bands along the projectile.
+
+    SCOTCH, dolfinx's default, gives a different partition from run to run on the same input, so that
+    two runs on the same number of ranks differ in the last bits (and a checkpoint could not be matched
+    cell for cell). Here: cells in breadth-first order from a pseudo-peripheral cell (the end of a
+    breadth-first sweep from cell 0: the nose tip or the tail of a slender body), cut into nparts runs of
+    equal length; each rank gets a band of the projectile, whose interfaces are cross-sections. With
+    ghosting, a cell is also sent to the ranks owning its facet neighbours. A split wall (split_wall) adds
+    its links to the graph: the bands cross both bodies, and a cell is also ghosted where its links are.
+
+    Args:
+        comm: communicator; graph: this rank's rows of the dual graph (global cell indices);
+        nparts: number of parts; ghosting: return ghost destinations too.
+        extra_links: rank 0, a split wall's cell links (scipy sparse, n x n), or None.
+
+    Returns:
+        AdjacencyList_int32: per local row, the owner rank then the ghost ranks.
+    """
+    from dolfinx import cpp as _cpp
+    from scipy.sparse import csr_matrix
+    from scipy.sparse.csgraph import breadth_first_order
+
+    offsets = np.asarray(graph.offsets, dtype=np.int64)
+    array = np.asarray(graph.array, dtype=np.int64)
+    rows = comm.gather((offsets, array), root=0)
+    dest = None
+    if comm.rank == 0:
+        sizes = [len(o) - 1 for o, _ in rows]
+        n = sum(sizes)
+        indptr = np.concatenate([[0], np.cumsum(np.concatenate([np.diff(o) for o, _ in rows]))])
+        indices = np.concatenate([a for _, a in rows]) if n else np.zeros(0, dtype=np.int64)
+        part = np.zeros(n, dtype=np.int32)
+        if n:
+            g = csr_matrix((np.ones(len(indices)), indices, indptr), shape=(n, n))
+            if extra_links is not None and extra_links.shape == (n, n):
+                g = (g + extra_links).tocsr()
+                g.sort_indices()
+                indptr, indices = g.indptr.astype(np.int64), g.indices.astype(np.int64)
+            start = int(breadth_first_order(g, 0, directed=False, return_predecessors=False)[-1])
+            order = breadth_first_order(g, start, directed=False, return_predecessors=False)
+            if len(order) < n:  # a disconnected mesh: the rest in index order
+                rest = np.setdiff1d(np.arange(n), order)
+                order = np.concatenate([order, rest])
+            part[order] = (np.arange(n, dtype=np.int64) * nparts // n).astype(np.int32)
+        dest = []
+        lo = 0
+        for size in sizes:
+            data, offs = [], [0]
+            for c in range(lo, lo + size):
+                owner = int(part[c])
+                ghosts = sorted({int(part[j]) for j in indices[indptr[c]:indptr[c + 1]]} - {owner}) if ghosting else []
+                data += [owner, *ghosts]
+                offs.append(len(data))
+            dest.append((np.array(data, dtype=np.int32), np.array(offs, dtype=np.int32)))
+            lo += size
+    data, offs = comm.scatter(dest, root=0)
+    return _cpp.graph.AdjacencyList_int32(data, offs)
+
+
+def cell_points(mesh) -> np.ndarray:
+    """Node coordinates of the locally owned cells, shape (n_owned, 4, 3)."""
+    n = mesh.topology.index_map(mesh.topology.dim).size_local
+    dofs = mesh.geometry.dofmap.array.reshape(-1, 4)[:n]
+    return mesh.geometry.x[dofs]
+
+
+def owned_cells_tagged(pm: ProjectileMesh, tag: int) -> np.ndarray:
+    """Local indices of the owned cells carrying a volume tag."""
+    n = pm.mesh.topology.index_map(pm.mesh.topology.dim).size_local
+    cells = pm.cell_tags.find(tag)
+    return cells[cells < n]
+
+
+def metrics(pm: ProjectileMesh, density: dict, speed: dict, safety: float, nominal_size: float) -> dict:
+    """The figures of mesh.json: sizes, mass, volume, quality, shortest altitude, stable step.
+
+    Args:
+        pm: the mesh.
+        density, speed: per volume tag (tags.SHELL, tags.CHARGE), the density (kg/m^3) and dilatational
+            wave speed (m/s).
+        safety: the stable-step safety factor; the stable step is safety x min over cells of (shortest
+            altitude / wave speed of the cell's material).
+        nominal_size: the nominal element size (m).
+    """
+    comm = pm.mesh.comm
+    p = cell_points(pm.mesh)
+    vol = np.abs(tetra.signed_volumes(p))
+    alt = tetra.shortest_altitudes(p)
+    q = tetra.mean_ratio(p)
+    tag = np.full(len(vol), tags.SHELL)
+    if pm.charge:
+        tag[owned_cells_tagged(pm, tags.CHARGE)] = tags.CHARGE
+    rho = np.array([density.get(int(t), 0.0) for t in (tags.SHELL, tags.CHARGE)])[tag - tags.SHELL]
+    c = np.array([speed.get(int(t), 1.0) for t in (tags.SHELL, tags.CHARGE)])[tag - tags.SHELL]
+
+    def total(a):
+        return comm.allreduce(float(np.sum(a)), op=MPI.SUM)
+
+    def smallest(a):
+        return comm.allreduce(float(np.min(a)) if len(a) else math.inf, op=MPI.MIN)
+
+    shell_v = total(vol[tag == tags.SHELL])
+    charge_v = total(vol[tag == tags.CHARGE])
+    exact_shell = pm.shape.shell_volume()
+    exact_total = pm.shape.outer_volume() if pm.charge else exact_shell
+    volume = shell_v + charge_v
+    h = nominal_size
+    shortest = smallest(alt)
+    return {
+        "cells": pm.mesh.topology.index_map(3).size_global,
+        "nodes": pm.mesh.geometry.index_map().size_global,
+        "mass_kg": total(vol * rho),
+        "volume_m3": volume,
+        "shell_volume_m3": shell_v,
+        "charge_volume_m3": charge_v,
+        "exact_volume_m3": exact_total,
+        "volume_error": volume / exact_total - 1.0,
+        "min_quality": smallest(q),
+        "shortest_altitude_m": shortest,
+        "nominal_size_m": h,
+        "altitude_over_size": shortest / h,
+        "stable_dt_s": safety * smallest(alt / c),
+        "cavity_length_m": pm.shape.cavity_length,
+        "mesh_s": pm.mesh_s,
+        "from_cache": pm.cached,
+        "ranks": comm.size,
+    }

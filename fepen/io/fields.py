@@ -1,0 +1,175 @@
+"""Field output (fields.xdmf + fields.h5, dolfinx's XDMF layout, gathered to rank 0) that a killed run never
+leaves half-written: one file per output time while the run goes on, one self-contained file at its end
+(docs/theory.md §12).
+"""
+
+from __future__ import annotations
+
+import os
+import shutil
+from pathlib import Path
+from xml.sax.saxutils import quoteattr
+
+import numpy as np
+from mpi4py import MPI
+
+
+def _time_name(t: float) -> str:
+    """dolfinx's dataset name for an output time."""
+    return repr(float(t)).replace(".", "_") if t != 0 else "0"
+
+
+class FieldWriter:
+    """fields.xdmf + fields.h5 of a run.
+
+    Args:
+        out: results directory.
+        solver: the ExplicitSolver (its mesh, index maps and reference positions).
+        nodal: names of nodal vector fields, in writing order.
+        cell: names of cell scalar fields, in writing order.
+        nodal_scalar: names of nodal scalar fields, written after the cell fields.
+        times: output times already written (when resuming a run; later step files are deleted).
+    """
+
+    def __init__(self, out: Path, solver, nodal: list[str], cell: list[str], times: list[float] = (),
+                 nodal_scalar: list[str] = ()):
+        self.out, self.comm = Path(out), solver.comm
+        self.nodal, self.cell, self.nodal_scalar = list(nodal), list(cell), list(nodal_scalar)
+        self.times = list(times)
+        self.dir = self.out / "fields.d"
+        imap = solver.V.dofmap.index_map
+        self._n_owned = solver.n_owned
+        self._n_cells = solver.n_cells
+        counts_n = self.comm.gather(self._n_owned, root=0)
+        counts_c = self.comm.gather(self._n_cells, root=0)
+        self.n_nodes_global = imap.size_global
+        self.n_cells_global = self.comm.allreduce(self._n_cells, op=MPI.SUM)
+        # global topology: each rank's cells in global node numbering
+        l2g = np.asarray(imap.local_to_global(np.arange(solver.n_nodes, dtype=np.int32)), dtype=np.int64)
+        topo = self._gather(l2g[solver.dofs])
+        geom = self._gather(solver.X[: self._n_owned])
+        if self.comm.rank == 0:
+            assert sum(counts_n) == self.n_nodes_global and sum(counts_c) == self.n_cells_global
+            self.dir.mkdir(parents=True, exist_ok=True)
+            mesh_file = self.dir / "mesh.h5"
+            if not self.times or not mesh_file.exists():
+                self._write_h5(mesh_file, {"geometry": geom, "topology": topo})
+            keep = {mesh_file.name} | {self._step_file(k).name for k in range(len(self.times))}
+            for f in self.dir.iterdir():  # output times after a checkpoint, and temporaries
+                if f.name not in keep:
+                    f.unlink()
+            self._write_index()
+
+    @property
+    def names(self) -> list[str]:
+        """Every field name, in writing order."""
+        return self.nodal + self.cell + self.nodal_scalar
+
+    # ------------------------------------------------------------------------------------------------
+    def _gather(self, local: np.ndarray):
+        parts = self.comm.gather(np.ascontiguousarray(local), root=0)
+        return np.concatenate(parts) if self.comm.rank == 0 else None
+
+    def _step_file(self, k: int) -> Path:
+        return self.dir / f"{k:06d}.h5"
+
+    @staticmethod
+    def _write_h5(path: Path, datasets: dict) -> None:
+        import h5py
+
+        tmp = path.with_name(path.name + f".tmp{os.getpid()}")
+        with h5py.File(tmp, "w") as h5:
+            for name, data in datasets.items():
+                h5.create_dataset(name, data=data)
+        os.replace(tmp, path)
+
+    def write(self, t: float, values: dict[str, np.ndarray]) -> None:
+        """Write one output time (collective).
+
+        Args:
+            t: time (s).
+            values: name -> nodal (n_owned, 3), cell (n_cells,) or nodal scalar (n_owned,) array (longer
+                arrays are cut), for every name given.
+        """
+        data = {}
+        for name in self.nodal + self.nodal_scalar:
+            data[name] = self._gather(values[name][: self._n_owned])
+        for name in self.cell:
+            data[name] = self._gather(values[name][: self._n_cells])
+        if self.comm.rank == 0:
+            data = {k: (v.reshape(-1, 1) if v.ndim == 1 else v) for k, v in data.items()}
+            self._write_h5(self._step_file(len(self.times)), data)
+        self.times.append(float(t))
+        if self.comm.rank == 0:
+            self._write_index()
+
+    def _write_index(self) -> None:
+        """fields.h5 of external links and fields.xdmf, each replaced atomically (rank 0)."""
+        import h5py
+
+        path = self.out / "fields.h5"
+        tmp = path.with_name(path.name + f".tmp{os.getpid()}")
+        with h5py.File(tmp, "w") as h5:
+            for name in ("geometry", "topology"):
+                h5[f"/Mesh/mesh/{name}"] = h5py.ExternalLink("fields.d/mesh.h5", f"/{name}")
+            for k, t in enumerate(self.times):
+                for name in self.names:
+                    h5[f"/Function/{name}/{_time_name(t)}"] = h5py.ExternalLink(
+                        f"fields.d/{self._step_file(k).name}", f"/{name}")
+        os.replace(tmp, path)
+        self._write_xdmf()
+
+    def _write_xdmf(self) -> None:
+        nc, nn = self.n_cells_global, self.n_nodes_global
+        lines = ['<?xml version="1.0"?>', '<!DOCTYPE Xdmf SYSTEM "Xdmf.dtd" []>',
+                 '<Xdmf Version="3.0" xmlns:xi="http://www.w3.org/2001/XInclude">', "  <Domain>",
+                 '    <Grid Name="mesh" GridType="Uniform">',
+                 f'      <Topology TopologyType="Tetrahedron" NumberOfElements="{nc}" NodesPerElement="4">',
+                 f'        <DataItem Dimensions="{nc} 4" NumberType="Int" Precision="8" Format="HDF">'
+                 'fields.h5:/Mesh/mesh/topology</DataItem>',
+                 "      </Topology>", '      <Geometry GeometryType="XYZ">',
+                 f'        <DataItem Dimensions="{nn} 3" Format="HDF">fields.h5:/Mesh/mesh/geometry</DataItem>',
+                 "      </Geometry>", "    </Grid>"]
+        ref = ("        <xi:include xpointer=\"xpointer(/Xdmf/Domain/Grid[@GridType='Uniform'][1]"
+               "/*[self::Topology or self::Geometry])\" />")
+        for name in self.names:
+            lines.append(f'    <Grid Name={quoteattr(name)} GridType="Collection" CollectionType="Temporal">')
+            for t in self.times:
+                if name in self.nodal:
+                    dims, kind, centre = f"{nn} 3", "Vector", "Node"
+                elif name in self.cell:
+                    dims, kind, centre = f"{nc} 1", "Scalar", "Cell"
+                else:
+                    dims, kind, centre = f"{nn} 1", "Scalar", "Node"
+                lines += [f'      <Grid Name={quoteattr(name)} GridType="Uniform">', ref,
+                          f'        <Time Value="{float(t)!r}" />',
+                          f'        <Attribute Name={quoteattr(name)} AttributeType="{kind}" Center="{centre}">',
+                          f'          <DataItem Dimensions="{dims}" Format="HDF">'
+                          f"fields.h5:/Function/{name}/{_time_name(t)}</DataItem>",
+                          "        </Attribute>", "      </Grid>"]
+            lines.append("    </Grid>")
+        lines += ["  </Domain>", "</Xdmf>", ""]
+        path = self.out / "fields.xdmf"
+        tmp = path.with_name(path.name + f".tmp{os.getpid()}")
+        tmp.write_text("\n".join(lines))
+        os.replace(tmp, path)
+
+    def consolidate(self) -> None:
+        """Copy every output time into a self-contained fields.h5 (atomic) and remove fields.d (rank 0;
+        call on every rank)."""
+        if self.comm.rank == 0 and self.dir.exists():
+            import h5py
+
+            path = self.out / "fields.h5"
+            tmp = path.with_name(path.name + f".tmp{os.getpid()}")
+            with h5py.File(tmp, "w") as dst:
+                with h5py.File(self.dir / "mesh.h5", "r") as src:
+                    for name in ("geometry", "topology"):
+                        dst.create_dataset(f"/Mesh/mesh/{name}", data=src[name][()])
+                for k, t in enumerate(self.times):
+                    with h5py.File(self._step_file(k), "r") as src:
+                        for name in self.names:
+                            dst.create_dataset(f"/Function/{name}/{_time_name(t)}", data=src[name][()])
+            os.replace(tmp, path)
+            shutil.rmtree(self.dir)
+        self.comm.barrier()

@@ -1,0 +1,99 @@
+"""What a run writes (contract): history.csv, summary.json with the Table 1 comparison, figures."""
+
+from __future__ import annotations
+
+import csv
+import io
+import math
+from pathlib import Path
+
+import numpy as np
+from mpi4py import MPI
+
+from fepen.errors import SimulationError
+from fepen.experiments import shot
+from fepen.geometry.frames import unit_axis
+from fepen.io import files
+
+G0 = 9.80665  # m/s^2, for accelerations in g
+
+HISTORY_COLUMNS = ["t_s", "nose_x_mm", "nose_y_mm", "tail_x_mm", "tail_y_mm", "speed_m_s", "decel_g",
+                   "vx_m_s", "vy_m_s", "force_x_N", "force_y_N", "length_mm", "kinetic_J", "internal_work_J",
+                   "external_work_J", "elastic_J", "plastic_J", "heat_J", "energy_error", "contact_nodes",
+                   "dt_s", "max_peeq", "contact_area_m2"]
+COL = {k: i for i, k in enumerate(HISTORY_COLUMNS)}
+#: appended with a charge: mass-averaged acceleration of each body along the axis (tail to nose), in g
+#: (negative while the projectile decelerates)
+CHARGE_COLUMNS = ["shell_acc_g", "charge_acc_g"]
+#: appended with a charge in frictional contact (fepen.solver.shell_charge): friction dissipation, the largest gap,
+#: interpenetration and slip over the wall's node pairs, the fractions of pairs open and sliding
+INTERFACE_COLUMNS = ["friction_J", "interface_gap_max_mm", "interface_penetration_max_mm", "interface_slip_max_mm",
+                     "interface_free_fraction", "interface_sliding_fraction"]
+
+
+def history_row(t, tip, tail, velocity, force, mass, energies: dict, contact: int, dt: float, peeq: float,
+                contact_area: float = 0.0):
+    """One history row in the reported frame: x along the face, y depth into the target (mm from O).
+
+    Args:
+        tip, tail: world positions (m) of the nose tip and tail centre. velocity: centre-of-mass velocity.
+        force: target force on the projectile (N, world). mass: projectile mass (kg).
+        contact: number of loaded points (nodes on a rigid wall); contact_area: loaded area (m^2).
+        energies: kinetic, internal_work, external_work, elastic, plastic, heat, energy_error (J, -).
+    """
+    axis = unit_axis(tip, tail)
+    decel = -float(np.dot(force, axis)) / mass / G0
+    row = [t, tip[0] * 1e3, -tip[1] * 1e3, tail[0] * 1e3, -tail[1] * 1e3, float(np.linalg.norm(velocity)), decel,
+           velocity[0], -velocity[1], force[0], -force[1], float(np.linalg.norm(tip - tail)) * 1e3,
+           energies["kinetic"], energies["internal_work"], energies["external_work"], energies["elastic"],
+           energies["plastic"], energies["heat"], energies["energy_error"], contact, dt, peeq, contact_area]
+    return row
+
+
+def write_history(rows, out: Path, comm=MPI.COMM_WORLD, columns=None) -> None:
+    """history.csv (rank 0, atomically); columns: HISTORY_COLUMNS (default), + CHARGE_COLUMNS with a charge."""
+    if comm.rank != 0:
+        return
+    buf = io.StringIO()
+    w = csv.writer(buf)
+    w.writerow(columns or HISTORY_COLUMNS)
+    for r in rows:
+        w.writerow([f"{v:.9g}" for v in r])
+    files.write_text(Path(out) / "history.csv", buf.getvalue(), comm)
+
+
+def comparison(scene, summary: dict) -> dict | None:
+    """Errors against Table 1 when the scene names a shot: nose error |H_sim − H_exp| / |H_exp| with
+    H = (Hx, Hy) 2-vectors, likewise the tail; and each component's relative error."""
+    name = scene.get("impact.shot")
+    if name is None:
+        return None
+    s = shot(name)
+    H_exp, T_exp = np.array([s.Hx_mm, s.Hy_mm]), np.array([s.Tx_mm, s.Ty_mm])
+    H = np.array([summary["Hx_mm"], summary["Hy_mm"]])
+    T = np.array([summary["Tx_mm"], summary["Ty_mm"]])
+    return {"shot": name, "Hx_mm": s.Hx_mm, "Hy_mm": s.Hy_mm, "Tx_mm": s.Tx_mm, "Ty_mm": s.Ty_mm,
+            "nose_error": float(np.linalg.norm(H - H_exp) / np.linalg.norm(H_exp)),
+            "tail_error": float(np.linalg.norm(T - T_exp) / np.linalg.norm(T_exp)),
+            "Hy_error": float(summary["Hy_mm"] / s.Hy_mm - 1), "Ty_error": float(summary["Ty_mm"] / s.Ty_mm - 1)}
+
+
+def summary(scene, rows, outcome: str, extra: dict) -> dict:
+    """summary.json content (contract keys first)."""
+    last = rows[-1]
+    out = {"Hx_mm": abs(last[COL["nose_x_mm"]]), "Hy_mm": abs(last[COL["nose_y_mm"]]),
+           "Tx_mm": abs(last[COL["tail_x_mm"]]), "Ty_mm": abs(last[COL["tail_y_mm"]]),
+           "depth_mm": max(r[COL["nose_y_mm"]] for r in rows), "length_mm": last[COL["length_mm"]],
+           "residual_speed_m_s": last[COL["speed_m_s"]], "outcome": outcome,
+           "energy_error": max(r[COL["energy_error"]] for r in rows), "max_peeq": last[COL["max_peeq"]]}
+    out.update(extra)
+    out["experiment"] = comparison(scene, out)
+    out["scene"] = scene.as_dict()
+    out["versions"] = files.versions()
+    return out
+
+
+def finite_row(row, step, t) -> None:
+    """Raise SimulationError if a history row holds a non-finite number."""
+    if not all(math.isfinite(v) for v in row):
+        raise SimulationError(f"non-finite state at step {step}, t = {t * 1e6:.3f} us")

@@ -1,0 +1,164 @@
+"""The rigid projectile on plain arrays: exact mass properties of tetrahedra, quaternions, and the RK4
+rigid-body motion under the sum of the load points' forces (docs/theory.md §9).
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+
+import numpy as np
+
+
+def tet_mass_properties(p: np.ndarray, rho: np.ndarray):
+    """Mass, centre of mass and inertia tensor about the centre of a set of tetrahedra.
+
+    Args:
+        p: node coordinates (n, 4, 3). rho: density per cell (n,).
+
+    Returns:
+        (mass, centre (3,), inertia (3, 3)).
+    """
+    d = np.einsum("ij,ij->i", np.cross(p[:, 1] - p[:, 0], p[:, 2] - p[:, 0]), p[:, 3] - p[:, 0])
+    V = np.abs(d) / 6.0
+    m = rho * V
+    first = np.einsum("i,ij->j", m, p.mean(axis=1))
+    s = p.sum(axis=1)
+    second = np.einsum("i,iajk->jk", m / 20.0, np.einsum("iaj,iak->iajk", p, p)) \
+        + np.einsum("i,ij,ik->jk", m / 20.0, s, s)
+    return float(m.sum()), first, second
+
+
+def inertia_about_centre(mass: float, first: np.ndarray, second: np.ndarray):
+    """From Σ m, Σ m x and Σ ∫ρ x⊗x (about the origin): centre and inertia tensor about the centre."""
+    c = first / mass
+    S = second - mass * np.outer(c, c)
+    return c, np.trace(S) * np.eye(3) - S
+
+
+def quat_to_matrix(q: np.ndarray) -> np.ndarray:
+    """Rotation matrix of a unit quaternion (w, x, y, z)."""
+    w, x, y, z = q
+    return np.array([[1 - 2 * (y * y + z * z), 2 * (x * y - w * z), 2 * (x * z + w * y)],
+                     [2 * (x * y + w * z), 1 - 2 * (x * x + z * z), 2 * (y * z - w * x)],
+                     [2 * (x * z - w * y), 2 * (y * z + w * x), 1 - 2 * (x * x + y * y)]])
+
+
+def matrix_to_quat(R: np.ndarray) -> np.ndarray:
+    """Unit quaternion (w, x, y, z) of a rotation matrix (Shepperd's method)."""
+    t = np.trace(R)
+    if t > 0:
+        s = 2.0 * np.sqrt(1.0 + t)
+        q = [0.25 * s, (R[2, 1] - R[1, 2]) / s, (R[0, 2] - R[2, 0]) / s, (R[1, 0] - R[0, 1]) / s]
+    else:
+        i = int(np.argmax(np.diag(R)))
+        j, k = (i + 1) % 3, (i + 2) % 3
+        s = 2.0 * np.sqrt(1.0 + R[i, i] - R[j, j] - R[k, k])
+        q = np.zeros(4)
+        q[0] = (R[k, j] - R[j, k]) / s
+        q[1 + i] = 0.25 * s
+        q[1 + j] = (R[j, i] + R[i, j]) / s
+        q[1 + k] = (R[k, i] + R[i, k]) / s
+        return q / np.linalg.norm(q)
+    q = np.array(q)
+    return q / np.linalg.norm(q)
+
+
+def quat_mul(a: np.ndarray, b: np.ndarray) -> np.ndarray:
+    """Hamilton product a ⊗ b."""
+    w1, x1, y1, z1 = a
+    w2, x2, y2, z2 = b
+    return np.array([w1 * w2 - x1 * x2 - y1 * y2 - z1 * z2, w1 * x2 + x1 * w2 + y1 * z2 - z1 * y2,
+                     w1 * y2 - x1 * z2 + y1 * w2 + z1 * x2, w1 * z2 + x1 * y2 - y1 * x2 + z1 * w2])
+
+
+@dataclass
+class RigidState:
+    """c, V, L: world-frame centre, velocity, angular momentum; q: body rotation quaternion."""
+
+    c: np.ndarray
+    q: np.ndarray
+    V: np.ndarray
+    L: np.ndarray
+
+    def as_array(self) -> np.ndarray:
+        return np.concatenate([self.c, self.q, self.V, self.L])
+
+    @staticmethod
+    def from_array(y: np.ndarray) -> RigidState:
+        return RigidState(y[0:3].copy(), y[3:7].copy(), y[7:10].copy(), y[10:13].copy())
+
+
+class RigidBody:
+    """A rigid body with surface load points.
+
+    Args:
+        mass, centre0, inertia: mass properties in the reference frame (centre0: reference centre).
+        points: reference positions of the load points (k, 3). normals: their reference normals (k, 3).
+    """
+
+    def __init__(self, mass: float, centre0: np.ndarray, inertia: np.ndarray, points: np.ndarray,
+                 normals: np.ndarray):
+        self.mass = mass
+        self.centre0 = np.asarray(centre0, float)
+        self.I_body = np.asarray(inertia, float)
+        self.I_body_inv = np.linalg.inv(self.I_body)
+        self.r0 = np.asarray(points, float) - self.centre0  # body-frame arms
+        self.N0 = np.asarray(normals, float)
+
+    def omega(self, s: RigidState, R: np.ndarray | None = None) -> np.ndarray:
+        """World angular velocity ω = R I_b^{-1} R^T L."""
+        R = quat_to_matrix(s.q) if R is None else R
+        return R @ (self.I_body_inv @ (R.T @ s.L))
+
+    def points(self, s: RigidState):
+        """World positions, velocities and normals of the load points."""
+        R = quat_to_matrix(s.q)
+        arm = self.r0 @ R.T
+        w = self.omega(s, R)
+        return s.c + arm, s.V + np.cross(w, arm), self.N0 @ R.T, arm
+
+    def to_world(self, s: RigidState, X: np.ndarray) -> np.ndarray:
+        """World position of reference points X (k, 3)."""
+        return s.c + (np.asarray(X, float) - self.centre0) @ quat_to_matrix(s.q).T
+
+    def derivative(self, s: RigidState, force_fn):
+        """Time derivative of the state, and the force and moment; force_fn(s, x, v, n) -> forces (k, 3) on
+        the load points at world positions x, velocities v, normals n."""
+        x, v, n, arm = self.points(s)
+        f = force_fn(s, x, v, n)
+        F = f.sum(axis=0)
+        M = np.cross(arm, f).sum(axis=0)
+        w = self.omega(s)
+        dq = 0.5 * quat_mul(np.array([0.0, *w]), s.q)
+        return np.concatenate([s.V, dq, F / self.mass, M]), F, M
+
+    def power(self, s: RigidState, F: np.ndarray, M: np.ndarray) -> float:
+        """Power F·V + M·ω of the external force and moment (W)."""
+        return float(F @ s.V + M @ self.omega(s))
+
+    def rk4_step(self, s: RigidState, dt: float, force_fn):
+        """One classical Runge–Kutta step.
+
+        Returns:
+            (new state, force and moment at the start, work of the external force and moment over the step
+            by the same RK4 weights on the stage powers: dt/6 (P1 + 2 P2 + 2 P3 + P4)).
+        """
+        y0 = s.as_array()
+        work = 0.0
+        k = []
+        state = s
+        for i, (c, w) in enumerate(((0.0, 1.0), (0.5, 2.0), (0.5, 2.0), (1.0, 1.0))):
+            if i:
+                state = RigidState.from_array(y0 + c * dt * k[-1])
+            ki, F, M = self.derivative(state, force_fn)
+            if i == 0:
+                F0, M0 = F, M
+            work += w * self.power(state, F, M)
+            k.append(ki)
+        y = y0 + dt / 6.0 * (k[0] + 2 * k[1] + 2 * k[2] + k[3])
+        new = RigidState.from_array(y)
+        new.q /= np.linalg.norm(new.q)
+        return new, F0, M0, dt / 6.0 * work
+
+    def kinetic_energy(self, s: RigidState) -> float:
+        return 0.5 * self.mass * float(s.V @ s.V) + 0.5 * float(self.omega(s) @ s.L)

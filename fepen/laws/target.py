@@ -1,0 +1,347 @@
+"""The concrete target as a resistance law on plain arrays of projectile surface points (docs/theory.md §8,
+docs/paper.md §4): cavity-expansion σ_s, tunnel stress, wake, separation, free surface, both craters,
+friction, and the load on a set of points. The target face is the plane y = 0, the target y < 0.
+"""
+
+from __future__ import annotations
+
+import functools
+import math
+from dataclasses import dataclass
+
+import numpy as np
+
+SIN_TOL = 1e-9  # v̂·n below this counts as zero (a surface parallel to the motion is not loaded)
+
+
+# ---------------------------------------------------------------------------------------------------------
+# §4.1 quasi-static cavity expansion
+# ---------------------------------------------------------------------------------------------------------
+def cavity_ratio(Y: float, E: float, T: float) -> float:
+    """c/a of the elastic–cracked–plastic cavity expansion: (a/c)^3 = (9Y/(4E)) (Y/(2T))^(1/2)."""
+    return (9.0 * Y / (4.0 * E) * math.sqrt(Y / (2.0 * T))) ** (-1.0 / 3.0)
+
+
+def quasi_static_stress(Y, E, T, lam, c_over_a=None):
+    """Quasi-static radial stress at the cavity wall (Pa), compression positive (§4.1):
+
+        σ_s = (Y/λ) [(2/α)(c/a)^(αλ) − (3 − λ)/3],   α = 6/(3 + 2λ)
+
+    written as Y [(2/α) expm1(αλ ln(c/a))/λ + 1], which tends to the Tresca value Y [1 + 2 ln(c/a)] as
+    λ → 0 without dividing by zero.
+
+    Args:
+        Y: unconfined compressive strength (Pa); E: Young's modulus (Pa); T: tensile strength (Pa).
+        lam: pressure-hardening coefficient λ (0 <= λ < 3).
+        c_over_a: plastic-zone radius over cavity radius (array allowed); default from cavity_ratio.
+
+    Returns:
+        σ_s (Pa), scalar or array like c_over_a.
+    """
+    ca = cavity_ratio(Y, E, T) if c_over_a is None else np.asarray(c_over_a, dtype=float)
+    alpha = 6.0 / (3.0 + 2.0 * lam)
+    L = np.log(ca)
+    if lam == 0.0:
+        g = alpha * L
+    else:
+        g = np.expm1(alpha * lam * L) / lam
+    return Y * ((2.0 / alpha) * g + 1.0)
+
+
+def forrestal_S(fc_pa: float) -> float:
+    """Forrestal's empirical S = 82.6 fc^−0.544 (fc in MPa): σ_s = S fc."""
+    return 82.6 * (fc_pa / 1e6) ** -0.544
+
+
+def ogive_nose_factor(crh: float) -> float:
+    """N* = (8ψ − 1)/(24ψ²) of a tangent ogive (frictionless)."""
+    return (8.0 * crh - 1.0) / (24.0 * crh * crh)
+
+
+# ---------------------------------------------------------------------------------------------------------
+# The law
+# ---------------------------------------------------------------------------------------------------------
+@dataclass(frozen=True)
+class TargetLaw:
+    """Parameters of the resistance law (SI units).
+
+    Attributes:
+        density: ρ0 (kg/m^3). Y, E, T, lam: strength, modulus, tensile strength, λ (§4.1).
+        sigma_s: the quasi-static stress used (Pa) (computed or given).
+        B: inertial factor. thickness: None for semi-infinite.
+        crater: "none", "linear" or "energy"; k: crater depth factor; D: projectile diameter (m).
+        separation, phi_min: switch and minimum separation angle (rad).
+        free_surface: switch the plastic-zone truncation by the face.
+        friction, mu: Coulomb friction switch and coefficient.
+        lock_density: Q1 of the energy crater (kg/m^3); crush_strain: ε of the energy crater.
+        c_over_a: plastic-zone ratio of the cavity expansion.
+    """
+
+    density: float
+    Y: float
+    E: float
+    T: float
+    lam: float
+    sigma_s: float
+    B: float = 1.0
+    thickness: float | None = None
+    crater: str = "none"
+    k: float = 2.37
+    D: float = 0.0236
+    separation: bool = False
+    phi_min: float = 0.0
+    free_surface: bool = False
+    friction: bool = False
+    mu: float = 0.0
+    lock_density: float = 2650.0
+    crush_strain: float = 0.094
+    c_over_a: float = 1.0
+    given_sigma_s: bool = False
+    onset: float = 0.0
+
+
+@dataclass
+class SurfaceState:
+    """Surface points as the law sees them (all arrays over the points).
+
+    Attributes:
+        x, v, n: position, velocity, outward unit normal (k, 3). area: tributary area (k,).
+        radius: distance of the point from the projectile axis (k,) (the local cavity radius).
+        R_meridian: meridional radius of curvature of the surface at the point (k,), inf where flat.
+        sin_phi0: sine of the angle between the surface and the axis at the point (k,) (0 on the shank).
+        axis: unit vector of the projectile axis, tail to nose (3,), or None (no wake rule).
+    """
+
+    x: np.ndarray
+    v: np.ndarray
+    n: np.ndarray
+    area: np.ndarray
+    radius: np.ndarray
+    R_meridian: np.ndarray
+    sin_phi0: np.ndarray
+    axis: np.ndarray | None = None
+
+
+def inside(law: TargetLaw, x: np.ndarray) -> np.ndarray:
+    """Points inside the target material: −thickness < y < 0."""
+    y = x[:, 1]
+    mask = y < 0.0
+    if law.thickness is not None:
+        mask &= y > -law.thickness
+    return mask
+
+
+def immersion(law: TargetLaw, x: np.ndarray, area: np.ndarray) -> np.ndarray:
+    """Immersed fraction of each load point's patch, clip(½ − y/ℓ, 0, 1) with ℓ = √A (and likewise at the
+    rear face): a patch crossing the face is loaded in proportion to the part of it inside the target, so
+    the force grows continuously as the projectile enters instead of jumping point by point."""
+    ell = np.sqrt(area)
+    y = x[:, 1]
+    w = np.clip(0.5 - y / ell, 0.0, 1.0)
+    if law.thickness is not None:
+        w *= np.clip(0.5 + (y + law.thickness) / ell, 0.0, 1.0)
+    return w
+
+
+def escape_length(law: TargetLaw, x: np.ndarray, n: np.ndarray) -> np.ndarray:
+    """Distance L_e from the point to the nearest free face along the outward normal (inf if the normal
+    never reaches a face): the path along which crushed medium escapes (docs/theory.md §8.3)."""
+    depth = np.maximum(-x[:, 1], 0.0)
+    ny = n[:, 1]
+    L = np.full(len(x), np.inf)
+    up = ny > SIN_TOL
+    L[up] = depth[up] / ny[up]
+    if law.thickness is not None:
+        down = ny < -SIN_TOL
+        L[down] = np.maximum(law.thickness - depth[down], 0.0) / (-ny[down])
+    return L
+
+
+def tunnel_stress(law: TargetLaw, vn: np.ndarray, sigma_s) -> np.ndarray:
+    """σ_s + B ρ0 (v·n)² where v·n > 0, else 0 (Pa)."""
+    return np.where(vn > 0.0, sigma_s + law.B * law.density * vn * vn, 0.0)
+
+
+@functools.lru_cache(maxsize=8)
+def _gauss_legendre(n: int):
+    """Gauss-Legendre nodes and weights on [-1, 1] (computed once: an eigenvalue problem)."""
+    return np.polynomial.legendre.leggauss(n)
+
+
+def crater_energy_ejects(law: TargetLaw, vn, L_e, radius, R_meridian, sin_phi0, n_gauss: int = 8):
+    """The splash-streamline energy balance per unit surface area (docs/theory.md §8.3).
+
+        E_kin      = ½ Q1 v_n² ∫_0^l (1 + w/R)(1 + w sinφ/ρ) (ρ/(ρ + w))^4 dw,   l = (c/a − 1) ρ
+        E_strength = ε σ_cf (2ρ L_e + L_e²) / ρ
+    The medium is thrown out (no load) where E_kin − E_strength >= 0.
+
+    Returns:
+        Boolean array: True where the medium is ejected.
+    """
+    rho = np.maximum(radius, 1e-12)
+    l = (law.c_over_a - 1.0) * rho
+    xg, wg = _gauss_legendre(n_gauss)
+    integral = np.zeros_like(rho)
+    for xi, wi in zip(xg, wg):
+        w = 0.5 * l * (xi + 1.0)
+        growth = (1.0 + w / R_meridian) * (1.0 + w * sin_phi0 / rho)
+        integral += 0.5 * l * wi * growth * (rho / (rho + w)) ** 4
+    e_kin = 0.5 * law.lock_density * vn * vn * integral
+    finite = np.isfinite(L_e)
+    e_str = np.full_like(rho, np.inf)
+    e_str[finite] = law.crush_strain * law.Y * (2.0 * rho[finite] * L_e[finite] + L_e[finite] ** 2) / rho[finite]
+    return e_kin - e_str >= 0.0
+
+
+def normal_stress(law: TargetLaw, s: SurfaceState, vhat_tol: float = SIN_TOL):
+    """Normal stress σ_n on every surface point (Pa), with the crater ("energy"), separation and
+    free-surface effects that the law switches on; the "linear" crater is applied to forces by
+    :func:`forces` because it is a statement about the total force.
+
+    Returns:
+        (σ_n (k,) (already weighted by the immersed fraction), inside mask (k,), v·n (k,)).
+    """
+    frac = immersion(law, s.x, s.area)
+    ins = frac > 0.0
+    vn = np.einsum("ij,ij->i", s.v, s.n)
+    speed = np.linalg.norm(s.v, axis=1)
+    sin_phi = np.where(speed > 0.0, vn / np.maximum(speed, 1e-300), 0.0)
+    loaded = ins & (sin_phi > vhat_tol)
+    if s.axis is not None:  # the wake: moving backward, a point meets the open tunnel, not concrete
+        loaded &= s.v @ s.axis > 0.0
+    if law.separation:
+        loaded &= sin_phi > math.sin(law.phi_min)
+    sigma_s = np.full(len(vn), law.sigma_s)
+    need_L = law.free_surface or law.crater == "energy"
+    L_e = escape_length(law, s.x, s.n) if need_L else None
+    if law.free_surface and not law.given_sigma_s:
+        ca = np.minimum(law.c_over_a, 1.0 + L_e / np.maximum(s.radius, 1e-12))
+        sigma_s = quasi_static_stress(law.Y, law.E, law.T, law.lam, ca)
+    elif law.free_surface:  # σ_s given: scale it like the cavity-expansion value
+        ca = np.minimum(law.c_over_a, 1.0 + L_e / np.maximum(s.radius, 1e-12))
+        sigma_s = law.sigma_s * quasi_static_stress(law.Y, law.E, law.T, law.lam, ca) / quasi_static_stress(
+            law.Y, law.E, law.T, law.lam, law.c_over_a)
+    if law.onset > 0.0:  # σ_s develops over the first `onset` of surface angle (grazing: no expansion)
+        sigma_s = sigma_s * np.minimum(sin_phi / math.sin(law.onset), 1.0)
+    sig = np.where(loaded, tunnel_stress(law, vn, sigma_s), 0.0) * frac
+    if law.crater == "energy":
+        shallow = loaded & (-s.x[:, 1] < law.k * law.D)
+        if np.any(shallow):
+            idx = np.flatnonzero(shallow)
+            out = crater_energy_ejects(law, vn[idx], L_e[idx], s.radius[idx], s.R_meridian[idx], s.sin_phi0[idx])
+            sig[idx[out]] = 0.0
+    return sig, ins, vn
+
+
+def forces(law: TargetLaw, s: SurfaceState):
+    """Nodal forces of the target on the surface points (N), shape (k, 3).
+
+    Args:
+        law: the TargetLaw.
+        s: the surface state.
+
+    Returns:
+        (forces (k, 3), σ_n (k,)).
+    """
+    sig, ins, vn = normal_stress(law, s)
+    f = -(sig * s.area)[:, None] * s.n
+    if law.friction and law.mu > 0.0:
+        vt = s.v - vn[:, None] * s.n
+        speed_t = np.linalg.norm(vt, axis=1)
+        slide = speed_t > 1e-9
+        f[slide] -= (law.mu * sig[slide] * s.area[slide] / speed_t[slide])[:, None] * vt[slide]
+    return f, sig
+
+
+@dataclass
+class PointLoad:
+    """The target's load on a set of surface points (fepen.laws.target.load_on_points).
+
+    Attributes:
+        force: force on every point (k, 3) (N), zero where not immersed.
+        total: total force (3,) (N); loaded: points under a positive stress; area: their area (m^2);
+            each summed over all ranks when the caller's ``reduce`` does so.
+    """
+
+    force: np.ndarray
+    total: np.ndarray
+    loaded: int
+    area: float
+
+
+def load_on_points(law: TargetLaw, x, v, n, area, radius, R_meridian, sin_phi0, axis, crater=None,
+                   tip_depth: float = 0.0, reduce=None) -> PointLoad:
+    """The target's forces on surface points: immersion, the law on the immersed points, the linear crater.
+
+    The one implementation for the rigid and the deformable projectile (they differ only in where their
+    points come from and in ``reduce``).
+
+    Args:
+        law: the TargetLaw. x, v, n, area, radius, R_meridian, sin_phi0, axis: as SurfaceState, over all of
+            this process's points.
+        crater: a ForrestalCrater (the "linear" crater) or None. tip_depth: the nose tip's depth (m).
+        reduce: sums an array over the processes that share the points (the MPI sum of a distributed
+            surface), or None when this process holds them all.
+
+    Returns:
+        The PointLoad.
+    """
+    f = np.zeros_like(x)
+    idx = np.flatnonzero(immersion(law, x, area) > 0.0)
+    sig = np.zeros(0)
+    if len(idx):
+        st = SurfaceState(x[idx], v[idx], n[idx], area[idx], radius[idx], R_meridian[idx], sin_phi0[idx], axis)
+        f[idx], sig = forces(law, st)
+    loaded = sig > 0.0
+    sums = np.array([*f.sum(axis=0), float(loaded.sum()), float(area[idx][loaded].sum()) if len(idx) else 0.0])
+    if reduce is not None:
+        sums = reduce(sums)
+    total = sums[:3]
+    if crater is not None:
+        scale = crater.scale(tip_depth, -float(total @ axis))
+        f *= scale
+        total = total * scale
+    return PointLoad(f, total, int(sums[3]), float(sums[4]))
+
+
+@dataclass
+class ForrestalCrater:
+    """Forrestal et al. (1994): in the crater (tip depth z < k D) the axial force is c z, with c set by
+    continuity with the tunnel force at z = k D:
+
+        V1² = (M V0² − π a² k D σ_s) / (M + N* ρ0 π a² k D),    c = π a² (σ_s + N* ρ0 V1²) / (k D)
+
+    fepen applies it by scaling the tunnel-law stresses of all loaded points so that their force along the
+    axis is c z; past k D the scale is 1.
+
+    Args:
+        law: the target law. mass: projectile mass (kg). v0: striking speed (m/s). crh: nose CRH.
+    """
+
+    law: TargetLaw
+    mass: float
+    v0: float
+    crh: float
+
+    def __post_init__(self):
+        a = 0.5 * self.law.D
+        kd = self.law.k * self.law.D
+        N = ogive_nose_factor(self.crh) if self.crh > 0 else 1.0
+        area = math.pi * a * a
+        self.v1_sq = max((self.mass * self.v0**2 - area * kd * self.law.sigma_s)
+                         / (self.mass + N * self.law.density * area * kd), 0.0)
+        self.c = area * (self.law.sigma_s + N * self.law.density * self.v1_sq) / kd if kd > 0 else 0.0
+        self.kd = kd
+
+    def scale(self, tip_depth: float, axial_force: float) -> float:
+        """Factor on the stresses given the tunnel-law force along the axis (N) at this tip depth (m)."""
+        if tip_depth >= self.kd or axial_force <= 0.0:
+            return 1.0
+        return max(tip_depth, 0.0) * self.c / axial_force
+
+    def depth(self) -> float:
+        """Forrestal's two-stage final depth (m): k D + M/(2π a² ρ0 N*) ln(1 + N* ρ0 V1²/σ_s)."""
+        a = 0.5 * self.law.D
+        N = ogive_nose_factor(self.crh)
+        return self.kd + self.mass / (2 * math.pi * a * a * self.law.density * N) * math.log(
+            1 + N * self.law.density * self.v1_sq / self.law.sigma_s)

@@ -1,0 +1,81 @@
+"""Checkpoint files of a deformable run (``fepen run --resume DIR``; docs/theory.md §12).
+
+A checkpoint is every rank's arrays in its own file, ``checkpoint/step<N>-rank<r>.npz`` (rank 0's also
+holds the run's tables), and ``checkpoint/state.json``, which names the complete step and carries the run's
+small state. Files are written under temporary names and renamed; state.json is replaced last, after a
+barrier, and older step files are deleted only then, so a run killed at any instant leaves a complete
+checkpoint. What goes in is the run's business (DeformableRun.checkpoint_state); this module only writes
+and reads it. Resuming needs the same number of ranks as the run it continues.
+"""
+
+from __future__ import annotations
+
+import json
+import os
+import shutil
+from pathlib import Path
+
+import numpy as np
+
+from fepen.errors import InputError
+
+
+def _atomic_savez(path: Path, **arrays) -> None:
+    tmp = path.with_name(path.name + f".tmp{os.getpid()}.npz")
+    np.savez(tmp, **arrays)
+    os.replace(tmp, path)
+
+
+def write(out: Path, comm, step: int, t: float, arrays: dict, meta: dict) -> None:
+    """Write a checkpoint (collective).
+
+    Args:
+        out: the results directory.
+        step, t: the step number and time of the state.
+        arrays: this rank's arrays (name -> array).
+        meta: rank 0's small state (JSON-serialisable), stored in state.json.
+    """
+    d = Path(out) / "checkpoint"
+    if comm.rank == 0:
+        d.mkdir(exist_ok=True)
+    comm.barrier()
+    _atomic_savez(d / f"step{step:09d}-rank{comm.rank}.npz", **arrays)
+    comm.barrier()
+    if comm.rank == 0:
+        state = {"step": step, "t_s": t, "ranks": comm.size, **meta}
+        tmp = d / f"state.json.tmp{os.getpid()}"
+        tmp.write_text(json.dumps(state, indent=1) + "\n")
+        os.replace(tmp, d / "state.json")
+        for f in d.iterdir():
+            if f.name.startswith("step") and not f.name.startswith(f"step{step:09d}-"):
+                f.unlink()
+    comm.barrier()
+
+
+def read_state(out: Path, comm) -> dict:
+    """The state.json of a results directory's last checkpoint (InputError when there is none)."""
+    path = Path(out) / "checkpoint" / "state.json"
+    if not path.exists():
+        raise InputError("--resume", f"{out} holds no checkpoint (checkpoint/state.json); the deformable "
+                                     "fidelities write one every run.checkpoint_interval of simulated time")
+    state = json.loads(path.read_text())
+    if state["ranks"] != comm.size:
+        raise InputError("--resume", f"the run in {out} ran on {state['ranks']} ranks; resume it on the same "
+                                     f"number (mpirun -n {state['ranks']}), not {comm.size}")
+    return state
+
+
+def read_arrays(out: Path, comm, state: dict, root_names: tuple[str, ...]) -> dict:
+    """This rank's arrays of the checkpoint that state.json names; ``root_names``, stored by rank 0 only,
+    are sent to every rank (absent ones are left out)."""
+    with np.load(Path(out) / "checkpoint" / f"step{state['step']:09d}-rank{comm.rank}.npz") as z:
+        arrays = {k: z[k] for k in z.files if k not in root_names}
+        root = {k: z[k] for k in root_names if k in z.files} if comm.rank == 0 else None
+    arrays.update(comm.bcast(root, root=0))
+    return arrays
+
+
+def drop(out: Path, comm) -> None:
+    """Remove the checkpoints of a completed run (rank 0)."""
+    if comm.rank == 0 and (Path(out) / "checkpoint").exists():
+        shutil.rmtree(Path(out) / "checkpoint")

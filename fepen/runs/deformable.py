@@ -1,0 +1,276 @@
+"""The deformable run (``effects.fidelity = "elastic"`` or ``"plastic"``): scene in, results directory out.
+
+The model comes from fepen.runs.setup, the stop rules from fepen.runs.events, the outputs are the objects
+of fepen.runs.outputs. Reported frame (docs/theory.md §7): x along the target face in the direction of
+travel, y depth into the target, both from the impact point, in mm.
+"""
+
+from __future__ import annotations
+
+import time
+
+import numpy as np
+from mpi4py import MPI
+
+from fepen.errors import BeyondMethod, InputError
+from fepen.geometry.frames import unit_axis
+from fepen.io import files, results
+from fepen.io.fields import FieldWriter
+from fepen.post import analyses, signals, slices
+from fepen.runs import checkpoint, events, outputs, setup
+
+#: steps between two checks of the stop rules in the target (each costs a few reductions)
+EVENT_EVERY = 20
+#: the longest a run without run.end_time may last (s)
+MAX_TIME = 5e-3
+
+
+class DeformableRun:
+    """One deformable run.
+
+    Args:
+        scene: resolved Scene.
+        out: results directory (created).
+        comm: MPI communicator.
+        progress: show a tqdm bar on rank 0.
+        resume: the state.json of a checkpoint in ``out`` to continue from, or None.
+    """
+
+    def __init__(self, scene, out, comm=MPI.COMM_WORLD, progress: bool = False, resume: dict | None = None):
+        self.scene, self.comm = scene, comm
+        self.wall_t0 = time.perf_counter()
+        self.model = setup.build(scene, comm)
+        self.out = files.prepare(out, comm)
+        m = self.model
+        self.pm, self.solver, self.load, self.contact = m.pm, m.solver, m.load, m.contact
+        self.gauges = analyses.Gauges(self.solver, self.pm)
+        self.sections = analyses.ChargeSections(self.solver, self.pm) if self.pm.charge else None
+        self.columns = (results.HISTORY_COLUMNS + (results.CHARGE_COLUMNS if self.pm.charge else [])
+                        + (results.INTERFACE_COLUMNS if self.contact is not None else []))
+        self.rows: list[list[float]] = []
+        self.end = scene.get("run.end_time")
+        self.rules = events.StopRules(m.law.thickness if m.law is not None else None, self.end is None)
+        self.peaks: dict | None = None
+        self.charge: dict | None = None
+        self.output_s = 0.0
+        self.wall_before = 0.0
+        sc = scene.run
+        self.history = outputs.History(min(sc.output_interval / 10.0, 1e-6))
+        self.fields_out = outputs.Fields(sc.output_interval) if sc.fields else None
+        self.checkpoints = outputs.Checkpoint(sc.checkpoint_interval, sc.checkpoint_interval)
+        self.fields = None
+        field_times = []
+        if resume is not None:
+            field_times = self.restore(resume)
+        if self.fields_out is not None:
+            self.fields = self._field_writer(field_times)
+        self.outputs = [o for o in (self.history, self.fields_out, self.checkpoints) if o is not None]
+        if progress and comm.rank == 0:
+            self.outputs.append(outputs.Progress(self.hard_end, self.solver.t))
+
+    @property
+    def hard_end(self) -> float:
+        return self.end if self.end is not None else MAX_TIME
+
+    # ------------------------------------------------------------------------------------------------
+    def run(self) -> dict:
+        """Advance to run.end_time or a stop event; write the outputs; return the summary."""
+        s = self.solver
+        t_loop = time.perf_counter()
+        outcome, completed = None, False
+        try:
+            while outcome is None and s.t < self.hard_end:
+                for o in self.outputs:
+                    if o.due(self):
+                        o.write(self)
+                s.step()
+                outcome = self.stop_rules()
+            self.record()  # the final state
+            if self.fields is not None:
+                self.write_fields()
+            completed = True
+        finally:
+            t_out = time.perf_counter()
+            for o in reversed(self.outputs):
+                o.close(self, completed)
+            if completed:
+                self.write_analyses()
+            self.output_s += time.perf_counter() - t_out
+        return self.write_summary(outcome or "ended", time.perf_counter() - t_loop)
+
+    def stop_rules(self) -> str | None:
+        """The outcome if a stop rule fires (fepen.runs.events), else None; BeyondMethod past the failure
+        strain. In the target the rules are checked every EVENT_EVERY steps, on the rigid wall every step."""
+        s, m = self.solver, self.model
+        if m.law is None:
+            return self.rules.rebound(s.t, self.load.contact_nodes)
+        if s.step_count % EVENT_EVERY:
+            return None
+        if events.beyond_method(s.max_peeq(), self.scene.projectile.failure_strain):
+            self._beyond_method()
+        pts = m.surface.kinematics(s.positions(), s.Vel)[0]
+        y_min = self.comm.allreduce(float(pts[:, 1].min()) if len(pts) else np.inf, op=MPI.MIN)
+        y_max = self.comm.allreduce(float(pts[:, 1].max()) if len(pts) else -np.inf, op=MPI.MAX)
+        if not (self.rules.entered or y_min < 0.0):
+            return None  # not in the target yet
+        x = s.positions()
+        axis = unit_axis(s.node_value(m.tip, x), s.node_value(m.tail, x))
+        return self.rules.penetration(y_min, y_max, s.momentum_velocity(), axis, s.total_mass, s.ke0)
+
+    def _beyond_method(self):
+        """Stop: the equivalent plastic strain passed projectile.failure_strain (where, when)."""
+        s = self.solver
+        peeq, where = s.max_peeq_where()
+        raise BeyondMethod(
+            f"the equivalent plastic strain reached {peeq:.3g} > projectile.failure_strain = "
+            f"{self.scene.projectile.failure_strain:g}, {where[1] * 1e3:.1f} mm behind the nose tip "
+            f"(radius {np.hypot(where[0], where[2]) * 1e3:.1f} mm), at t = {s.t * 1e6:.1f} us, step "
+            f"{s.step_count}: the projectile would fracture or erode, which projectile-target separation "
+            "does not model; no result is reported")
+
+    # ------------------------------------------------------------------------------------------------
+    def record(self) -> list[float]:
+        """Append one history row (and the gauges' and sections' rows); return the row."""
+        s, m = self.solver, self.model
+        x = s.positions()
+        e = s.energies()
+        en = dict(kinetic=e.kinetic, internal_work=e.internal_work, external_work=e.external_work,
+                  elastic=e.elastic, plastic=e.plastic, heat=e.heat, energy_error=e.balance_error)
+        tip, tail = s.node_value(m.tip, x), s.node_value(m.tail, x)
+        row = results.history_row(s.t, tip, tail, s.momentum_velocity(), self.load.force, s.total_mass, en,
+                                  self.load.contact_nodes, s.dt, s.max_peeq(), self.load.area)
+        if self.pm.charge:
+            row += list(s.body_accelerations(unit_axis(tip, tail)) / results.G0)
+            self.sections.record(tip, tail)
+        if self.contact is not None:
+            i = self.contact.summary()
+            row += [e.friction, i["gap_max_mm"], i["penetration_max_mm"], i["slip_max_mm"], i["free_fraction"],
+                    i["sliding_fraction"]]
+        results.finite_row(row, s.step_count, s.t)
+        self.rows.append(row)
+        self.gauges.record()
+        return row
+
+    def write_history(self) -> None:
+        results.write_history(self.rows, self.out, self.comm, self.columns)
+
+    def _field_writer(self, times) -> FieldWriter:
+        names = ["von_mises_Pa", "axial_stress_Pa"]  # fields of switched-off physics are not written
+        if self.scene.effects.fidelity == "plastic":
+            names.append("peeq")
+            if self.scene.effects.thermal:
+                names.append("temperature_K")
+        if self.pm.charge:
+            names.append("body")  # 1 shell, 2 charge: for ParaView's Threshold
+        scalars = ["interface_gap_m", "interface_slip_m"] if self.contact is not None else []
+        return FieldWriter(self.out, self.solver, ["displacement", "velocity"], names, times, scalars)
+
+    def write_fields(self) -> None:
+        s, m = self.solver, self.model
+        x = s.positions()
+        axis = unit_axis(s.node_value(m.tip, x), s.node_value(m.tail, x))
+        values = {"displacement": s.U, "velocity": s.Vel, "von_mises_Pa": s.von_mises(),
+                  "axial_stress_Pa": s.axial_stress(axis), "peeq": s.eps_p, "temperature_K": s.temp,
+                  "body": s.mat + 1.0}
+        if self.contact is not None:
+            values.update(self.contact.nodal_gap_and_slip())
+        self.fields.write(s.t, values)
+
+    def write_analyses(self) -> None:
+        """The closing analyses of a completed run: gauges and hazard map, charge sections, accelerations,
+        the charge's pictures, the deformed picture."""
+        self.gauges.write(self.out)
+        if self.sections is not None:
+            self.sections.write(self.out)
+        self.peaks = self._write_accelerations()
+        if self.pm.charge:
+            report = None
+            if self.comm.rank == 0:
+                report = slices.charge_report(self.out, self.sections.sections, self.peaks["charge_acc"]["t_s"])
+            self.charge = self.comm.bcast(report, root=0)
+        s = self.solver
+        analyses.deformed_picture(s, self.out / "deformed.png", f"t = {s.t * 1e6:.0f} us, max PEEQ {s.max_peeq():.3g}")
+
+    def _write_accelerations(self) -> dict:
+        """accelerations.csv: the target deceleration (and with a charge each body's axial acceleration),
+        raw and low-pass filtered (run.acceleration_filter_hz). Returns the peaks."""
+        rows = np.array(self.rows)
+        t = rows[:, 0]
+        names = ["decel_g"] + (results.CHARGE_COLUMNS if self.pm.charge else [])
+        cut = self.scene.run.acceleration_filter_hz
+        cols, header, peaks = [t], ["t_s"], {}
+        for name in names:
+            raw = rows[:, self.columns.index(name)]
+            filt = signals.lowpass(t, raw, cut)
+            cols += [raw, filt]
+            header += [name, name.replace("_g", "_filtered_g")]
+            k = int(np.argmax(np.abs(filt)))
+            depth = rows[k, self.columns.index("nose_y_mm")]
+            peaks[name.replace("_g", "")] = {"filtered_g": float(filt[k]), "t_s": float(t[k]),
+                                             "nose_depth_mm": float(depth),
+                                             "raw_peak_g": float(raw[np.argmax(np.abs(raw))])}
+        body = "\n".join(",".join(f"{v:.9g}" for v in r) for r in np.column_stack(cols))
+        files.write_text(self.out / "accelerations.csv", ",".join(header) + "\n" + body + "\n", self.comm)
+        return peaks
+
+    def write_summary(self, outcome: str, loop_s: float) -> dict:
+        s, m = self.solver, self.model
+        extra = {"steps": s.step_count, "dt_s": s.dt_min, "end_time_s": s.t,
+                 "wall_s": self.wall_before + time.perf_counter() - self.wall_t0,
+                 "time_split_s": {"mesh": m.mesh_s, "setup_jit": m.setup_s,
+                                  "time_loop": loop_s - self.output_s, "output": self.output_s},
+                 "mass_kg": s.total_mass, "cells": self.pm.mesh.topology.index_map(3).size_global,
+                 "ranks": self.comm.size, "stress_kernel": s.kernel, "step_gain": s.step_gain,
+                 "peak_memory_bytes": files.peak_memory_bytes(self.comm),
+                 "peak_accelerations": self.peaks, "charge": self.charge,
+                 "acceleration_filter_hz": self.scene.run.acceleration_filter_hz}
+        summary = results.summary(self.scene, self.rows, outcome, extra)
+        files.write_json(self.out / "summary.json", summary, self.comm)
+        return summary
+
+    # ------------------------------------------------------------------------------------------------
+    #: arrays held by rank 0 only in a checkpoint: the run's tables and the load's last state
+    ROOT_ARRAYS = ("rows", "gauge_rows", "section_rows", "load")
+
+    def write_checkpoint(self) -> None:
+        """A checkpoint of the state between two steps (collective)."""
+        s = self.solver
+        arrays = dict(s.state())
+        if self.comm.rank == 0:
+            arrays["rows"] = np.array(self.rows, dtype=float)
+            arrays["gauge_rows"] = np.array(self.gauges.rows, dtype=float)
+            if self.sections is not None:
+                arrays["section_rows"] = np.array(self.sections.rows, dtype=float)
+            arrays["load"] = np.array([*self.load.force, self.load.contact_nodes, self.load.area])
+        loop = {"next_hist": self.history.clock.next,
+                "next_out": self.fields_out.clock.next if self.fields_out is not None else 0.0,
+                "next_ckpt": self.checkpoints.clock.next, **self.rules.state()}
+        meta = {"wall_s": self.wall_before + time.perf_counter() - self.wall_t0, "loop": loop,
+                "field_times_s": list(self.fields.times) if self.fields is not None else []}
+        checkpoint.write(self.out, self.comm, s.step_count, s.t, arrays, meta)
+
+    def restore(self, state: dict) -> list[float]:
+        """Put a checkpoint back into this freshly built run (collective). Returns the field output times."""
+        z = checkpoint.read_arrays(self.out, self.comm, state, self.ROOT_ARRAYS)
+        same = z["X"].shape == self.solver.X.shape and np.array_equal(z["X"], self.solver.X)
+        if not self.comm.allreduce(same, op=MPI.LAND):
+            raise InputError("--resume", "the mesh rebuilt from scene.toml differs from the checkpointed one "
+                                         "(another fepen or gmsh version, or another partition)")
+        self.solver.restore(z)
+        self.rows = [list(r) for r in z["rows"]]
+        self.gauges.rows = [list(r) for r in z["gauge_rows"]]
+        if self.sections is not None and "section_rows" in z:
+            self.sections.rows = [list(r) for r in z["section_rows"]]
+        load = z["load"]
+        self.load.force, self.load.contact_nodes, self.load.area = np.array(load[:3]), int(load[3]), float(load[4])
+        loop = state["loop"]
+        self.history.clock.next = loop["next_hist"]
+        if self.fields_out is not None:
+            self.fields_out.clock.next = loop["next_out"]
+        self.checkpoints.clock.next = loop["next_ckpt"]
+        self.rules.restore(loop)
+        self.wall_before = float(state["wall_s"])
+        return state["field_times_s"]
+
+    def drop_checkpoints(self) -> None:
+        checkpoint.drop(self.out, self.comm)

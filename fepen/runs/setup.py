@@ -1,0 +1,205 @@
+"""The one door from a scene to the physics: every law, shape, mesh and solver a run needs, built from a
+resolved Scene. No module below fepen.runs reads a scene (docs/theory.md §1-§10 give the defaults'
+reasons).
+"""
+
+from __future__ import annotations
+
+import math
+import time
+from dataclasses import dataclass
+
+import numpy as np
+from mpi4py import MPI
+
+from fepen.errors import InputError
+from fepen.geometry import gmsh_model, tags, tetra
+from fepen.geometry import mesh as fmesh
+from fepen.geometry.shape import Shape
+from fepen.laws import materials as M
+from fepen.laws import target as tg
+from fepen.solver import explicit, rigid_wall, shell_charge, surface, target_load
+
+
+# ---------------------------------------------------------------------------------------------------------
+# laws and shape from the scene
+# ---------------------------------------------------------------------------------------------------------
+def projectile_material(scene) -> M.Material:
+    """The projectile material: elastic or Johnson-Cook by effects.fidelity."""
+    m = scene.projectile.material
+    if scene.effects.fidelity == "elastic":
+        return M.elastic(m.youngs_modulus, m.poisson_ratio, m.density)
+    return M.johnson_cook(m.youngs_modulus, m.poisson_ratio, m.density, m.A, m.B, m.n, m.C, m.m,
+                          m.melt_temperature, m.room_temperature, m.reference_strain_rate, m.specific_heat,
+                          m.taylor_quinney, scene.effects.strain_rate, scene.effects.thermal)
+
+
+def charge_material(scene) -> M.Material:
+    """The explosive charge material (bilinear, docs/charge.md)."""
+    c = scene.charge.material
+    return M.bilinear(c.youngs_modulus, c.poisson_ratio, c.density, c.yield_stress, c.tangent_modulus)
+
+
+def target_law(scene) -> tg.TargetLaw:
+    """The concrete target law (docs/theory.md §8)."""
+    t, e = scene.target, scene.effects
+    Y, E, T, lam = t.compressive_strength, t.youngs_modulus, t.tensile_strength, t.pressure_hardening
+    given = scene.get("target.quasi_static_stress")
+    sigma_s = given if given is not None else float(tg.quasi_static_stress(Y, E, T, lam))
+    return tg.TargetLaw(
+        density=t.density, Y=Y, E=E, T=T, lam=lam, sigma_s=sigma_s, B=t.inertial_factor,
+        thickness=scene.get("target.thickness"), crater=e.crater, k=t.crater_depth_factor,
+        D=scene.projectile.diameter, separation=e.separation, phi_min=math.radians(t.separation_angle_deg),
+        free_surface=e.free_surface, friction=e.friction, mu=t.friction,
+        lock_density=t.lock_density, crush_strain=1.0 - t.density / t.lock_density,
+        c_over_a=tg.cavity_ratio(Y, E, T), given_sigma_s=given is not None,
+        onset=math.radians(t.onset_angle_deg))
+
+
+def projectile_shape(scene) -> Shape:
+    """The checked exact geometry (cavity sized from projectile.mass if given); InputError if impossible."""
+    p = scene.projectile
+    solid = p.cavity_diameter == 0.0
+    shape = Shape(
+        diameter=p.diameter, length=p.length, nose=p.nose, crh=p.crh,
+        cavity_diameter=p.cavity_diameter,
+        cavity_length=0.0 if solid else (scene.get("projectile.cavity_length") or 0.0),
+        step_diameter=0.0 if solid else p.cavity_step_diameter,
+        step_length=0.0 if solid else p.cavity_step_length,
+        base_thickness=p.base_thickness,
+    )
+    shape.check()
+    mass = scene.get("projectile.mass")
+    if mass is not None and not solid:
+        rho_c = scene.charge.material.density if scene.effects.charge else None
+        shape = shape.with_mass(mass, p.material.density, rho_c)
+    return shape
+
+
+def placement(scene) -> tuple[np.ndarray, np.ndarray]:
+    """Rotation (3x3) of the body about the nose tip and its velocity (3,) at impact (docs/theory.md §7):
+    θ = α + ϑ about +z, velocity v0 (sin α, −cos α, 0)."""
+    a = math.radians(scene.impact.obliquity_deg)
+    th = a + math.radians(scene.impact.attack_deg)
+    R = np.array([[math.cos(th), -math.sin(th), 0.0], [math.sin(th), math.cos(th), 0.0], [0.0, 0.0, 1.0]])
+    v = scene.impact.velocity * np.array([math.sin(a), -math.cos(a), 0.0])
+    return R, v
+
+
+def check_supported(scene) -> None:
+    """Raise InputError for settings this version cannot simulate, before anything is meshed."""
+    projectile_shape(scene)
+    if scene.effects.fidelity == "rigid" and scene.target.kind != "concrete":
+        raise InputError("effects.fidelity", "'rigid' runs against target.kind = 'concrete'; a rigid "
+                                             "projectile on a rigid wall has nothing to compute")
+
+
+def crater(scene, law: tg.TargetLaw, mass: float, v0: float) -> tg.ForrestalCrater | None:
+    """Forrestal's linear crater when effects.crater = "linear", else None (the energy crater is in the law)."""
+    return tg.ForrestalCrater(law, mass, v0, scene.projectile.crh) if law.crater == "linear" else None
+
+
+# ---------------------------------------------------------------------------------------------------------
+# the mesh
+# ---------------------------------------------------------------------------------------------------------
+def mesh(scene, comm: MPI.Comm = MPI.COMM_WORLD, use_cache: bool = True,
+         split: bool | None = None) -> fmesh.ProjectileMesh:
+    """The distributed projectile mesh of a scene.
+
+    Args:
+        split: give the charge its own wall nodes; default: a deformable charge in frictional contact.
+    """
+    shape = projectile_shape(scene)  # InputError on impossible geometry, on every rank
+    charge = bool(scene.effects.charge)
+    if split is None:
+        split = charge and scene.charge.contact == "frictional" and scene.effects.fidelity != "rigid"
+    opts = gmsh_model.MeshOptions(scene.mesh.size, scene.get("mesh.nose_size"), scene.mesh.optimize)
+    return fmesh.create(shape, opts, comm, charge=charge, mass=scene.get("projectile.mass"),
+                        shell_density=scene.projectile.material.density,
+                        charge_density=scene.charge.material.density, split=split, use_cache=use_cache)
+
+
+def densities(scene) -> dict[int, float]:
+    """Density (kg/m^3) per volume tag."""
+    return {tags.SHELL: scene.projectile.material.density, tags.CHARGE: scene.charge.material.density}
+
+
+def mesh_metrics(pm: fmesh.ProjectileMesh, scene) -> dict:
+    """The figures of mesh.json for a scene's mesh (fepen.geometry.mesh.metrics)."""
+    p, c = scene.projectile.material, scene.charge.material
+    speed = {tags.SHELL: tetra.dilatational_speed(p.youngs_modulus, p.poisson_ratio, p.density),
+             tags.CHARGE: tetra.dilatational_speed(c.youngs_modulus, c.poisson_ratio, c.density)}
+    return fmesh.metrics(pm, densities(scene), speed, scene.run.safety_factor, scene.mesh.size)
+
+
+# ---------------------------------------------------------------------------------------------------------
+# the deformable model
+# ---------------------------------------------------------------------------------------------------------
+@dataclass
+class Model:
+    """What a deformable run advances.
+
+    Attributes:
+        pm: the projectile mesh. solver: the ExplicitSolver, at its initial state.
+        load: the target (TargetLoad) or the rigid wall (RigidWall), hooked in as ``solver.external``.
+        contact: the shell-charge contact (hooked in as ``solver.interface``), or None.
+        tip, tail: node handles of the nose tip and the tail centre (ExplicitSolver.node_at).
+        v0: striking speed (m/s). surface: the target's load points (None on the rigid wall).
+        law: the target law (None on the rigid wall). mesh_s, setup_s: wall seconds meshing and building.
+    """
+
+    pm: fmesh.ProjectileMesh
+    solver: explicit.ExplicitSolver
+    load: explicit.Load
+    contact: shell_charge.ShellChargeContact | None
+    tip: tuple[int, int]
+    tail: tuple[int, int]
+    v0: float
+    surface: surface.Surface | None
+    law: tg.TargetLaw | None
+    mesh_s: float
+    setup_s: float
+
+
+def solver(scene, pm: fmesh.ProjectileMesh, kernel: str | None = None) -> explicit.ExplicitSolver:
+    """The explicit solver on a scene's mesh: the shell's material, and the charge's on its cells.
+
+    Args:
+        kernel: "C", "numba" or None (the C trial pass where it can be built).
+    """
+    mats = [projectile_material(scene)]
+    cellmat = np.zeros(pm.mesh.topology.index_map(3).size_local, dtype=np.int64)
+    if pm.charge:  # material 1: the charge, tied through shared wall nodes or in contact (split)
+        mats.append(charge_material(scene))
+        cellmat[fmesh.owned_cells_tagged(pm, tags.CHARGE)] = 1
+    s = explicit.ExplicitSolver(pm.mesh, mats, cellmat, scene.run.safety_factor, kernel=kernel)
+    if scene.run.stable_step == "eigenvalue":
+        s.calibrate_step()
+    return s
+
+
+def build(scene, comm: MPI.Comm = MPI.COMM_WORLD) -> Model:
+    """Mesh, solver, target or wall, contact and initial state of a deformable run."""
+    t0 = time.perf_counter()
+    pm = mesh(scene, comm)
+    mesh_s = time.perf_counter() - t0
+    t0 = time.perf_counter()
+    s = solver(scene, pm)
+    contact = None
+    if pm.split:
+        contact = shell_charge.ShellChargeContact(s, pm.facet_tags, scene.charge.friction)
+        s.interface = contact
+    tip = s.node_at((0.0, 0.0, 0.0))
+    tail = s.node_at((0.0, pm.shape.length, 0.0))
+    R, v = placement(scene)
+    v0 = float(np.linalg.norm(v))
+    surf = law = None
+    if scene.target.kind == "concrete":
+        law = target_law(scene)
+        surf = surface.outer_surface(s.V, pm.facet_tags, pm.shape)
+        load = target_load.TargetLoad(s, surf, law, tip, tail, crater(scene, law, s.total_mass, v0))
+    else:
+        load = rigid_wall.RigidWall(s)
+    s.external = load
+    s.set_initial(displacement=lambda X: X @ R.T - X, velocity=lambda X: np.tile(v, (len(X), 1)))
+    return Model(pm, s, load, contact, tip, tail, v0, surf, law, mesh_s, time.perf_counter() - t0)

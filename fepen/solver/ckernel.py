@@ -1,0 +1,124 @@
+"""The C trial pass of the stress update (fepen/solver/cell_kernel.c), built once per machine and called
+with ctypes; the numba kernel (fepen.solver.kernels.stress_update) stays the reference (docs/theory.md §3.3)."""
+
+from __future__ import annotations
+
+import ctypes
+import hashlib
+import os
+import subprocess
+import tempfile
+from pathlib import Path
+
+import numpy as np
+
+SOURCE = Path(__file__).with_name("cell_kernel.c")
+FLAGS = ["-O3", "-march=native", "-fopenmp-simd", "-fPIC", "-shared"]
+
+_lib = None
+_why_not = None
+
+
+def _cpu_flags() -> str:
+    try:
+        for line in Path("/proc/cpuinfo").read_text().splitlines():
+            if line.startswith("flags"):
+                return line
+    except OSError:
+        pass
+    return os.uname().machine
+
+
+def cache_dir() -> Path:
+    """Where the built kernel is kept."""
+    env = os.environ.get("FEPEN_KERNEL_CACHE")
+    if env:
+        return Path(env)
+    base = os.environ.get("XDG_CACHE_HOME") or str(Path.home() / ".cache")
+    return Path(base) / "fepen"
+
+
+def _build(cc: str) -> Path:
+    version = subprocess.run([cc, "--version"], capture_output=True, text=True, check=True).stdout
+    src = SOURCE.read_bytes()
+    key = hashlib.sha256(src + " ".join(FLAGS).encode() + version.encode() + _cpu_flags().encode())
+    out = cache_dir() / f"cell_kernel-{key.hexdigest()[:16]}.so"
+    if out.exists():
+        return out
+    out.parent.mkdir(parents=True, exist_ok=True)
+    fd, tmp = tempfile.mkstemp(suffix=".so", dir=out.parent)
+    os.close(fd)
+    try:
+        subprocess.run([cc, *FLAGS, str(SOURCE), "-o", tmp], capture_output=True, text=True, check=True)
+        os.replace(tmp, out)
+    finally:
+        if os.path.exists(tmp):
+            os.unlink(tmp)
+    return out
+
+
+def library():
+    """The loaded C kernel, or None (then ``why_not()`` says why) — built on first use."""
+    global _lib, _why_not
+    if _lib is not None or _why_not is not None:
+        return _lib
+    if os.environ.get("FEPEN_KERNEL", "").lower() == "numba":
+        _why_not = "FEPEN_KERNEL=numba"
+        return None
+    try:
+        lib = ctypes.CDLL(str(_build(os.environ.get("CC", "cc"))))
+    except (OSError, subprocess.CalledProcessError) as err:
+        detail = getattr(err, "stderr", "") or str(err)
+        _why_not = f"C kernel not built ({detail.strip().splitlines()[-1] if detail.strip() else err})"
+        return None
+    vp, i32, dbl = ctypes.c_void_p, ctypes.c_int32, ctypes.c_double
+    lib.trial_pass.argtypes = [i32, vp, vp, vp, dbl, vp, vp, vp, vp, vp, i32, vp, vp, vp, vp]
+    lib.trial_pass.restype = i32
+    _lib = lib
+    return lib
+
+
+def why_not() -> str | None:
+    """Why the C kernel is not used (None when it is)."""
+    library()
+    return _why_not
+
+
+class TrialPass:
+    """The C trial pass bound to a solver's arrays (their addresses are taken once: the arrays must live
+    as long as this object and never be reallocated).
+
+    Args:
+        x, v, X: current positions, velocities and reference positions of the nodes (n_nodes, 3),
+            C-contiguous float64.
+        dofs: (n_cells, 4) node indices; mat: (n_cells,) material index.
+        det_R: (n_cells,) det of the reference edge matrix (X1 − X0, X2 − X0, X3 − X0) = ±6 V0.
+        G_m: shear modulus per material (Pa); nodal_p: (n_nodes, n_materials) nodal mean stress.
+        sT: (6, n_cells) deviatoric stress, component-major (updated in place).
+        sy0: (n_cells,) static flow stress. P_out: (≥ n_cells, 9) the packed coefficient of the form.
+    """
+
+    def __init__(self, x, v, X, dofs, mat, det_R, G_m, nodal_p, sT, sy0, P_out):
+        lib = library()
+        if lib is None:
+            raise RuntimeError(why_not())
+        n = len(mat)
+        self.n = n
+        self._dofs = np.ascontiguousarray(dofs, dtype=np.int32)
+        self._mat = np.ascontiguousarray(mat, dtype=np.int32)
+        self._inv_det = 1.0 / np.asarray(det_R, dtype=float)
+        self.yielding = np.zeros(n, dtype=np.int32)
+        for a in (x, v, X, G_m, nodal_p, sT, sy0, P_out):
+            assert a.dtype == np.float64 and a.flags.c_contiguous
+        assert sT.shape == (6, n) and P_out.shape[1] == 9 and x.shape == X.shape == v.shape
+        self._keep = (x, v, X, G_m, nodal_p, sT, sy0, P_out)
+        addr = lambda a: a.ctypes.data  # noqa: E731
+        self._head = (n, addr(x), addr(v), addr(X))
+        self._tail = (addr(self._dofs), addr(self._inv_det), addr(self._mat), addr(G_m), addr(nodal_p),
+                      nodal_p.shape[1], addr(sT), addr(sy0), addr(P_out), addr(self.yielding))
+        self._lib = lib
+
+    def __call__(self, dt: float) -> np.ndarray:
+        """Trial state of every cell over a step dt; returns the cells over their flow stress."""
+        k = self._lib.trial_pass(*self._head, dt, *self._tail)
+        return self.yielding[:k]

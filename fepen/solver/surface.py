@@ -1,0 +1,202 @@
+"""The loaded surface: each OUTER facet one load point on the exact projectile surface, with its exact
+normal turned with the facet and its curved patch's area stretched with it (docs/theory.md §10).
+"""
+
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass
+
+import numba
+import numpy as np
+from mpi4py import MPI
+
+from fepen.geometry import tags
+
+SUBDIVISION = 4  # facet patch areas: 4 x 4 sub-triangles projected on the exact surface
+
+
+@numba.njit(cache=True, error_model="numpy")
+def _facet_kinematics(x_all, v_all, tri, n_flat0, N0, area0, flat0, x, v, area, n):
+    """Surface.kinematics in one compiled loop (the numpy version was a third of a penetration step):
+    centroid, mean velocity, stretched exact area, and the exact normal N0 turned by the smallest rotation
+    taking the flat reference normal a to the current one b (Rodrigues without angles):
+    R v = (a·b) v + (a×b)×v + ((a×b)·v)(a×b)/(1 + a·b)."""
+    for i in range(tri.shape[0]):
+        i0, i1, i2 = tri[i, 0], tri[i, 1], tri[i, 2]
+        ax, ay, az = x_all[i1, 0] - x_all[i0, 0], x_all[i1, 1] - x_all[i0, 1], x_all[i1, 2] - x_all[i0, 2]
+        bx, by, bz = x_all[i2, 0] - x_all[i0, 0], x_all[i2, 1] - x_all[i0, 1], x_all[i2, 2] - x_all[i0, 2]
+        cx, cy, cz = 0.5 * (ay * bz - az * by), 0.5 * (az * bx - ax * bz), 0.5 * (ax * by - ay * bx)
+        a = math.sqrt(cx * cx + cy * cy + cz * cz)
+        bx, by, bz = cx / a, cy / a, cz / a  # current unit normal of the flat facet
+        px, py, pz = n_flat0[i, 0], n_flat0[i, 1], n_flat0[i, 2]
+        c = px * bx + py * by + pz * bz
+        kx, ky, kz = py * bz - pz * by, pz * bx - px * bz, px * by - py * bx
+        vx, vy, vz = N0[i, 0], N0[i, 1], N0[i, 2]
+        kv = (kx * vx + ky * vy + kz * vz) / max(1.0 + c, 1e-12)
+        n[i, 0] = c * vx + (ky * vz - kz * vy) + kv * kx
+        n[i, 1] = c * vy + (kz * vx - kx * vz) + kv * ky
+        n[i, 2] = c * vz + (kx * vy - ky * vx) + kv * kz
+        area[i] = area0[i] * (a / flat0[i])
+        for k in range(3):
+            x[i, k] = (x_all[i0, k] + x_all[i1, k] + x_all[i2, k]) / 3.0
+            v[i, k] = (v_all[i0, k] + v_all[i1, k] + v_all[i2, k]) / 3.0
+
+
+@numba.njit(cache=True)
+def _to_nodes(tri, f, out):
+    """out[tri[i, j]] += f[i] / 3 for each facet i and corner j, in facet order."""
+    for j in range(3):
+        for i in range(tri.shape[0]):
+            for k in range(3):
+                out[tri[i, j], k] += f[i, k] / 3.0
+
+
+def area_vectors(x: np.ndarray, tri: np.ndarray) -> np.ndarray:
+    """Area vectors ½ (x1 − x0) × (x2 − x0) of triangles (f, 3) of node indices into x."""
+    p0 = x[tri[:, 0]]
+    return 0.5 * np.cross(x[tri[:, 1]] - p0, x[tri[:, 2]] - p0)
+
+
+def _patch_areas(shape, p: np.ndarray, patch: np.ndarray, m: int = SUBDIVISION) -> np.ndarray:
+    """Areas of the exact-surface patches spanned by flat triangles p (f, 3, 3)."""
+    pts, tris = [], []
+    index = {}
+    for i in range(m + 1):
+        for j in range(m + 1 - i):
+            index[(i, j)] = len(pts)
+            pts.append((i / m, j / m))
+    for i in range(m):
+        for j in range(m - i):
+            tris.append((index[(i, j)], index[(i + 1, j)], index[(i, j + 1)]))
+            if i + j < m - 1:
+                tris.append((index[(i + 1, j)], index[(i + 1, j + 1)], index[(i, j + 1)]))
+    lam = np.array([[1 - u - v, u, v] for u, v in pts])
+    q = np.einsum("sk,fkd->fsd", lam, p)  # (f, s, 3)
+    nf, ns = q.shape[:2]
+    qp = shape.project(q.reshape(-1, 3), np.repeat(patch, ns)).reshape(nf, ns, 3)
+    t = np.array(tris)
+    a = qp[:, t[:, 0]]
+    return 0.5 * np.linalg.norm(np.cross(qp[:, t[:, 1]] - a, qp[:, t[:, 2]] - a), axis=2).sum(axis=1)
+
+
+@dataclass
+class Surface:
+    """Facet load points of the outer surface owned by this rank.
+
+    Attributes:
+        tri: facet node (block) indices (f, 3), ordered so that their area vector points outward.
+        X: reference load points on the exact surface (f, 3).
+        area0: exact patch areas (f,). flat0: flat reference facet areas (f,).
+        N0: exact reference normals at the load points (f, 3). n_flat0: flat reference facet normals (f, 3).
+        radius, R_meridian, sin_phi0: shape data for the law (f,).
+    """
+
+    tri: np.ndarray
+    X: np.ndarray
+    area0: np.ndarray
+    flat0: np.ndarray
+    N0: np.ndarray
+    n_flat0: np.ndarray
+    radius: np.ndarray
+    R_meridian: np.ndarray
+    sin_phi0: np.ndarray
+
+    def kinematics(self, x_all: np.ndarray, v_all: np.ndarray):
+        """Current load-point positions, velocities, areas and unit normals.
+
+        Args:
+            x_all, v_all: current positions and velocities of all local nodes (ghosts included).
+
+        Returns:
+            (x (f, 3), v (f, 3), area (f,), n (f, 3)).
+        """
+        f = len(self.tri)
+        x, v, n, area = np.empty((f, 3)), np.empty((f, 3)), np.empty((f, 3)), np.empty(f)
+        _facet_kinematics(x_all, v_all, self.tri, self.n_flat0, self.N0, self.area0, self.flat0, x, v, area, n)
+        return x, v, area, n
+
+    def to_nodes(self, f: np.ndarray, out: np.ndarray) -> None:
+        """Add the load points' forces (f, 3) to their nodes, one third each, into out (n_nodes, 3)."""
+        _to_nodes(self.tri, f, out)
+
+
+def oriented_facets(V, facet_tags, tag: int) -> np.ndarray:
+    """The owned facets carrying ``tag``, as node triples (block indices of V) ordered so that their area
+    vectors point out of the cell they bound.
+
+    Args:
+        V: the P1 vector function space of the solver (its block indices are the nodes).
+        facet_tags: the mesh's facet MeshTags.
+        tag: the facet tag.
+
+    Returns:
+        (n_facets, 3) int64 node indices.
+    """
+    mesh = V.mesh
+    tdim = mesh.topology.dim
+    for a, b in ((tdim - 1, tdim), (tdim - 1, 0), (tdim, 0)):
+        mesh.topology.create_connectivity(a, b)
+    f2c = mesh.topology.connectivity(tdim - 1, tdim)
+    f2v = mesh.topology.connectivity(tdim - 1, 0)
+    c2v = mesh.topology.connectivity(tdim, 0).array.reshape(-1, 4)
+    cdofs = V.dofmap.list.array.reshape(-1, 4)
+    v2d = np.full(c2v.max() + 1, -1, dtype=np.int64)
+    v2d[c2v.ravel()] = cdofs.ravel()
+    imap = V.dofmap.index_map
+    X = V.tabulate_dof_coordinates()[: imap.size_local + imap.num_ghosts]
+    facets = facet_tags.find(tag)
+    facets = facets[facets < mesh.topology.index_map(tdim - 1).size_local]
+    tri = np.array([v2d[f2v.links(f)] for f in facets], dtype=np.int64).reshape(-1, 3)
+    for i, f in enumerate(facets):  # order each facet so that its area vector points outward
+        cell = f2c.links(f)[0]
+        opp = [d for d in cdofs[cell] if d not in tri[i]][0]
+        p = X[tri[i]]
+        if np.dot(np.cross(p[1] - p[0], p[2] - p[0]), p.mean(axis=0) - X[opp]) < 0:
+            tri[i, [1, 2]] = tri[i, [2, 1]]
+    return tri
+
+
+def outer_surface(V, facet_tags, shape, tag: int = tags.OUTER) -> Surface:
+    """The facet load points of the owned facets carrying ``tag``.
+
+    Args:
+        V: the P1 vector function space of the solver (its block indices are the nodes).
+        facet_tags: the mesh's facet MeshTags.
+        shape: the exact fepen.shape.Shape the mesh was built from (body frame = reference frame).
+    """
+    imap = V.dofmap.index_map
+    X = V.tabulate_dof_coordinates()[: imap.size_local + imap.num_ghosts]
+    tri = oriented_facets(V, facet_tags, tag)
+    av = area_vectors(X, tri)
+    flat = np.linalg.norm(av, axis=1)
+    nflat = av / np.maximum(flat, 1e-300)[:, None]
+    centroid = X[tri].mean(axis=1)
+    tol = 1e-6 * shape.length
+    patch = np.zeros(len(tri), dtype=np.int64)
+    patch[(nflat[:, 1] > 0.99) & (np.abs(centroid[:, 1] - shape.length) < tol)] = 1
+    patch[(nflat[:, 1] < -0.99) & (np.abs(centroid[:, 1]) < tol) & (shape.nose_length == 0.0)] = 2
+    P = shape.project(centroid, patch)
+    N, radius, Rm, sphi = shape.surface_info(P)
+    bad = np.isnan(N[:, 0])  # should not happen for centroids; fall back to the flat normal
+    N[bad] = nflat[bad]
+    area = _patch_areas(shape, X[tri], patch) if len(tri) else np.zeros(0)
+    return Surface(tri, P, area, flat, N, nflat, radius, Rm, sphi)
+
+
+def gather_global(surface: Surface, comm: MPI.Comm) -> dict:
+    """Every rank's load points in one deterministic order, on every rank (for the rigid body).
+
+    Points are ordered by reference position (dolfinx's global numbering depends on the partition;
+    positions do not), so every rank count gives bitwise the same arrays.
+
+    Returns:
+        dict of arrays X, area0, N, radius, R_meridian, sin_phi0.
+    """
+    local = dict(X=surface.X, area0=surface.area0, N=surface.N0, radius=surface.radius,
+                 R_meridian=surface.R_meridian, sin_phi0=surface.sin_phi0)
+    parts = comm.allgather(local)
+    out = {k: np.concatenate([p[k] for p in parts]) for k in local}
+    X = out["X"]
+    order = np.lexsort((X[:, 2], X[:, 1], X[:, 0]))
+    return {k: v[order] for k, v in out.items()}

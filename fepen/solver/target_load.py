@@ -1,0 +1,52 @@
+"""The concrete target acting on the deformable projectile: the nodal external force of each step
+(docs/theory.md §10).
+
+Each step: the load points of the deformed surface (fepen.solver.surface) → the target law on them
+(fepen.laws.target.load_on_points) → forces shared to the facets' nodes, summed across ranks, added to
+the owned nodes' external force.
+"""
+
+from __future__ import annotations
+
+import numpy as np
+from dolfinx import la
+from mpi4py import MPI
+
+from fepen.geometry.frames import unit_axis
+from fepen.laws import target as tg
+from fepen.solver.surface import Surface
+
+
+class TargetLoad:
+    """External force of the concrete target on an ExplicitSolver (an explicit.Load).
+
+    Args:
+        solver: the ExplicitSolver.
+        surf: its Surface (owned outer facets).
+        law: the TargetLaw.
+        tip, tail: (owner, local) node handles of the nose tip and tail centre (ExplicitSolver.node_at).
+        crater: a ForrestalCrater for the linear crater, else None.
+    """
+
+    def __init__(self, solver, surf: Surface, law: tg.TargetLaw, tip, tail, crater=None):
+        self.surf, self.law, self.tip, self.tail, self.crater = surf, law, tip, tail, crater
+        self.buf = la.vector(solver.V.dofmap.index_map, bs=3)
+        self.force = np.zeros(3)
+        self.contact_nodes = 0
+        self.area = 0.0
+
+    def __call__(self, solver) -> None:
+        x_all = solver.positions()
+        tip = solver.node_value(self.tip, x_all)
+        axis = unit_axis(tip, solver.node_value(self.tail, x_all))
+        x, v, area, n = self.surf.kinematics(x_all, solver.Vel)
+        s = self.surf
+        load = tg.load_on_points(self.law, x, v, n, area, s.radius, s.R_meridian, s.sin_phi0, axis, self.crater,
+                                 -tip[1], lambda a: solver.comm.allreduce(a, op=MPI.SUM))
+        arr = self.buf.array.reshape(-1, 3)
+        arr[:] = 0.0
+        self.surf.to_nodes(load.force, arr)
+        self.buf.scatter_reverse(la.ScatterMode.add)
+        n_own = solver.n_owned
+        solver.fext[:n_own] += arr[:n_own]
+        self.force, self.contact_nodes, self.area = load.total, load.loaded, load.area

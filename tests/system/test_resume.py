@@ -1,0 +1,108 @@
+"""Interruption: a run killed midway (SIGKILL) leaves valid files, and ``fepen run --resume`` ends with the
+very results of an uninterrupted run; serially and on 2 ranks (the runs are subprocesses)."""
+
+import json
+import os
+import signal
+import subprocess
+import sys
+import time
+import xml.etree.ElementTree as ET
+
+import numpy as np
+import pytest
+from conftest import ROOT, run_fepen
+
+SETS = ["--set", "mesh.size=0.004", "--set", "run.end_time=1.2e-4", "--set", "run.output_interval=1e-5",
+        "--set", "run.checkpoint_interval=1.5e-5", "--set", 'impact.shot="C7"']
+
+
+#: the charged projectile, its charge sliding in frictional contact (the interface's work and the
+#: contact accelerations must be restored too)
+CHARGED = ["--set", "effects.charge=true", "--set", 'charge.contact="frictional"']
+
+
+def start(out, ranks, extra=()):
+    cmd = [sys.executable, "-m", "fepen", "run", *SETS, *extra, "--out", str(out)]
+    if ranks > 1:
+        cmd = ["mpirun", "-n", str(ranks), *cmd]
+    env = dict(os.environ, OMPI_ALLOW_RUN_AS_ROOT="1", OMPI_ALLOW_RUN_AS_ROOT_CONFIRM="1",
+               OMPI_MCA_rmaps_base_oversubscribe="1", PYTHONPATH=str(ROOT))
+    return subprocess.Popen(cmd, cwd=ROOT, env=env, start_new_session=True, stdout=subprocess.DEVNULL,
+                            stderr=subprocess.PIPE, text=True)
+
+
+def kill_after_checkpoints(proc, out, n=2, timeout=300):
+    """SIGKILL the whole process group once the n-th checkpoint is complete; returns its time."""
+    state = out / "checkpoint" / "state.json"
+    t0 = time.time()
+    seen = set()
+    while time.time() - t0 < timeout:
+        if state.exists():
+            try:
+                seen.add(json.loads(state.read_text())["step"])
+            except (json.JSONDecodeError, OSError):  # being replaced: read it again
+                pass
+        if len(seen) >= n:
+            break
+        assert proc.poll() is None, f"the run ended before it could be killed: {proc.stderr.read()}"
+        time.sleep(0.01)
+    time.sleep(0.05)
+    os.killpg(proc.pid, signal.SIGKILL)
+    proc.wait()
+    return json.loads(state.read_text())["t_s"]
+
+
+def check_valid_fields(out):
+    """fields.xdmf parses and every dataset it names reads from fields.h5 with the right shape."""
+    import h5py
+
+    root = ET.parse(out / "fields.xdmf").getroot()
+    items = [d for d in root.iter("DataItem")]
+    assert len(items) > 2
+    with h5py.File(out / "fields.h5", "r") as h5:
+        for d in items:
+            path = d.text.strip().split(":", 1)[1]
+            dims = tuple(int(v) for v in d.get("Dimensions").split())
+            data = h5[path][()]
+            assert data.reshape(dims).shape == dims and np.all(np.isfinite(data))
+    return sum(1 for g in root.iter("Grid") if g.get("Name") == "displacement" and g.get("GridType") == "Uniform")
+
+
+@pytest.mark.parametrize("ranks,extra", [(1, []), (2, []), (2, CHARGED)], ids=["1", "2", "2-charged"])
+def test_killed_run_resumes_to_the_same_results(tmp_path, ranks, extra):
+    whole, cut = tmp_path / "whole", tmp_path / "cut"
+    done = run_fepen("run", *SETS, *extra, "--out", whole, ranks=ranks)
+    assert done.returncode == 0, done.stderr
+    proc = start(cut, ranks, extra)
+    t_ckpt = kill_after_checkpoints(proc, cut)
+    # what the killed run left is valid up to its last output time
+    n_out = check_valid_fields(cut)
+    assert n_out >= 2
+    hist = np.genfromtxt(cut / "history.csv", delimiter=",", names=True)
+    assert hist["t_s"][-1] >= t_ckpt - 1e-6 and np.all(np.isfinite(hist["nose_y_mm"]))
+    assert not (cut / "summary.json").exists()
+    if ranks == 2:  # resuming on another rank count is refused, cleanly
+        wrong = run_fepen("run", "--resume", cut, ranks=1)
+        assert wrong.returncode == 2 and "2 ranks" in wrong.stderr and "Traceback" not in wrong.stderr
+    res = run_fepen("run", "--resume", cut, ranks=ranks)
+    assert res.returncode == 0, res.stderr
+    a = json.loads((whole / "summary.json").read_text())
+    b = json.loads((cut / "summary.json").read_text())
+    for k in ("Hx_mm", "Hy_mm", "Tx_mm", "Ty_mm", "depth_mm", "residual_speed_m_s", "energy_error",
+              "max_peeq", "steps", "dt_s", "outcome"):
+        assert a[k] == b[k], k  # the same operations: equal, not merely close
+    assert (whole / "history.csv").read_text() == (cut / "history.csv").read_text()
+    assert check_valid_fields(cut) == check_valid_fields(whole) > n_out
+    assert not (cut / "checkpoint").exists() and not (cut / "fields.d").exists()
+
+
+def test_resume_needs_a_checkpoint(tmp_path):
+    """A finished run (its checkpoint removed) and a directory that is no run: exit 2, one line."""
+    res = run_fepen("run", "--resume", tmp_path)
+    assert res.returncode == 2 and "no scene.toml" in res.stderr
+    assert run_fepen("run", *SETS[:4], "--set", "run.end_time=2e-5", "--out", tmp_path).returncode == 0
+    res = run_fepen("run", "--resume", tmp_path)
+    assert res.returncode == 2 and "holds no checkpoint" in res.stderr and "Traceback" not in res.stderr
+    res = run_fepen("run", "--resume", tmp_path, "--set", "mesh.size=0.003")
+    assert res.returncode == 2 and "--resume" in res.stderr

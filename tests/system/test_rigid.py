@@ -1,0 +1,136 @@
+"""The rigid fidelity in the concrete target: force and depth against Forrestal's closed forms, events,
+mass properties, rank-count invariance."""
+
+import math
+
+import numpy as np
+import pytest
+from dolfinx import fem
+from mpi4py import MPI
+
+from fepen import scene
+from fepen.geometry import mesh
+from fepen.io.results import COL
+from fepen.laws import rigid_body as rigid
+from fepen.laws import target as tg
+from fepen.runs import setup
+from fepen.runs.rigid import RigidRun
+from fepen.solver import surface
+
+SIGMA_S = tg.forrestal_S(40e6) * 40e6  # Forrestal's S fc: the standard check of such codes
+CLOSED_FORM = ["effects.fidelity=rigid", f"target.quasi_static_stress={SIGMA_S}", "target.inertial_factor=1",
+               "effects.crater=none", "effects.separation=false", "effects.free_surface=false",
+               "impact.obliquity_deg=0", "impact.attack_deg=0"]
+
+
+@pytest.mark.parametrize("crh", [2.0, 3.0, 4.5])
+def test_nose_force_at_the_default_mesh(crh):
+    """Acceptance 1: the load points of a tangent ogive moving along its axis give (pi d^2/4)(sigma_s +
+    N* rho V^2), N* = (8 psi - 1)/(24 psi^2), within 0.5 %."""
+    sc = scene.load(None, [f"projectile.crh={crh}", *CLOSED_FORM])
+    pm = setup.mesh(sc, MPI.COMM_SELF)
+    V = fem.VectorFunctionSpace(pm.mesh, ("CG", 1))
+    g = surface.gather_global(surface.outer_surface(V, pm.facet_tags, pm.shape), MPI.COMM_SELF)
+    law = setup.target_law(sc)
+    for speed in (300.0, 900.0):
+        st = tg.SurfaceState(g["X"] - [0.0, 1.0, 0.0], np.tile([0.0, -speed, 0.0], (len(g["X"]), 1)), g["N"],
+                             g["area0"], g["radius"], g["R_meridian"], g["sin_phi0"], np.array([0.0, -1.0, 0.0]))
+        f, _ = tg.forces(law, st)
+        a = 0.5 * sc.projectile.diameter
+        expect = math.pi * a * a * (SIGMA_S + tg.ogive_nose_factor(crh) * 2400.0 * speed**2)
+        assert f[:, 1].sum() == pytest.approx(expect, rel=5e-3)
+        # an unstructured mesh is not exactly symmetric: the side force stays below 0.3 % of the axial
+        assert abs(f[:, 0].sum()) < 3e-3 * expect and abs(f[:, 2].sum()) < 3e-3 * expect
+
+
+def nose_entry_speed(rows, nose_length_mm):
+    d = np.array(rows)
+    depth, speed = d[:, COL["nose_y_mm"]], d[:, COL["speed_m_s"]]
+    i = np.flatnonzero(depth >= nose_length_mm)[0]
+    return float(np.interp(nose_length_mm, depth[i - 1:i + 1], speed[i - 1:i + 1]))
+
+
+@pytest.mark.parametrize("crh", [2.0, 3.0, 4.5])
+def test_depth_after_the_nose_is_embedded(crh):
+    """Acceptance 2: rigid, normal, sigma_s given, B = 1, no crater: once the nose is in at V_e, the rest of
+    the depth is M/(2 pi a^2 rho N*) ln(1 + N* rho V_e^2 / sigma_s), within 1 %, for V0 = 300, 600, 900."""
+    for v0 in (300.0, 600.0, 900.0):
+        sc = scene.load(None, [f"projectile.crh={crh}", f"impact.velocity={v0}", *CLOSED_FORM])
+        run = RigidRun(sc, None, MPI.COMM_SELF)
+        summ = run.run()
+        assert summ["outcome"] == "embedded"
+        ln_mm = run.pm.shape.nose_length * 1e3
+        ve = nose_entry_speed(run.rows, ln_mm)
+        a, N, rho = 0.5 * sc.projectile.diameter, tg.ogive_nose_factor(crh), 2400.0
+        rest = run.mass / (2 * math.pi * a * a * rho * N) * math.log(1 + N * rho * ve**2 / SIGMA_S)
+        assert (summ["Hy_mm"] - ln_mm) * 1e-3 == pytest.approx(rest, rel=0.01), (v0, ve)
+        # the unstructured mesh is not exactly symmetric: sideways drift below 1 % of the depth
+        assert summ["Hx_mm"] < 1e-2 * summ["Hy_mm"]
+
+
+@pytest.mark.parametrize("v0", [300.0, 600.0, 900.0])
+def test_forrestal_two_stage_depth_with_the_linear_crater(v0):
+    """Acceptance 2: with the linear crater (force c z up to k D), Forrestal's two-stage depth within 1 %."""
+    sets = [s for s in CLOSED_FORM if not s.startswith("effects.crater")]
+    sc = scene.load(None, [f"impact.velocity={v0}", "effects.crater=linear", *sets])
+    run = RigidRun(sc, None, MPI.COMM_SELF)
+    summ = run.run()
+    expect = tg.ForrestalCrater(run.law, run.mass, v0, 3.0).depth()
+    assert summ["Hy_mm"] * 1e-3 == pytest.approx(expect, rel=0.01)
+
+
+def test_ricochet_and_perforation():
+    """Acceptance 6: 250 m/s at 75 degrees ricochets; 800 m/s into a 150 mm slab perforates with a residual
+    speed (below the striking speed, above the speed a semi-infinite target would leave at that depth)."""
+    rico = RigidRun(scene.load(None, ["effects.fidelity=rigid", "impact.velocity=250", "impact.obliquity_deg=75",
+                                      "impact.attack_deg=0"]), None, MPI.COMM_SELF).run()
+    assert rico["outcome"] == "ricochet" and 0 < rico["residual_speed_m_s"] < 250
+    perf = RigidRun(scene.load(None, ["effects.fidelity=rigid", "impact.velocity=800", "impact.obliquity_deg=0",
+                                      "impact.attack_deg=0", "target.thickness=0.15"]), None, MPI.COMM_SELF).run()
+    assert perf["outcome"] == "perforated"
+    assert 300 < perf["residual_speed_m_s"] < 800
+    deep = RigidRun(scene.load(None, ["effects.fidelity=rigid", "impact.velocity=800", "impact.obliquity_deg=0",
+                                      "impact.attack_deg=0"]), None, MPI.COMM_SELF).run()
+    assert deep["outcome"] == "embedded" and deep["Hy_mm"] > 150 + 144
+
+
+def test_mass_properties_of_a_cylinder():
+    """Exact tetrahedral integration: a solid flat rod's mass, centre and inertia against closed forms."""
+    sc = scene.load(None, ["projectile.nose=flat", "projectile.cavity_diameter=0", "mesh.size=0.003"])
+    pm = setup.mesh(sc, MPI.COMM_SELF)
+    p = mesh.cell_points(pm.mesh)
+    m, first, second = rigid.tet_mass_properties(p, np.full(len(p), 7850.0))
+    c, inertia = rigid.inertia_about_centre(m, first, second)
+    vol = sum(np.abs(np.linalg.det(np.stack([q[1] - q[0], q[2] - q[0], q[3] - q[0]]))) / 6 for q in p)
+    assert m == pytest.approx(7850.0 * vol, rel=1e-12)
+    R, L = 0.0118, 0.144
+    assert c == pytest.approx([0.0, L / 2, 0.0], abs=1e-5)  # unstructured mesh: ~1 um off the axis
+    assert inertia[1, 1] == pytest.approx(0.5 * m * R * R, rel=0.02)  # faceting of the radius
+    assert inertia[0, 0] == pytest.approx(m * (3 * R * R + L * L) / 12, rel=0.01)
+    assert abs(inertia[0, 1]) < 1e-6 * inertia[0, 0]
+
+
+def test_quaternions_round_trip():
+    rng = np.random.default_rng(1)
+    for _ in range(5):
+        q = rng.standard_normal(4)
+        q /= np.linalg.norm(q)
+        R = rigid.quat_to_matrix(q)
+        assert np.allclose(R @ R.T, np.eye(3), atol=1e-14)
+        q2 = rigid.matrix_to_quat(R)
+        assert np.allclose(q2, q if q2 @ q > 0 else -q, atol=1e-12)
+
+
+@pytest.mark.mpi
+def test_rigid_run_is_the_same_on_any_rank_count():
+    """Acceptance 5: a rigid shot on COMM_WORLD and on one process agree to round-off: 1e-12 of the depth
+    for lengths (the mass properties are summed in the cells' original order and the load points sorted by
+    position; what remains differs in the last bit, and C7's tail travel of ~1.5 mm is a small difference
+    of large numbers)."""
+    sets = ["effects.fidelity=rigid", 'impact.shot="C7"']
+    world = RigidRun(scene.load(None, sets), None, MPI.COMM_WORLD).run()
+    alone = RigidRun(scene.load(None, sets), None, MPI.COMM_SELF).run()
+    scale = {"residual_speed_m_s": 1.0}
+    for k in ("Hx_mm", "Hy_mm", "Tx_mm", "Ty_mm", "residual_speed_m_s"):
+        assert world[k] == pytest.approx(alone[k], rel=0, abs=1e-12 * scale.get(k, abs(alone["Hy_mm"]))), k
+    assert world["steps"] == alone["steps"]

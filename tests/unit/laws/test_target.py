@@ -1,0 +1,183 @@
+"""The target resistance law on plain arrays (no mesh): limits, closed forms, switches."""
+
+import math
+
+import numpy as np
+import pytest
+
+from fepen import scene
+from fepen.laws import target as tg
+from fepen.runs import setup
+
+SMALL = 1e-12  # m^2: a load point so small that it is wholly on one side of a face
+
+
+def law(**kw):
+    base = dict(density=2400.0, Y=40e6, E=32.5e9, T=4e6, lam=0.67, sigma_s=300e6, B=1.0,
+                c_over_a=tg.cavity_ratio(40e6, 32.5e9, 4e6))
+    base.update(kw)
+    return tg.TargetLaw(**base)
+
+
+def test_quasi_static_stress_limits():
+    Y, E, T = 40e6, 32.5e9, 4e6
+    ca = tg.cavity_ratio(Y, E, T)
+    assert (1 / ca) ** 3 == pytest.approx(9 * Y / (4 * E) * math.sqrt(Y / (2 * T)), rel=1e-14)
+    tresca = Y * (1 + 2 * math.log(ca))
+    assert tg.quasi_static_stress(Y, E, T, 0.0) == pytest.approx(tresca, rel=1e-14)
+    for lam in (1e-6, 1e-9):
+        assert tg.quasi_static_stress(Y, E, T, lam) == pytest.approx(tresca, rel=10 * lam)
+    # the direct formula for a finite lambda
+    lam = 0.67
+    alpha = 6 / (3 + 2 * lam)
+    direct = Y / lam * (2 / alpha * ca ** (alpha * lam) - (3 - lam) / 3)
+    assert tg.quasi_static_stress(Y, E, T, lam) == pytest.approx(direct, rel=1e-13)
+    # no plastic zone (c = a): the stress at the wall is the unconfined strength
+    assert tg.quasi_static_stress(Y, E, T, lam, 1.0) == pytest.approx(Y, rel=1e-14)
+    # tau0 = (3 - lambda) Y / 3 is Table 3's 31.07 MPa
+    assert (3 - 0.67) * 40 / 3 == pytest.approx(31.07, abs=0.005)
+
+
+def ogive_surface(crh, a=0.0118, nz=4000, nt=64, speed=600.0):
+    """Exact quadrature points on a tangent-ogive nose moving along -y (tip at the origin, body at y > 0),
+    embedded deep in the target."""
+    s = 2 * a * crh
+    ln = a * math.sqrt(4 * crh - 1)
+    zg, wz = np.polynomial.legendre.leggauss(nz // 8)
+    edges = np.linspace(0, ln, 9)
+    z = np.concatenate([0.5 * (b - a_) * (zg + 1) + a_ for a_, b in zip(edges[:-1], edges[1:])])
+    wzz = np.concatenate([0.5 * (b - a_) * wz for a_, b in zip(edges[:-1], edges[1:])])
+    r = np.sqrt(s * s - (ln - z) ** 2) - (s - a)
+    dr = (ln - z) / np.sqrt(s * s - (ln - z) ** 2)
+    th = (np.arange(nt) + 0.5) * 2 * math.pi / nt
+    Z, TH = np.meshgrid(z, th, indexing="ij")
+    R, DR = np.meshgrid(r, th, indexing="ij")[0], np.meshgrid(dr, th, indexing="ij")[0]
+    W = np.meshgrid(wzz, th, indexing="ij")[0] * 2 * math.pi / nt
+    norm = np.sqrt(1 + DR**2)
+    n = np.stack([np.cos(TH) / norm, -DR / norm, np.sin(TH) / norm], axis=-1).reshape(-1, 3)
+    x = np.stack([R * np.cos(TH), Z - 10.0, R * np.sin(TH)], axis=-1).reshape(-1, 3)
+    area = (R * norm * W).ravel()
+    v = np.tile([0.0, -speed, 0.0], (len(area), 1))
+    flat = np.full(len(area), np.inf)
+    return tg.SurfaceState(x, v, n, area, R.ravel(), flat, np.zeros(len(area)))
+
+
+@pytest.mark.parametrize("crh", [2.0, 3.0, 4.5])
+def test_exact_ogive_force_is_forrestals(crh):
+    """Integrating the nodal law over the exact ogive gives (pi d^2/4)(sigma_s + N* rho V^2)."""
+    L = law()
+    s = ogive_surface(crh)
+    f, sig = tg.forces(L, s)
+    a, V = 0.0118, 600.0
+    expect = math.pi * a * a * (L.sigma_s + tg.ogive_nose_factor(crh) * L.density * V * V)
+    assert f[:, 1].sum() == pytest.approx(expect, rel=1e-6)
+    assert abs(f[:, 0].sum()) < 1e-9 * expect and abs(f[:, 2].sum()) < 1e-9 * expect
+
+
+def test_only_inside_and_approaching_points_are_loaded():
+    L = law(thickness=0.1)
+    n = np.array([[0, -1.0, 0]] * 4)
+    x = np.array([[0, 0.01, 0], [0, -0.05, 0], [0, -0.2, 0], [0, -0.05, 0]])
+    v = np.array([[0, -100.0, 0], [0, -100.0, 0], [0, -100.0, 0], [0, 100.0, 0]])  # last one moves away
+    st = tg.SurfaceState(x, v, n, np.full(4, SMALL), np.ones(4), np.full(4, np.inf), np.zeros(4))
+    sig, ins, vn = tg.normal_stress(L, st)
+    assert list(ins) == [False, True, False, True]
+    assert sig[0] == 0 and sig[2] == 0 and sig[3] == 0
+    assert sig[1] == pytest.approx(300e6 + 2400 * 100.0**2)
+
+
+def test_separation_angle_unloads_shallow_surfaces():
+    L = law(separation=True, phi_min=math.radians(10))
+    ang = np.radians([5.0, 15.0])
+    n = np.stack([np.cos(ang), -np.sin(ang), 0 * ang], axis=1)  # surface at angle phi to the motion (-y)
+    st = tg.SurfaceState(np.array([[0, -0.05, 0]] * 2), np.array([[0, -300.0, 0]] * 2), n, np.full(2, SMALL),
+                         np.ones(2), np.full(2, np.inf), np.zeros(2))
+    sig, _, _ = tg.normal_stress(L, st)
+    assert sig[0] == 0 and sig[1] > 0
+    assert tg.normal_stress(law(), st)[0][0] > 0  # without separation both are loaded
+
+
+def test_free_surface_truncates_the_plastic_zone():
+    L = law(free_surface=True, sigma_s=float(tg.quasi_static_stress(40e6, 32.5e9, 4e6, 0.67)))
+    n = np.array([[0.0, 1.0, 0.0]] * 3)  # facing the face, moving towards it (v.n > 0)
+    x = np.array([[0, -1e-5, 0], [0, -0.005, 0], [0, -1.0, 0]])
+    v = np.array([[0, 1e-3, 0]] * 3)
+    st = tg.SurfaceState(x, v, n, np.full(3, SMALL), np.full(3, 0.01), np.full(3, np.inf), np.zeros(3))
+    sig, _, _ = tg.normal_stress(L, st)
+    assert sig[0] == pytest.approx(40e6, rel=2e-3)  # at the face: Y
+    assert sig[0] < sig[1] < sig[2]
+    assert sig[2] == pytest.approx(L.sigma_s, rel=1e-9)  # deep: the full cavity-expansion stress
+
+
+def test_friction_opposes_sliding():
+    L = law(friction=True, mu=0.2)
+    n = np.array([[1.0, 0.0, 0.0]])
+    v = np.array([[50.0, -400.0, 0.0]])
+    st = tg.SurfaceState(np.array([[0, -0.05, 0]]), v, n, np.array([2e-6]), np.ones(1), np.full(1, np.inf),
+                         np.zeros(1))
+    f, sig = tg.forces(L, st)
+    assert f[0, 0] == pytest.approx(-sig[0] * 2e-6)
+    assert f[0, 1] == pytest.approx(0.2 * sig[0] * 2e-6)  # against the -y sliding
+    assert f[0, 2] == 0
+
+
+def test_energy_crater_limits():
+    """At the face the medium is thrown out (no resistance); deep down it is the tunnel law."""
+    L = law(crater="energy", D=0.0236, k=2.37, c_over_a=tg.cavity_ratio(40e6, 32.5e9, 4e6))
+    ny = math.sin(math.radians(30))
+    n = np.array([[math.cos(math.radians(30)), ny, 0.0]] * 3)
+    depths = np.array([1e-5, 0.02, 2.0])  # the last is past k D: always the tunnel law
+    x = np.stack([np.full(3, 0.01), -depths, np.zeros(3)], axis=1)
+    v = np.tile(np.array(n[0]) * 300.0, (3, 1))
+    st = tg.SurfaceState(x, v, n, np.full(3, SMALL), np.full(3, 0.01), np.full(3, 0.07), np.full(3, 0.3))
+    sig, _, vn = tg.normal_stress(L, st)
+    tunnel = L.sigma_s + L.density * vn**2
+    assert sig[0] == 0.0
+    assert sig[2] == pytest.approx(tunnel[2])
+    # the balance alone: deep but shallower than k D, a slow point is confined, a fast one is thrown out
+    ej = tg.crater_energy_ejects(L, np.array([10.0, 2000.0]), np.array([0.04, 0.04]), np.full(2, 0.01),
+                                 np.full(2, 0.07), np.full(2, 0.3))
+    assert list(ej) == [False, True]
+
+
+def test_forrestal_two_stage_depth_closed_form():
+    L = law(sigma_s=tg.forrestal_S(40e6) * 40e6, D=0.0236, k=2.0)
+    fc = tg.ForrestalCrater(L, 0.367, 600.0, 3.0)
+    a, kd, N = 0.0118, 2.0 * 0.0236, tg.ogive_nose_factor(3.0)
+    # continuity at k D and energy of stage 1: M (V0^2 - V1^2) / 2 = c (kd)^2 / 2
+    assert 0.367 * (600.0**2 - fc.v1_sq) == pytest.approx(fc.c * kd * kd, rel=1e-12)
+    assert fc.c * kd == pytest.approx(math.pi * a * a * (L.sigma_s + N * 2400 * fc.v1_sq), rel=1e-12)
+    assert fc.scale(kd / 2, 1.0) == pytest.approx(fc.c * kd / 2)
+    assert fc.scale(2 * kd, 123.0) == 1.0
+
+
+def test_scene_builds_the_law():
+    sc = scene.load(None, ["effects.crater=linear", "target.quasi_static_stress=4.4e8"])
+    L = setup.target_law(sc)
+    assert L.sigma_s == 4.4e8 and L.crater == "linear" and L.given_sigma_s
+    L2 = setup.target_law(scene.load())
+    assert L2.sigma_s == pytest.approx(float(tg.quasi_static_stress(40e6, 32.5e9, 4e6, 0.67)))
+    assert L2.crush_strain == pytest.approx(1 - 2400 / 2650)
+
+
+def test_immersion_is_the_submerged_fraction_of_a_patch():
+    L = law(thickness=0.1)
+    A = 4e-6  # a 2 mm patch
+    y = np.array([0.002, 0.001, 0.0, -0.001, -0.05, -0.099, -0.1, -0.101, -0.2])
+    x = np.stack([np.zeros_like(y), y, np.zeros_like(y)], axis=1)
+    w = tg.immersion(L, x, np.full(len(y), A))
+    assert np.allclose(w, [0, 0, 0.5, 1, 1, 1, 0.5, 0, 0])
+
+
+def test_sigma_s_onset_ramps_over_the_first_degrees():
+    """target.onset_angle_deg: sigma_s grows linearly in sin(phi) up to the onset angle, then is whole."""
+    L = law(onset=math.radians(2.0))
+    ang = np.radians([0.5, 1.0, 5.0])
+    n = np.stack([np.cos(ang), -np.sin(ang), 0 * ang], axis=1)
+    st = tg.SurfaceState(np.array([[0, -0.05, 0]] * 3), np.array([[0, -300.0, 0]] * 3), n, np.full(3, SMALL),
+                         np.ones(3), np.full(3, np.inf), np.zeros(3))
+    sig, _, vn = tg.normal_stress(L, st)
+    inertial = 2400 * vn**2
+    ramp = np.sin(ang[:2]) / math.sin(math.radians(2.0))
+    assert sig[:2] == pytest.approx(300e6 * ramp + inertial[:2], rel=1e-12)
+    assert sig[2] == pytest.approx(300e6 + inertial[2], rel=1e-12)

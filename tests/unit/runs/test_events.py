@@ -1,0 +1,54 @@
+"""The stop rules (fepen.runs.events) on plain numbers: one definition for the rigid and deformable runs."""
+
+import numpy as np
+import pytest
+
+from fepen.runs import events
+
+AXIS = np.array([0.0, -1.0, 0.0])  # nose down, into the target
+
+
+def test_embedded_when_the_centre_stops_advancing_or_its_energy_is_spent():
+    m, ke0 = 0.4, 0.5 * 0.4 * 800.0**2
+    assert not events.embedded(np.array([0.0, -10.0, 0.0]), AXIS, m, ke0)
+    assert events.embedded(np.array([0.0, 1e-3, 0.0]), AXIS, m, ke0)  # moving back along the axis
+    assert events.embedded(np.array([5.0, 0.0, 0.0]), AXIS, m, ke0)  # sideways only: V·a = 0
+    # the energy rule: ½ M V² = STOP_ENERGY KE0 exactly at V = 800 sqrt(STOP_ENERGY)
+    v = 800.0 * np.sqrt(events.STOP_ENERGY)
+    assert events.embedded(np.array([0.0, -v * (1 - 1e-9), 0.0]), AXIS, m, ke0)
+    assert not events.embedded(np.array([0.0, -v * (1 + 1e-6), 0.0]), AXIS, m, ke0)
+
+
+def test_perforation_needs_a_finite_target_and_every_point_beyond_its_rear_face():
+    assert not events.perforated(-1.0, None)
+    assert events.perforated(-0.2001, 0.2)
+    assert not events.perforated(-0.1999, 0.2)
+
+
+def test_ricochet_needs_every_point_above_the_face_and_the_centre_moving_away():
+    assert events.ricochet(1e-6, 3.0)
+    assert not events.ricochet(-1e-6, 3.0)
+    assert not events.ricochet(1e-6, -3.0)
+
+
+@pytest.mark.parametrize("until_stopped", [True, False])
+def test_stop_rules_remember_entry_and_respect_the_end_time(until_stopped):
+    r = events.StopRules(thickness=None, until_stopped=until_stopped)
+    rest = np.zeros(3)
+    assert r.penetration(0.01, 0.2, rest, AXIS, 1.0, 1.0) is None  # not entered yet: never embedded
+    assert not r.entered
+    assert r.penetration(-0.01, 0.2, rest, AXIS, 1.0, 1.0) == ("embedded" if until_stopped else None)
+    assert r.entered
+    state = r.state()
+    fresh = events.StopRules(thickness=None, until_stopped=until_stopped)
+    fresh.restore(state)
+    assert fresh == r
+
+
+def test_rebound_after_leaving_the_wall_for_long_enough():
+    r = events.StopRules(thickness=None, until_stopped=True)
+    assert r.rebound(0.0, 0) is None  # never touched
+    assert r.rebound(1e-6, 5) is None
+    assert r.rebound(2e-6, 0) is None  # left at 2 us
+    assert r.rebound(2e-6 + 0.99 * events.REBOUND_FREE_S, 0) is None
+    assert r.rebound(2e-6 + 1.01 * events.REBOUND_FREE_S, 0) == "rebound"
