@@ -123,6 +123,11 @@ def _mesh_on_root(shape: Shape, opts, charge: bool, mass, rho_s, rho_c, use_cach
         gmsh.write(str(tmp))
         os.replace(tmp, msh)
         side.write_text(json.dumps({"shape": asdict(current), "mesh_s": seconds}))
+        # the run goes on with the mesh as the cache holds it: the .msh file keeps 16 significant digits,
+        # so a mesh used straight from gmsh would differ in the last bits from the same mesh read back,
+        # and a run's numbers would depend on whether its mesh was cached
+        gmsh.clear()
+        gmsh.open(str(msh))
     return current, seconds, False
 
 

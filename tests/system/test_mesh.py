@@ -155,3 +155,16 @@ def test_split_wall_gives_the_charge_its_own_surface(ranks):
     # a model just meshed (not read back from the cache) keeps nodes no cell uses: the same mesh results
     fresh = setup.mesh(scene.load(None, ["mesh.size=0.004", "effects.charge=true"]), comm, use_cache=False)
     assert fresh.mesh.geometry.index_map().size_global == info["nodes"]
+
+
+def test_a_cold_and_a_warm_mesh_cache_give_the_same_mesh_to_the_bit(tmp_path, monkeypatch):
+    """A run's numbers must not depend on whether its mesh was cached: the mesh just built is the one the
+    cache holds (the .msh file keeps 16 significant digits)."""
+    monkeypatch.setenv("FEPEN_MESH_CACHE", str(tmp_path))
+    sc = scene.load(None, ["mesh.size=0.006"])
+    cold = setup.mesh(sc, MPI.COMM_SELF)
+    assert not cold.cached
+    warm = setup.mesh(sc, MPI.COMM_SELF)
+    assert warm.cached
+    assert np.array_equal(cold.mesh.geometry.x, warm.mesh.geometry.x)
+    assert np.array_equal(cold.mesh.geometry.dofmap.array, warm.mesh.geometry.dofmap.array)
