@@ -8,24 +8,20 @@ includes Python start-up and imports.
 """
 
 import json
-import os
-import subprocess
 import sys
 import tempfile
 import time
 from pathlib import Path
+
+from fepen.studies import processes
 
 ROOT = Path(__file__).resolve().parents[1]
 
 
 def run(ranks: int) -> dict:
     out = Path(tempfile.mkdtemp(prefix="fepen-shot-"))
-    env = dict(os.environ, OMPI_ALLOW_RUN_AS_ROOT="1", OMPI_ALLOW_RUN_AS_ROOT_CONFIRM="1",
-               OMPI_MCA_rmaps_base_oversubscribe="1")
-    cmd = ["mpirun", "-n", str(ranks), sys.executable, "-m", "fepen", "run", str(ROOT / "scenes/default.toml"),
-           "--out", str(out)]
     t0 = time.perf_counter()
-    subprocess.run(cmd, check=True, env=env, cwd=ROOT, capture_output=True)
+    processes.run(["run", ROOT / "scenes/default.toml", "--out", out], ranks, check=True)
     whole = time.perf_counter() - t0
     s = json.loads((out / "summary.json").read_text())
     return dict(ranks=ranks, whole=whole, **s["time_split_s"], steps=s["steps"], Hy=s["Hy_mm"])

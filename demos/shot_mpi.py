@@ -10,12 +10,13 @@ beside its path from history.csv.
 import argparse
 import json
 import os
-import subprocess
 import sys
 from pathlib import Path
 
 import h5py
 import numpy as np
+
+from fepen.studies import processes
 
 
 def main():
@@ -26,13 +27,12 @@ def main():
     ap.add_argument("--set", dest="sets", action="append", default=[])
     args = ap.parse_args()
     out = Path(args.out)
-    cmd = ["mpirun", "-n", str(args.ranks), sys.executable, "-m", "fepen", "run", "scenes/default.toml",
-           "--out", str(out), "--set", f'impact.shot="{args.shot}"']
+    cmd = ["run", "scenes/default.toml", "--out", out.resolve(), "--set", f'impact.shot="{args.shot}"']
     for s in args.sets:
         cmd += ["--set", s]
-    env = dict(os.environ, OMPI_ALLOW_RUN_AS_ROOT="1", OMPI_ALLOW_RUN_AS_ROOT_CONFIRM="1",
-               OMPI_MCA_rmaps_base_oversubscribe="1")
-    subprocess.run(cmd, check=True, env=env)
+    r = processes.run(cmd, args.ranks)
+    if r.returncode:
+        sys.exit(r.stderr)
     summary = json.loads((out / "summary.json").read_text())
     print({k: summary[k] for k in ("outcome", "Hx_mm", "Hy_mm", "Tx_mm", "Ty_mm", "max_peeq", "ranks", "wall_s")})
 

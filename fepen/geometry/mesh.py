@@ -17,6 +17,7 @@ from pathlib import Path
 import numpy as np
 from mpi4py import MPI
 
+from fepen.atomic import replacing
 from fepen.geometry import gmsh_model, tags, tetra
 from fepen.geometry.shape import Shape
 
@@ -119,10 +120,10 @@ def _mesh_on_root(shape: Shape, opts, charge: bool, mass, rho_s, rho_c, use_cach
     seconds = time.perf_counter() - t0
     if use_cache:
         folder.mkdir(parents=True, exist_ok=True)
-        tmp = folder / f"{key}.{os.getpid()}.msh"
-        gmsh.write(str(tmp))
-        os.replace(tmp, msh)
-        side.write_text(json.dumps({"shape": asdict(current), "mesh_s": seconds}))
+        with replacing(msh, ".msh") as tmp:
+            gmsh.write(str(tmp))
+        with replacing(side) as tmp:
+            tmp.write_text(json.dumps({"shape": asdict(current), "mesh_s": seconds}))
         # the run goes on with the mesh as the cache holds it: the .msh file keeps 16 significant digits,
         # so a mesh used straight from gmsh would differ in the last bits from the same mesh read back,
         # and a run's numbers would depend on whether its mesh was cached

@@ -5,13 +5,14 @@ leaves half-written: one file per output time while the run goes on, one self-co
 
 from __future__ import annotations
 
-import os
 import shutil
 from pathlib import Path
 from xml.sax.saxutils import quoteattr
 
 import numpy as np
 from mpi4py import MPI
+
+from fepen.atomic import replacing
 
 
 def _time_name(t: float) -> str:
@@ -77,11 +78,9 @@ class FieldWriter:
     def _write_h5(path: Path, datasets: dict) -> None:
         import h5py
 
-        tmp = path.with_name(path.name + f".tmp{os.getpid()}")
-        with h5py.File(tmp, "w") as h5:
+        with replacing(path) as tmp, h5py.File(tmp, "w") as h5:
             for name, data in datasets.items():
                 h5.create_dataset(name, data=data)
-        os.replace(tmp, path)
 
     def write(self, t: float, values: dict[str, np.ndarray]) -> None:
         """Write one output time (collective).
@@ -108,15 +107,13 @@ class FieldWriter:
         import h5py
 
         path = self.out / "fields.h5"
-        tmp = path.with_name(path.name + f".tmp{os.getpid()}")
-        with h5py.File(tmp, "w") as h5:
+        with replacing(path) as tmp, h5py.File(tmp, "w") as h5:
             for name in ("geometry", "topology"):
                 h5[f"/Mesh/mesh/{name}"] = h5py.ExternalLink("fields.d/mesh.h5", f"/{name}")
             for k, t in enumerate(self.times):
                 for name in self.names:
                     h5[f"/Function/{name}/{_time_name(t)}"] = h5py.ExternalLink(
                         f"fields.d/{self._step_file(k).name}", f"/{name}")
-        os.replace(tmp, path)
         self._write_xdmf()
 
     def _write_xdmf(self) -> None:
@@ -150,9 +147,8 @@ class FieldWriter:
             lines.append("    </Grid>")
         lines += ["  </Domain>", "</Xdmf>", ""]
         path = self.out / "fields.xdmf"
-        tmp = path.with_name(path.name + f".tmp{os.getpid()}")
-        tmp.write_text("\n".join(lines))
-        os.replace(tmp, path)
+        with replacing(path) as tmp:
+            tmp.write_text("\n".join(lines))
 
     def consolidate(self) -> None:
         """Copy every output time into a self-contained fields.h5 (atomic) and remove fields.d (rank 0;
@@ -161,8 +157,7 @@ class FieldWriter:
             import h5py
 
             path = self.out / "fields.h5"
-            tmp = path.with_name(path.name + f".tmp{os.getpid()}")
-            with h5py.File(tmp, "w") as dst:
+            with replacing(path) as tmp, h5py.File(tmp, "w") as dst:
                 with h5py.File(self.dir / "mesh.h5", "r") as src:
                     for name in ("geometry", "topology"):
                         dst.create_dataset(f"/Mesh/mesh/{name}", data=src[name][()])
@@ -170,6 +165,5 @@ class FieldWriter:
                     with h5py.File(self._step_file(k), "r") as src:
                         for name in self.names:
                             dst.create_dataset(f"/Function/{name}/{_time_name(t)}", data=src[name][()])
-            os.replace(tmp, path)
             shutil.rmtree(self.dir)
         self.comm.barrier()

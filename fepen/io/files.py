@@ -3,11 +3,11 @@
 from __future__ import annotations
 
 import json
-import os
 from pathlib import Path
 
 from mpi4py import MPI
 
+from fepen.atomic import replacing
 from fepen.version import __version__
 
 
@@ -33,10 +33,8 @@ def write_text(path: Path, text: str, comm: MPI.Comm = MPI.COMM_WORLD) -> None:
     """Write a text file on rank 0 through a temporary file, so it is never left half-written."""
     if comm.rank != 0:
         return
-    path = Path(path)
-    tmp = path.with_name(path.name + f".tmp{os.getpid()}")
-    tmp.write_text(text)
-    os.replace(tmp, path)
+    with replacing(path) as tmp:
+        tmp.write_text(text)
 
 
 def write_json(path: Path, data: dict, comm: MPI.Comm = MPI.COMM_WORLD) -> None:

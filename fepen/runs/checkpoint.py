@@ -11,19 +11,18 @@ and reads it. Resuming needs the same number of ranks as the run it continues.
 from __future__ import annotations
 
 import json
-import os
 import shutil
 from pathlib import Path
 
 import numpy as np
 
+from fepen.atomic import replacing
 from fepen.errors import InputError
 
 
 def _atomic_savez(path: Path, **arrays) -> None:
-    tmp = path.with_name(path.name + f".tmp{os.getpid()}.npz")
-    np.savez(tmp, **arrays)
-    os.replace(tmp, path)
+    with replacing(path, ".npz") as tmp:
+        np.savez(tmp, **arrays)
 
 
 def write(out: Path, comm, step: int, t: float, arrays: dict, meta: dict) -> None:
@@ -43,9 +42,8 @@ def write(out: Path, comm, step: int, t: float, arrays: dict, meta: dict) -> Non
     comm.barrier()
     if comm.rank == 0:
         state = {"step": step, "t_s": t, "ranks": comm.size, **meta}
-        tmp = d / f"state.json.tmp{os.getpid()}"
-        tmp.write_text(json.dumps(state, indent=1) + "\n")
-        os.replace(tmp, d / "state.json")
+        with replacing(d / "state.json") as tmp:
+            tmp.write_text(json.dumps(state, indent=1) + "\n")
         for f in d.iterdir():
             if f.name.startswith("step") and not f.name.startswith(f"step{step:09d}-"):
                 f.unlink()

@@ -7,12 +7,12 @@ from __future__ import annotations
 import csv
 import io
 import json
-import os
 from pathlib import Path
 
 import numpy as np
 
 from fepen import scene as fscene
+from fepen.atomic import replacing
 from fepen.io import files
 from fepen.studies import processes
 
@@ -243,7 +243,6 @@ def pareto(rows, path: Path) -> None:
     axes[0].legend(handles=handles, fontsize=8)
     fig.suptitle("fepen: accuracy against time (shots C3 and C7)")
     fig.tight_layout()
-    tmp = path.with_name(path.stem + f".tmp{os.getpid()}.png")
-    fig.savefig(tmp, dpi=120)
+    with replacing(path, ".png") as tmp:
+        fig.savefig(tmp, dpi=120)
     plt.close(fig)
-    os.replace(tmp, path)

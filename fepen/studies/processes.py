@@ -1,28 +1,51 @@
-"""Whole ``fepen`` processes, as a user would start them (studies, demos and tests)."""
+"""Whole ``fepen`` processes and Python scripts, as a user would start them, under ``mpirun -n RANKS`` when
+ranks > 1 (studies, demos, benchmarks and tests all start them here)."""
 
 from __future__ import annotations
 
 import os
+import subprocess
+import sys
+import time
+from pathlib import Path
+
+ROOT = Path(__file__).resolve().parents[2]
+
+
+def mpi_env(**extra) -> dict:
+    """The environment of a child process: OpenMPI allowed to run as root and to oversubscribe, and this
+    source tree first on the Python path (a checkout runs its own fepen)."""
+    path = os.pathsep.join(p for p in (str(ROOT), os.environ.get("PYTHONPATH", "")) if p)
+    return dict(os.environ, OMPI_ALLOW_RUN_AS_ROOT="1", OMPI_ALLOW_RUN_AS_ROOT_CONFIRM="1",
+                OMPI_MCA_rmaps_base_oversubscribe="1", PYTHONPATH=path, **extra)
+
+
+def command(args, ranks: int = 1, fepen: bool = True) -> list[str]:
+    """``python -m fepen ARGS`` (or ``python ARGS`` with fepen=False), under mpirun when ranks > 1."""
+    cmd = [sys.executable, *(["-m", "fepen"] if fepen else []), *map(str, args)]
+    return ["mpirun", "-n", str(ranks), *cmd] if ranks > 1 else cmd
+
+
+def run(args, ranks: int = 1, fepen: bool = True, cwd=None, timeout: float | None = None, check: bool = False):
+    """Run a whole process to its end; its CompletedProcess (output captured as text)."""
+    return subprocess.run(command(args, ranks, fepen), cwd=cwd or ROOT, capture_output=True, text=True,
+                          env=mpi_env(), timeout=timeout, check=check)
+
+
+def start(args, ranks: int = 1, fepen: bool = True, cwd=None) -> subprocess.Popen:
+    """Start a whole process in a session of its own (so that its process group can be signalled)."""
+    return subprocess.Popen(command(args, ranks, fepen), cwd=cwd or ROOT, env=mpi_env(), start_new_session=True,
+                            stdout=subprocess.DEVNULL, stderr=subprocess.PIPE, text=True)
 
 
 def run_fepen_process(args: list[str], ranks: int = 1) -> tuple[int, float, str]:
-    """Run ``python -m fepen ARGS`` as a whole process, under ``mpirun -n RANKS`` when ranks > 1 (as a
-    user would; OpenMPI allowed to run as root and to oversubscribe).
+    """Run ``python -m fepen ARGS`` as a whole process.
 
     Returns:
         (exit code, wall seconds, the last "fepen:" line of its stderr, or its tail).
     """
-    import subprocess
-    import sys
-    import time
-
-    cmd = [sys.executable, "-m", "fepen", *map(str, args)]
-    if ranks > 1:
-        cmd = ["mpirun", "-n", str(ranks), *cmd]
-    env = dict(os.environ, OMPI_ALLOW_RUN_AS_ROOT="1", OMPI_ALLOW_RUN_AS_ROOT_CONFIRM="1",
-               OMPI_MCA_rmaps_base_oversubscribe="1")
     t0 = time.perf_counter()
-    r = subprocess.run(cmd, capture_output=True, text=True, env=env)
+    r = run(args, ranks)
     wall = time.perf_counter() - t0
     lines = [ln for ln in r.stderr.strip().splitlines() if ln.startswith("fepen:")]
     return r.returncode, wall, (lines[-1] if lines else r.stderr.strip()[-400:])

@@ -4,14 +4,14 @@ very results of an uninterrupted run; serially and on 2 ranks (the runs are subp
 import json
 import os
 import signal
-import subprocess
-import sys
 import time
 import xml.etree.ElementTree as ET
 
 import numpy as np
 import pytest
-from conftest import ROOT, run_fepen
+from conftest import run_fepen
+
+from fepen.studies import processes
 
 SETS = ["--set", "mesh.size=0.004", "--set", "run.end_time=1.2e-4", "--set", "run.output_interval=1e-5",
         "--set", "run.checkpoint_interval=1.5e-5", "--set", 'impact.shot="C7"']
@@ -23,13 +23,7 @@ CHARGED = ["--set", "effects.charge=true", "--set", 'charge.contact="frictional"
 
 
 def start(out, ranks, extra=()):
-    cmd = [sys.executable, "-m", "fepen", "run", *SETS, *extra, "--out", str(out)]
-    if ranks > 1:
-        cmd = ["mpirun", "-n", str(ranks), *cmd]
-    env = dict(os.environ, OMPI_ALLOW_RUN_AS_ROOT="1", OMPI_ALLOW_RUN_AS_ROOT_CONFIRM="1",
-               OMPI_MCA_rmaps_base_oversubscribe="1", PYTHONPATH=str(ROOT))
-    return subprocess.Popen(cmd, cwd=ROOT, env=env, start_new_session=True, stdout=subprocess.DEVNULL,
-                            stderr=subprocess.PIPE, text=True)
+    return processes.start(["run", *SETS, *extra, "--out", out], ranks)
 
 
 def kill_after_checkpoints(proc, out, n=2, timeout=300):
