@@ -2,19 +2,10 @@
 
 import numpy as np
 import pytest
+from test_kernels import rot, voigt_to_mat
 
 from fepen.laws import materials as M
 from fepen.solver import kernels as K
-
-
-def rot(axis, angle):
-    a = np.asarray(axis, float) / np.linalg.norm(axis)
-    Kx = np.array([[0, -a[2], a[1]], [a[2], 0, -a[0]], [-a[1], a[0], 0]])
-    return np.eye(3) + np.sin(angle) * Kx + (1 - np.cos(angle)) * Kx @ Kx
-
-
-def voigt_to_mat(s):
-    return np.array([[s[0], s[3], s[5]], [s[3], s[1], s[4]], [s[5], s[4], s[2]]])
 
 
 def one_tet(seed=0):
