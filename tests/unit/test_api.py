@@ -56,3 +56,22 @@ def test_importing_fepen_is_cheap():
     code = "import sys, fepen; print('dolfinx' in sys.modules, 'mpi4py' in sys.modules, fepen.Scene.__name__)"
     out = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True, check=True).stdout.split()
     assert out == ["False", "False", "Scene"]
+
+
+def test_load_gives_the_summary_the_history_by_column_and_a_dataframe(tmp_path):
+    """A results directory read back: history.csv by column name (numpy), the same as a DataFrame, the
+    resolved scene, and the figures and fields found there."""
+    sc = fepen.Scene({"effects": {"fidelity": "rigid"}})
+    (tmp_path / "scene.toml").write_text(to_toml(sc))
+    (tmp_path / "summary.json").write_text('{"outcome": "embedded", "Hx_mm": 1.5, "Hy_mm": 12.25}')
+    (tmp_path / "history.csv").write_text("t_s,nose_x_mm,nose_y_mm\n0,0,0\n1e-05,1,8\n2e-05,1.5,12.25\n")
+    (tmp_path / "history.png").write_bytes(b"png")
+    r = fepen.load(tmp_path)
+    assert r.history["nose_y_mm"][-1] == r.summary["Hy_mm"]
+    assert r.history.dtype.names == ("t_s", "nose_x_mm", "nose_y_mm")
+    assert r.scene.as_dict() == sc.as_dict()
+    assert r.fields is None and set(r.figures) == {"history"}
+    frame = r.history_frame
+    assert list(frame.columns) == ["t_s", "nose_x_mm", "nose_y_mm"] and frame["nose_x_mm"].iloc[-1] == 1.5
+    with pytest.raises(fepen.InputError):
+        fepen.load(tmp_path / "nothing")
