@@ -17,7 +17,7 @@ from mpi4py import MPI
 
 from fepen import scene
 from fepen.geometry import tetra
-from fepen.runs import setup
+from fepen.runs import model, setup
 from fepen.solver import ckernel, explicit
 from fepen.solver import rigid_wall as rigidwall
 
@@ -29,7 +29,7 @@ def measure(h_mm, comm, kernel):
                            "impact.obliquity_deg=0", "impact.attack_deg=0"])
     pm = setup.mesh(sc, comm)
     info = setup.mesh_metrics(pm, sc)
-    s = setup.solver(sc, pm, kernel=kernel)
+    s = model.solver(sc, pm, kernel=kernel)
     s.external = rigidwall.RigidWall(s)
     s.set_initial(velocity=lambda X: np.tile([0.0, -300.0, 0.0], (len(X), 1)))
     for _ in range(20):  # compile and warm up

@@ -12,20 +12,21 @@ from fepen.version import __version__
 
 
 def versions() -> dict[str, str]:
-    """Versions of fepen and the libraries that shape its numbers."""
-    import dolfinx
+    """Versions of fepen and of the libraries that shaped this process's numbers (dolfinx and PETSc only
+    when the run imported them: a rigid run does not)."""
+    import sys
+
     import numpy
-    from petsc4py import PETSc
 
-    out = {"fepen": __version__, "dolfinx": dolfinx.__version__,
-           "petsc": ".".join(str(v) for v in PETSc.Sys.getVersion()), "numpy": numpy.__version__,
-           "mpi": MPI.Get_library_version().splitlines()[0].strip()}
-    try:
-        import gmsh
+    out = {"fepen": __version__, "numpy": numpy.__version__, "mpi": MPI.Get_library_version().splitlines()[0].strip()}
+    if "dolfinx" in sys.modules:
+        import dolfinx
+        from petsc4py import PETSc
 
-        out["gmsh"] = gmsh.__version__
-    except ImportError:  # pragma: no cover
-        pass
+        out["dolfinx"] = dolfinx.__version__
+        out["petsc"] = ".".join(str(v) for v in PETSc.Sys.getVersion())
+    if "gmsh" in sys.modules:
+        out["gmsh"] = sys.modules["gmsh"].__version__
     return out
 
 

@@ -5,11 +5,9 @@ from __future__ import annotations
 from mpi4py import MPI
 
 from fepen.runs import setup
-from fepen.runs.deformable import DeformableRun
 from fepen.runs.rigid import RigidRun
 
-__all__ = ["setup", "deformable", "rigid", "events", "outputs", "checkpoint", "run_scene", "DeformableRun",
-           "RigidRun"]
+__all__ = ["setup", "model", "deformable", "rigid", "events", "outputs", "checkpoint", "run_scene", "RigidRun"]
 
 
 def run_scene(scene, out, comm=MPI.COMM_WORLD, progress: bool = False, resume: dict | None = None) -> dict:
@@ -28,4 +26,6 @@ def run_scene(scene, out, comm=MPI.COMM_WORLD, progress: bool = False, resume: d
     setup.check_supported(scene)
     if scene.effects.fidelity == "rigid":
         return RigidRun(scene, out, comm).run()
+    from fepen.runs.deformable import DeformableRun  # dolfinx: only a deformable run pays for importing it
+
     return DeformableRun(scene, out, comm, progress, resume).run()

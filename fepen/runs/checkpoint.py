@@ -4,7 +4,7 @@ A checkpoint is every rank's arrays in its own file, ``checkpoint/step<N>-rank<r
 holds the run's tables), and ``checkpoint/state.json``, which names the complete step and carries the run's
 small state. Files are written under temporary names and renamed; state.json is replaced last, after a
 barrier, and older step files are deleted only then, so a run killed at any instant leaves a complete
-checkpoint. What goes in is the run's business (DeformableRun.checkpoint_state); this module only writes
+checkpoint. What goes in is the run's business (DeformableRun.write_checkpoint); this module only writes
 and reads it. Resuming needs the same number of ranks as the run it continues.
 """
 

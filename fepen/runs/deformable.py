@@ -1,6 +1,6 @@
 """The deformable run (``effects.fidelity = "elastic"`` or ``"plastic"``): scene in, results directory out.
 
-The model comes from fepen.runs.setup, the stop rules from fepen.runs.events, the outputs are the objects
+The model comes from fepen.runs.model, the stop rules from fepen.runs.events, the outputs are the objects
 of fepen.runs.outputs. Reported frame (docs/theory.md §7): x along the target face in the direction of
 travel, y depth into the target, both from the impact point, in mm.
 """
@@ -17,7 +17,7 @@ from fepen.geometry.frames import unit_axis
 from fepen.io import files, results
 from fepen.io.fields import FieldWriter
 from fepen.post import analyses, signals, slices
-from fepen.runs import checkpoint, events, outputs, setup
+from fepen.runs import checkpoint, events, model, outputs
 
 #: steps between two checks of the stop rules in the target (each costs a few reductions)
 EVENT_EVERY = 20
@@ -39,7 +39,7 @@ class DeformableRun:
     def __init__(self, scene, out, comm=MPI.COMM_WORLD, progress: bool = False, resume: dict | None = None):
         self.scene, self.comm = scene, comm
         self.wall_t0 = time.perf_counter()
-        self.model = setup.build(scene, comm)
+        self.model = model.build(scene, comm)
         self.out = files.prepare(out, comm)
         m = self.model
         self.pm, self.solver, self.load, self.contact = m.pm, m.solver, m.load, m.contact

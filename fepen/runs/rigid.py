@@ -1,10 +1,9 @@
-"""The rigid fidelity (``effects.fidelity = "rigid"``): the meshed projectile as one rigid body in the
-concrete target law (docs/theory.md §9).
-
-The mesh gives the mass, centre and inertia (exact for tetrahedra) and the surface load points. Every
-rank holds all load points in the same order and integrates the same ODE, so the result does not depend
-on the number of ranks. The stop rules are fepen.runs.events'; a stop on V·a ≤ 0 is interpolated to
-where the speed along the axis vanishes.
+"""The rigid fidelity (``effects.fidelity = "rigid"``): the projectile as one rigid body in the concrete
+target law (docs/theory.md §9). By default the volume mesh gives the mass properties (exact for tetrahedra)
+and the load points (its outer facets on the exact surface); any other set can be handed in, such as the
+mesh-free rings of fepen.geometry.revolution. Every rank integrates the same ODE on all the points. The
+stop rules are fepen.runs.events'; a stop on V·a ≤ 0 is interpolated to where the speed along the axis
+vanishes.
 """
 
 from __future__ import annotations
@@ -27,7 +26,6 @@ from fepen.laws.rigid_body import (
     tet_mass_properties,
 )
 from fepen.runs import events, setup
-from fepen.solver import surface
 
 #: default RK4 step: the time to travel this fraction of a diameter at the striking speed, and at most
 #: 1/STOP_STEPS of the time the quasi-static force alone would take to stop the projectile
@@ -35,24 +33,33 @@ STEP_FRACTION = 0.1
 STOP_STEPS = 300
 
 
-def mass_properties(pm, density: dict, comm):
-    """Mass, reference centre and inertia about the centre of the meshed projectile (all ranks).
+def mesh_points(scene, comm) -> tuple[dict, tuple, int]:
+    """Load points and mass properties from the scene's volume mesh: its outer facets on the exact surface
+    (fepen.solver.surface) and the exact integrals over its cells, summed in the cells' original (gmsh)
+    order, so that the whole rigid trajectory is bitwise the same on any number of ranks.
 
-    The cells are gathered and summed in their original (gmsh) order, so that the sums, and the whole
-    rigid trajectory, are bitwise the same on any number of ranks."""
+    Returns:
+        (points as fepen.geometry.revolution.load_points returns them, (mass, centre, inertia), cells).
+    """
+    from dolfinx import fem
+
+    from fepen.solver import surface
+
+    pm = setup.mesh(scene, comm)
     p = fmesh.cell_points(pm.mesh)
-    rho = np.full(len(p), density[tags.SHELL])
+    rho = np.full(len(p), scene.projectile.material.density)
     if pm.charge:
-        rho[fmesh.owned_cells_tagged(pm, tags.CHARGE)] = density[tags.CHARGE]
+        rho[fmesh.owned_cells_tagged(pm, tags.CHARGE)] = scene.charge.material.density
     key = pm.mesh.topology.original_cell_index[: len(p)]
     parts = comm.allgather((np.asarray(key), p, rho))
-    key = np.concatenate([k for k, _, _ in parts])
-    order = np.argsort(key, kind="stable")
+    order = np.argsort(np.concatenate([k for k, _, _ in parts]), kind="stable")
     p = np.concatenate([q for _, q, _ in parts])[order]
     rho = np.concatenate([r for _, _, r in parts])[order]
     m, first, second = tet_mass_properties(p, rho)
     c, inertia = inertia_about_centre(m, first, second)
-    return m, c, inertia
+    V = fem.VectorFunctionSpace(pm.mesh, ("CG", 1))
+    points = surface.gather_global(surface.outer_surface(V, pm.facet_tags, pm.shape), comm)
+    return points, (m, c, inertia), pm.mesh.topology.index_map(3).size_global
 
 
 class RigidRun:
@@ -62,20 +69,25 @@ class RigidRun:
         scene: resolved Scene (fidelity rigid, concrete target).
         out: results directory (None: write nothing, for sweeps and tests).
         comm: MPI communicator.
+        points: load points (dict as fepen.geometry.revolution.load_points returns), e.g. the rings on the
+            exact surface; default: the volume mesh's outer facets (mesh_points).
+        mass_properties: (mass, centre, inertia); default: the volume mesh's (mesh_points).
     """
 
-    def __init__(self, scene, out, comm=MPI.COMM_WORLD):
-        from dolfinx import fem
-
+    def __init__(self, scene, out, comm=MPI.COMM_WORLD, points: dict | None = None,
+                 mass_properties: tuple | None = None):
         self.scene, self.comm = scene, comm
         self.t0 = time.perf_counter()
-        self.pm = setup.mesh(scene, comm)
-        self.mesh_s = time.perf_counter() - self.t0
+        self.cells = 0  # no volume mesh when both are given
+        if points is None or mass_properties is None:
+            meshed = mesh_points(scene, comm)
+            points, mass_properties = points or meshed[0], mass_properties or meshed[1]
+            self.cells = meshed[2]
+        self.shape = setup.projectile_shape(scene)
+        self.mass, c0, inertia = mass_properties
+        self.pts = g = points
+        self.setup_s = time.perf_counter() - self.t0
         self.out = files.prepare(out, comm) if out is not None else None
-        self.mass, c0, inertia = mass_properties(self.pm, setup.densities(scene), comm)
-        V = fem.VectorFunctionSpace(self.pm.mesh, ("CG", 1))
-        g = surface.gather_global(surface.outer_surface(V, self.pm.facet_tags, self.pm.shape), comm)
-        self.pts = g
         self.body = RigidBody(self.mass, c0, inertia, g["X"], g["N"])
         self.law = setup.target_law(scene)
         R, v = setup.placement(scene)
@@ -87,7 +99,7 @@ class RigidRun:
         self.dt = scene.get("run.rigid_step") or min(STEP_FRACTION * scene.projectile.diameter / self.v0,
                                                       t_stop / STOP_STEPS)
         self.tip_ref = np.zeros(3)
-        self.tail_ref = np.array([0.0, self.pm.shape.length, 0.0])
+        self.tail_ref = np.array([0.0, self.shape.length, 0.0])
         self.rows = []
         self.w_ext = 0.0
         self.ke0 = self.body.kinetic_energy(self.state)
@@ -157,8 +169,8 @@ class RigidRun:
         loop_s = time.perf_counter() - t_loop
         extra = {"steps": self.steps, "dt_s": self.dt, "end_time_s": self.t,
                  "wall_s": time.perf_counter() - self.t0,
-                 "time_split_s": {"mesh": self.mesh_s, "time_loop": loop_s}, "mass_kg": self.mass,
-                 "cells": self.pm.mesh.topology.index_map(3).size_global, "ranks": self.comm.size,
+                 "time_split_s": {"mesh": self.setup_s, "time_loop": loop_s}, "mass_kg": self.mass,
+                 "cells": self.cells, "ranks": self.comm.size,
                  "peak_memory_bytes": files.peak_memory_bytes(self.comm),
                  "load_points": len(self.pts["area0"]), "fidelity": "rigid"}
         summary = results.summary(self.scene, self.rows, outcome or "ended", extra)

@@ -1,13 +1,11 @@
-"""The one door from a scene to the physics: every law, shape, mesh and solver a run needs, built from a
-resolved Scene. No module below fepen.runs reads a scene (docs/theory.md §1-§10 give the defaults'
-reasons).
+"""The one door from a scene to the physics: every law, shape and mesh a run needs, built from a resolved
+Scene (the deformable model on top of them: fepen.runs.model). No module below fepen.runs reads a scene
+(docs/theory.md §1-§10 give the defaults' reasons). Imports no dolfinx: the rigid fidelity needs none.
 """
 
 from __future__ import annotations
 
 import math
-import time
-from dataclasses import dataclass
 
 import numpy as np
 from mpi4py import MPI
@@ -18,7 +16,6 @@ from fepen.geometry import mesh as fmesh
 from fepen.geometry.shape import Shape
 from fepen.laws import materials as M
 from fepen.laws import target as tg
-from fepen.solver import explicit, rigid_wall, shell_charge, surface, target_load
 
 
 # ---------------------------------------------------------------------------------------------------------
@@ -130,76 +127,3 @@ def mesh_metrics(pm: fmesh.ProjectileMesh, scene) -> dict:
     speed = {tags.SHELL: tetra.dilatational_speed(p.youngs_modulus, p.poisson_ratio, p.density),
              tags.CHARGE: tetra.dilatational_speed(c.youngs_modulus, c.poisson_ratio, c.density)}
     return fmesh.metrics(pm, densities(scene), speed, scene.run.safety_factor, scene.mesh.size)
-
-
-# ---------------------------------------------------------------------------------------------------------
-# the deformable model
-# ---------------------------------------------------------------------------------------------------------
-@dataclass
-class Model:
-    """What a deformable run advances.
-
-    Attributes:
-        pm: the projectile mesh. solver: the ExplicitSolver, at its initial state.
-        load: the target (TargetLoad) or the rigid wall (RigidWall), hooked in as ``solver.external``.
-        contact: the shell-charge contact (hooked in as ``solver.interface``), or None.
-        tip, tail: node handles of the nose tip and the tail centre (ExplicitSolver.node_at).
-        v0: striking speed (m/s). surface: the target's load points (None on the rigid wall).
-        law: the target law (None on the rigid wall). mesh_s, setup_s: wall seconds meshing and building.
-    """
-
-    pm: fmesh.ProjectileMesh
-    solver: explicit.ExplicitSolver
-    load: explicit.Load
-    contact: shell_charge.ShellChargeContact | None
-    tip: tuple[int, int]
-    tail: tuple[int, int]
-    v0: float
-    surface: surface.Surface | None
-    law: tg.TargetLaw | None
-    mesh_s: float
-    setup_s: float
-
-
-def solver(scene, pm: fmesh.ProjectileMesh, kernel: str | None = None) -> explicit.ExplicitSolver:
-    """The explicit solver on a scene's mesh: the shell's material, and the charge's on its cells.
-
-    Args:
-        kernel: "C", "numba" or None (the C trial pass where it can be built).
-    """
-    mats = [projectile_material(scene)]
-    cellmat = np.zeros(pm.mesh.topology.index_map(3).size_local, dtype=np.int64)
-    if pm.charge:  # material 1: the charge, tied through shared wall nodes or in contact (split)
-        mats.append(charge_material(scene))
-        cellmat[fmesh.owned_cells_tagged(pm, tags.CHARGE)] = 1
-    s = explicit.ExplicitSolver(pm.mesh, mats, cellmat, scene.run.safety_factor, kernel=kernel)
-    if scene.run.stable_step == "eigenvalue":
-        s.calibrate_step()
-    return s
-
-
-def build(scene, comm: MPI.Comm = MPI.COMM_WORLD) -> Model:
-    """Mesh, solver, target or wall, contact and initial state of a deformable run."""
-    t0 = time.perf_counter()
-    pm = mesh(scene, comm)
-    mesh_s = time.perf_counter() - t0
-    t0 = time.perf_counter()
-    s = solver(scene, pm)
-    contact = None
-    if pm.split:
-        contact = shell_charge.ShellChargeContact(s, pm.facet_tags, scene.charge.friction)
-        s.interface = contact
-    tip = s.node_at((0.0, 0.0, 0.0))
-    tail = s.node_at((0.0, pm.shape.length, 0.0))
-    R, v = placement(scene)
-    v0 = float(np.linalg.norm(v))
-    surf = law = None
-    if scene.target.kind == "concrete":
-        law = target_law(scene)
-        surf = surface.outer_surface(s.V, pm.facet_tags, pm.shape)
-        load = target_load.TargetLoad(s, surf, law, tip, tail, crater(scene, law, s.total_mass, v0))
-    else:
-        load = rigid_wall.RigidWall(s)
-    s.external = load
-    s.set_initial(displacement=lambda X: X @ R.T - X, velocity=lambda X: np.tile(v, (len(X), 1)))
-    return Model(pm, s, load, contact, tip, tail, v0, surf, law, mesh_s, time.perf_counter() - t0)
