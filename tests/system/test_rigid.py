@@ -23,6 +23,15 @@ CLOSED_FORM = ["effects.fidelity=rigid", f"target.quasi_static_stress={SIGMA_S}"
                "impact.obliquity_deg=0", "impact.attack_deg=0"]
 
 
+def nose_force(sc, law, g, crh, speed):
+    """The target's forces on load points g moving along the axis at speed, and the closed-form axial force."""
+    st = tg.SurfaceState(g["X"] - [0.0, 1.0, 0.0], np.tile([0.0, -speed, 0.0], (len(g["X"]), 1)), g["N"],
+                         g["area0"], g["radius"], g["R_meridian"], g["sin_phi0"], np.array([0.0, -1.0, 0.0]))
+    f, _ = tg.forces(law, st)
+    a = 0.5 * sc.projectile.diameter
+    return f, math.pi * a * a * (SIGMA_S + tg.ogive_nose_factor(crh) * 2400.0 * speed**2)
+
+
 @pytest.mark.parametrize("crh", [1.0, 2.0, 3.0, 4.5, 6.0])
 def test_nose_force_on_the_exact_surface(crh):
     """The rigid fidelity's load points (rings on the exact surface, fepen.geometry.revolution) of a tangent
@@ -32,11 +41,7 @@ def test_nose_force_on_the_exact_surface(crh):
     g = revolution.load_points(setup.projectile_shape(sc), sc.mesh.size)
     law = setup.target_law(sc)
     for speed in (300.0, 900.0):
-        st = tg.SurfaceState(g["X"] - [0.0, 1.0, 0.0], np.tile([0.0, -speed, 0.0], (len(g["X"]), 1)), g["N"],
-                             g["area0"], g["radius"], g["R_meridian"], g["sin_phi0"], np.array([0.0, -1.0, 0.0]))
-        f, _ = tg.forces(law, st)
-        a = 0.5 * sc.projectile.diameter
-        expect = math.pi * a * a * (SIGMA_S + tg.ogive_nose_factor(crh) * 2400.0 * speed**2)
+        f, expect = nose_force(sc, law, g, crh, speed)
         assert f[:, 1].sum() == pytest.approx(expect, rel=1e-5)
         assert abs(f[:, 0].sum()) < 1e-12 * expect and abs(f[:, 2].sum()) < 1e-12 * expect
 
@@ -51,11 +56,7 @@ def test_nose_force_at_the_default_mesh(crh):
     g = surface.gather_global(surface.outer_surface(V, pm.facet_tags, pm.shape), MPI.COMM_SELF)
     law = setup.target_law(sc)
     for speed in (300.0, 900.0):
-        st = tg.SurfaceState(g["X"] - [0.0, 1.0, 0.0], np.tile([0.0, -speed, 0.0], (len(g["X"]), 1)), g["N"],
-                             g["area0"], g["radius"], g["R_meridian"], g["sin_phi0"], np.array([0.0, -1.0, 0.0]))
-        f, _ = tg.forces(law, st)
-        a = 0.5 * sc.projectile.diameter
-        expect = math.pi * a * a * (SIGMA_S + tg.ogive_nose_factor(crh) * 2400.0 * speed**2)
+        f, expect = nose_force(sc, law, g, crh, speed)
         assert f[:, 1].sum() == pytest.approx(expect, rel=5e-3)
         assert abs(f[:, 0].sum()) < 3e-3 * expect and abs(f[:, 2].sum()) < 3e-3 * expect
 
