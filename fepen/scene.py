@@ -150,10 +150,16 @@ SCHEMA: dict[str, Key] = {
     "target.tensile_strength": _pos(_ABSENT, "Pa", 1.0e10, doc="absent: compressive_strength / 10"),
     "target.pressure_hardening": _num(0.67, "", 0.0, 3.0, hi_open=True, doc="lambda of Mohr-Coulomb"),
     "target.crater_depth_factor": _num(2.37, "", 0.0, 50.0, doc="crater depth k over diameter"),
+    "target.strength_model": _choice("cavity-expansion", "cavity-expansion", "forrestal-S",
+                                     doc="sigma_s from the elastic-cracked-plastic cavity expansion, or "
+                                         "Forrestal's empirical S(fc) fc with S = 82.6 fc^-0.544 (fc in MPa)"),
     "target.quasi_static_stress": _pos(_ABSENT, "Pa", 1.0e11,
-                                       doc="overrides the cavity-expansion sigma_s; absent: computed"),
+                                       doc="overrides the strength model's sigma_s; absent: computed"),
     "target.inertial_factor": _num(1.0, "", 0.0, 10.0, doc="B of sigma_n = sigma_s + B rho (v.n)^2"),
-    "target.friction": _num(0.1, "", 0.0, 2.0, doc="Coulomb coefficient, used when effects.friction"),
+    "target.friction": _num(0.1, "", 0.0, 2.0, doc="Coulomb (static) coefficient, used when effects.friction"),
+    "target.friction_dynamic": _num(_ABSENT, "", 0.0, 2.0,
+                                    doc="mu_d of mu(v_t) = mu_d + (mu - mu_d) exp(-c v_t); absent: target.friction"),
+    "target.friction_decay": _num(0.0, "s/m", 0.0, 1.0e3, doc="c of the sliding law; 0: constant Coulomb mu"),
     "target.separation_angle_deg": _num(0.0, "deg", 0.0, 90.0, hi_open=True),
     "target.onset_angle_deg": _num(0.0, "deg", 0.0, 30.0,
                                    doc="sigma_s develops over this first surface angle (0: at once)"),
@@ -411,6 +417,9 @@ def _check_consistency(flat: dict, given: dict) -> None:
                                                 f"target.density = {flat['target.density']:g} kg/m^3")
     if "target.tensile_strength" not in flat:
         flat["target.tensile_strength"] = 0.1 * flat["target.compressive_strength"]
+    if flat.get("target.friction_dynamic", 0.0) > flat["target.friction"]:
+        raise InputError("target.friction_dynamic", f"{flat['target.friction_dynamic']:g}: the sliding coefficient "
+                                                    f"must be at most target.friction = {flat['target.friction']:g}")
     if "mesh.nose_size" in flat and flat["mesh.nose_size"] > flat["mesh.size"]:
         raise InputError("mesh.nose_size", f"must be at most mesh.size = {flat['mesh.size']:g} m")
 

@@ -72,7 +72,8 @@ class TargetLaw:
         crater: "none", "linear" or "energy"; k: crater depth factor; D: projectile diameter (m).
         separation, phi_min: switch and minimum separation angle (rad).
         free_surface: switch the plastic-zone truncation by the face.
-        friction, mu: Coulomb friction switch and coefficient.
+        friction, mu: friction switch and (static) coefficient; mu_dynamic (None: mu) and mu_decay (s/m):
+            the velocity-dependent sliding law (sliding_friction).
         lock_density: Q1 of the energy crater (kg/m^3); crush_strain: ε of the energy crater.
         c_over_a: plastic-zone ratio of the cavity expansion.
     """
@@ -93,6 +94,8 @@ class TargetLaw:
     free_surface: bool = False
     friction: bool = False
     mu: float = 0.0
+    mu_dynamic: float | None = None
+    mu_decay: float = 0.0
     lock_density: float = 2650.0
     crush_strain: float = 0.094
     c_over_a: float = 1.0
@@ -249,8 +252,19 @@ def forces(law: TargetLaw, s: SurfaceState):
         vt = s.v - vn[:, None] * s.n
         speed_t = np.linalg.norm(vt, axis=1)
         slide = speed_t > 1e-9
-        f[slide] -= (law.mu * sig[slide] * s.area[slide] / speed_t[slide])[:, None] * vt[slide]
+        mu = sliding_friction(law, speed_t[slide])
+        f[slide] -= (mu * sig[slide] * s.area[slide] / speed_t[slide])[:, None] * vt[slide]
     return f, sig
+
+
+def sliding_friction(law: TargetLaw, speed_t):
+    """The friction coefficient at tangential sliding speed |v_t| (m/s): μ_d + (μ_s − μ_d) e^(−c |v_t|),
+    LS-DYNA's FS, FD, DC form (docs/theory.md §8.5), with μ_s = law.mu, μ_d = law.mu_dynamic, c =
+    law.mu_decay; the constant Coulomb coefficient law.mu when c = 0 or μ_d = μ_s."""
+    mu_d = law.mu if law.mu_dynamic is None else law.mu_dynamic
+    if law.mu_decay == 0.0 or mu_d == law.mu:
+        return law.mu
+    return mu_d + (law.mu - mu_d) * np.exp(-law.mu_decay * np.asarray(speed_t))
 
 
 @dataclass

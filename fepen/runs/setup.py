@@ -42,12 +42,18 @@ def target_law(scene) -> tg.TargetLaw:
     t, e = scene.target, scene.effects
     Y, E, T, lam = t.compressive_strength, t.youngs_modulus, t.tensile_strength, t.pressure_hardening
     given = scene.get("target.quasi_static_stress")
-    sigma_s = given if given is not None else float(tg.quasi_static_stress(Y, E, T, lam))
+    if given is not None:
+        sigma_s = given
+    elif t.strength_model == "forrestal-S":
+        sigma_s = tg.forrestal_S(Y) * Y
+    else:
+        sigma_s = float(tg.quasi_static_stress(Y, E, T, lam))
     return tg.TargetLaw(
         density=t.density, Y=Y, E=E, T=T, lam=lam, sigma_s=sigma_s, B=t.inertial_factor,
         thickness=scene.get("target.thickness"), crater=e.crater, k=t.crater_depth_factor,
         D=scene.projectile.diameter, separation=e.separation, phi_min=math.radians(t.separation_angle_deg),
         free_surface=e.free_surface, friction=e.friction, mu=t.friction,
+        mu_dynamic=scene.get("target.friction_dynamic"), mu_decay=t.friction_decay,
         lock_density=t.lock_density, crush_strain=1.0 - t.density / t.lock_density,
         c_over_a=tg.cavity_ratio(Y, E, T), given_sigma_s=given is not None,
         onset=math.radians(t.onset_angle_deg))

@@ -102,3 +102,10 @@ def test_cli_bad_toml_file(fepen_cli, tmp_path):
     f.write_text("[impact\nvelocity = 3\n")
     r = fepen_cli("mesh", f, "--out", tmp_path / "o")
     assert r.returncode == 2 and "not valid TOML" in r.stderr and "Traceback" not in r.stderr
+
+
+def test_sliding_friction_must_not_exceed_the_static_one():
+    with pytest.raises(InputError) as err:
+        scene.load(None, ["target.friction=0.1", "target.friction_dynamic=0.2"])
+    assert err.value.key == "target.friction_dynamic"
+    assert scene.load(None, ["target.friction_dynamic=0.05"]).target.friction_dynamic == 0.05

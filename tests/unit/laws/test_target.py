@@ -1,6 +1,7 @@
 """The target resistance law on plain arrays (no mesh): limits, closed forms, switches."""
 
 import math
+from dataclasses import replace
 
 import numpy as np
 import pytest
@@ -181,3 +182,29 @@ def test_sigma_s_onset_ramps_over_the_first_degrees():
     ramp = np.sin(ang[:2]) / math.sin(math.radians(2.0))
     assert sig[:2] == pytest.approx(300e6 * ramp + inertial[:2], rel=1e-12)
     assert sig[2] == pytest.approx(300e6 + inertial[2], rel=1e-12)
+
+
+def test_velocity_dependent_sliding_friction_limits():
+    """mu(v) = mu_d + (mu_s - mu_d) exp(-c |v|): mu_s at rest, mu_d when sliding fast, the constant Coulomb
+    mu when c = 0 or mu_d = mu_s; the tangential force is mu(v_t) sigma_n A against the sliding velocity."""
+    base = tg.TargetLaw(density=2400.0, Y=40e6, E=32.5e9, T=4e6, lam=0.67, sigma_s=400e6, friction=True, mu=0.3)
+    assert tg.sliding_friction(base, np.array([0.0, 500.0])) == 0.3
+    law = replace(base, mu_dynamic=0.05, mu_decay=0.02)
+    mu = tg.sliding_friction(law, np.array([0.0, 1.0 / 0.02, 1e4]))
+    assert mu == pytest.approx([0.3, 0.05 + 0.25 / np.e, 0.05], rel=1e-12)
+    # a point pressed into the target (v.n = 100 m/s) sliding at 300 m/s along x
+    st = tg.SurfaceState(np.array([[0.0, -0.05, 0.0]]), np.array([[300.0, -100.0, 0.0]]),
+                         np.array([[0.0, -1.0, 0.0]]), np.array([1e-4]), np.array([0.01]), np.array([np.inf]),
+                         np.array([0.0]), None)
+    f, sig = tg.forces(law, st)
+    assert f[0, 0] == pytest.approx(-tg.sliding_friction(law, 300.0) * sig[0] * 1e-4, rel=1e-12)
+    assert f[0, 1] == pytest.approx(sig[0] * 1e-4, rel=1e-12)  # the normal part is unchanged
+
+
+def test_forrestal_strength_model_gives_s_fc():
+    for fc in (13.5e6, 40e6, 62.8e6):
+        law = setup.target_law(scene.load(None, ["target.strength_model=forrestal-S",
+                                                 f"target.compressive_strength={fc}"]))
+        assert law.sigma_s == pytest.approx(82.6 * (fc / 1e6) ** -0.544 * fc, rel=1e-12)
+    cavity = setup.target_law(scene.load(None, []))
+    assert cavity.sigma_s == pytest.approx(369e6, rel=0.01)  # theory.md §8.1, the paper's concrete
