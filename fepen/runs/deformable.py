@@ -108,12 +108,12 @@ class DeformableRun:
             return None
         if events.beyond_method(s.max_peeq(), self.scene.projectile.failure_strain):
             self._beyond_method()
-        pts = m.surface.kinematics(s.positions(), s.Vel)[0]
+        x = s.positions()
+        pts = m.surface.kinematics(x, s.Vel)[0]
         y_min = self.comm.allreduce(float(pts[:, 1].min()) if len(pts) else np.inf, op=MPI.MIN)
         y_max = self.comm.allreduce(float(pts[:, 1].max()) if len(pts) else -np.inf, op=MPI.MAX)
         if not (self.rules.entered or y_min < 0.0):
             return None  # not in the target yet
-        x = s.positions()
         axis = unit_axis(s.node_value(m.tip, x), s.node_value(m.tail, x))
         return self.rules.penetration(y_min, y_max, s.momentum_velocity(), axis, s.total_mass, s.ke0)
 

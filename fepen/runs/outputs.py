@@ -31,14 +31,18 @@ class Clock:
             self.next += self.interval
 
 
-class History:
-    """The history row, strain gauges and charge sections (``run.record()``) at every interval."""
+class Timed:
+    """An output due on its Clock of simulated time."""
 
-    def __init__(self, interval: float):
-        self.clock = Clock(interval)
+    def __init__(self, interval: float, first: float = 0.0):
+        self.clock = Clock(interval, first)
 
     def due(self, run) -> bool:
         return self.clock.due(run.solver.t)
+
+
+class History(Timed):
+    """The history row, strain gauges and charge sections (``run.record()``) at every interval."""
 
     def write(self, run) -> None:
         run.record()
@@ -48,14 +52,8 @@ class History:
         run.write_history()  # kept even when the run failed
 
 
-class Fields:
+class Fields(Timed):
     """fields.xdmf / fields.h5 (``run.write_fields()``) at every run.output_interval, history.csv with them."""
-
-    def __init__(self, interval: float):
-        self.clock = Clock(interval)
-
-    def due(self, run) -> bool:
-        return self.clock.due(run.solver.t)
 
     def write(self, run) -> None:
         t0 = perf_counter()
@@ -68,14 +66,8 @@ class Fields:
         run.fields.consolidate()
 
 
-class Checkpoint:
+class Checkpoint(Timed):
     """A checkpoint (``run.write_checkpoint()``) at every run.checkpoint_interval, history.csv with it."""
-
-    def __init__(self, interval: float, first: float):
-        self.clock = Clock(interval, first)
-
-    def due(self, run) -> bool:
-        return self.clock.due(run.solver.t)
 
     def write(self, run) -> None:
         t0 = perf_counter()
