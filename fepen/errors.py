@@ -10,8 +10,11 @@ class InputError(ValueError):
     exit_code = 2
 
     def __init__(self, key: str, message: str):
-        self.key = key
+        self.key, self.message = key, message
         super().__init__(f"{key}: {message}" if key else message)
+
+    def __reduce__(self):  # picklable, so that it crosses a process pool whole
+        return (type(self), (self.key, self.message))
 
 
 class SimulationError(RuntimeError):

@@ -297,3 +297,106 @@ class Shape:
         out = replace(self, cavity_length=shortest.cavity_length + extra)
         out.check()
         return out
+
+
+#: shortest cavity worth keeping, in its own diameters: below this a sized cavity is reduced instead
+MIN_CAVITY_ASPECT = 1.0
+#: narrowest cavity worth keeping, as a fraction of the outer diameter: below this the body is made solid
+MIN_CAVITY_FRACTION = 0.05
+#: largest change of the steel density the mass rule makes when no cavity reaches the mass
+MAX_DENSITY_CHANGE = 0.25
+
+
+@dataclass(frozen=True)
+class Built:
+    """A projectile built to a mass (reach_mass).
+
+    Attributes:
+        shape: the exact geometry. shell_density: the steel's density used (kg/m^3), the scene's unless the
+        body had to be made solid with an adjusted density. note: one line saying what was changed, "" if
+        the given cavity was only sized.
+    """
+
+    shape: Shape
+    shell_density: float
+    note: str = ""
+
+
+def reach_mass(shape: Shape, mass: float, shell_density: float, charge_density: float | None = None,
+               adapt: bool = True) -> Built:
+    """The projectile of this outside with this total mass (docs/theory.md §1.1, the mass-reaching rule).
+
+    In order, the first that reaches the mass:
+      1. the given cavity (both sections), its length sized (the paper's rule), if the cavity is at least
+         MIN_CAVITY_ASPECT diameters long;
+      2. one cylindrical cavity (the step dropped), as long as fits, its diameter sized, between
+         MIN_CAVITY_FRACTION of the calibre and the widest that keeps the minimum wall;
+      3. lighter than the widest cavity: that cavity with the steel density lowered; heavier than
+         solid: a solid body with the steel density adjusted to the mass (said in the note), by at most
+         MAX_DENSITY_CHANGE; beyond, InputError.
+
+    Args:
+        shape: the checked outside and the wanted cavity (its length a first guess).
+        mass: total mass (kg). shell_density, charge_density: kg/m^3 (charge None: an empty cavity).
+        adapt: False keeps rule 1 only (the user fixed the cavity; InputError if unreachable).
+
+    Returns:
+        Built. Raises InputError (key projectile.mass) when rule 1 fails and adapt is False, or when a
+        filled cavity cannot be kept.
+    """
+    first = None
+    if shape.cavity_diameter > 0.0:
+        try:
+            out = shape.with_mass(mass, shell_density, charge_density)
+            if out.cavity_length >= MIN_CAVITY_ASPECT * out.cavity_diameter or not adapt:
+                return Built(out, shell_density)
+        except InputError as err:
+            first = err
+    if not adapt and first is not None:
+        raise first
+    # rule 2: one cylinder of the longest length that fits, its diameter sized (mass is linear in r²)
+    rho_fill = charge_density or 0.0
+    solid = replace(shape, cavity_diameter=0.0, cavity_length=0.0, step_diameter=0.0, step_length=0.0)
+    m_solid = solid.mass(shell_density)
+    widest = shape.diameter - 2.0 * shape._min_wall()
+    narrowest = MIN_CAVITY_FRACTION * shape.diameter
+    if widest > narrowest and shape.base_thickness < shape.length - shape.nose_length:
+        z_rear = shape.length - shape.base_thickness
+        # the longest length is set by the widest cavity; narrower ones fit that length too
+        length = max(0.0, z_rear - shape.front_limit(0.5 * widest * (1.0 - 1e-9)))
+        if length > 0.0:
+            need = (m_solid - mass) / ((shell_density - rho_fill) * math.pi * length)  # r²
+            if need > 0.0 and narrowest <= 2.0 * math.sqrt(need) <= widest:
+                d = 2.0 * math.sqrt(need)
+                out = replace(solid, cavity_diameter=d, cavity_length=length)
+                out.check()
+                return Built(out, shell_density,
+                             f"projectile.mass {mass:g} kg: cavity {1e3 * d:.2f} mm x {1e3 * length:.1f} mm "
+                             f"(one section; the given {1e3 * shape.cavity_diameter:g} mm cavity"
+                             f"{' with its step' if shape.step_length > 0 else ''} cannot reach it)")
+            if need > 0.0 and 2.0 * math.sqrt(need) > widest and charge_density is None:
+                # lighter than the widest cavity: keep it, lighten the steel
+                out = replace(solid, cavity_diameter=widest * (1.0 - 1e-9), cavity_length=length)
+                rho = mass / out.shell_volume()
+                if rho >= shell_density * (1.0 - MAX_DENSITY_CHANGE):
+                    out.check()
+                    return Built(out, rho, f"projectile.mass {mass:g} kg: widest cavity {1e3 * widest:.2f} mm x "
+                                           f"{1e3 * length:.1f} mm and steel density adjusted to {rho:.1f} kg/m^3 "
+                                           f"({rho / shell_density - 1:+.1%}; lighter than any cavity makes it)")
+    if charge_density is not None:
+        raise first or InputError("projectile.mass", f"{mass:g} kg cannot be reached with a charge-filled "
+                                                     f"cavity in this outside (solid: {m_solid:.4g} kg)")
+    rho = mass / solid.outer_volume()
+    if abs(rho / shell_density - 1.0) > MAX_DENSITY_CHANGE:
+        lightest = min(m_solid, shell_density * (1.0 - MAX_DENSITY_CHANGE) * solid.outer_volume())
+        if widest > narrowest:
+            lightest = min(lightest, (1.0 - MAX_DENSITY_CHANGE) * replace(
+                solid, cavity_diameter=widest * (1.0 - 1e-9),
+                cavity_length=max(0.0, shape.length - shape.base_thickness
+                                  - shape.front_limit(0.5 * widest * (1.0 - 1e-9)))).mass(shell_density))
+        raise InputError("projectile.mass", f"{mass:g} kg cannot be reached in this outside: must be in "
+                                            f"[{lightest:.4g}, {m_solid * (1.0 + MAX_DENSITY_CHANGE):.4g}] kg "
+                                            f"(a cavity, or the steel density changed by at most "
+                                            f"{MAX_DENSITY_CHANGE:.0%})")
+    return Built(solid, rho, f"projectile.mass {mass:g} kg: solid body, steel density adjusted to "
+                             f"{rho:.1f} kg/m^3 ({rho / shell_density - 1:+.1%}; no cavity reaches it)")

@@ -55,8 +55,9 @@ def test_charge_filled_cavity_is_sized_on_total_mass():
 
 
 @pytest.mark.parametrize("sets, key", [
-    (["projectile.mass=0.5"], "projectile.mass"),
-    (["projectile.mass=0.2"], "projectile.mass"),
+    (["projectile.mass=0.5", "projectile.cavity_diameter=0.012"], "projectile.mass"),
+    (["projectile.mass=0.2", "projectile.cavity_step_length=0.02"], "projectile.mass"),
+    (["projectile.mass=0.2", "effects.charge=true"], "projectile.mass"),
     (["projectile.cavity_diameter=0.03"], "projectile.cavity_diameter"),
     (["projectile.cavity_diameter=0.0230"], "projectile.cavity_diameter"),
     (["projectile.cavity_step_diameter=0.014"], "projectile.cavity_step_diameter"),
@@ -67,6 +68,57 @@ def test_impossible_geometry_names_the_key(sets, key):
     with pytest.raises(InputError) as err:
         setup.projectile_shape(scene.load(None, sets))
     assert err.value.key == key
+
+
+def _mass_rule_cases():
+    """24 projectiles: diameters 10-80 mm, L/D 4-12, CRH 1-6, masses from the lightest hollow body to
+    slightly over the solid one (fractions of the solid mass)."""
+    cases = []
+    for i, (D, LD, crh) in enumerate([(0.010, 4, 1.0), (0.0129, 8, 3.0), (0.0203, 6, 3.0), (0.0236, 6.1, 3.0),
+                                      (0.0305, 10, 3.0), (0.050, 12, 6.0), (0.0762, 7, 4.5), (0.080, 4, 2.0)]):
+        for frac in ((0.55, 0.8, 0.995) if i % 2 else (0.7, 0.93, 1.02)):
+            cases.append((D, LD * D, crh, frac))
+    return cases
+
+
+@pytest.mark.parametrize("D, L, crh, frac", _mass_rule_cases())
+def test_mass_rule_builds_any_projectile_to_its_mass(D, L, crh, frac):
+    """issue 13 item 4: an outside and a mass are enough; the default cavity is sized, reduced or dropped
+    (a solid with adjusted density last), within 0.5 % of the mass, and a change is said in one line."""
+    rho = 7850.0
+    solid = Shape(D, L, "ogive", crh)
+    mass = frac * rho * solid.outer_volume()
+    sc = scene.load(None, [f"projectile.diameter={D}", f"projectile.length={L}", f"projectile.crh={crh}",
+                           f"projectile.mass={mass}"])
+    built = setup.projectile(sc)
+    built.shape.check()
+    got = built.shape.mass(built.shell_density)
+    assert got == pytest.approx(mass, rel=5e-3)
+    default = Shape(D, L, "ogive", crh, 0.012, 0.0, 0.008, 0.020, 0.015)
+    kept = (built.shape.cavity_diameter == default.cavity_diameter and built.shape.step_length == 0.020)
+    assert kept or built.note.startswith("projectile.mass")
+    if built.shell_density != rho:
+        assert not built.shape.has_cavity and "density adjusted" in built.note
+        assert abs(built.shell_density / rho - 1.0) <= 0.03  # only near-solid masses come here
+    if built.shape.has_cavity:  # the thinnest wall is kept everywhere
+        assert built.shape.cavity_length <= built.shape.max_cavity_length() * (1 + 1e-9)
+
+
+def test_mass_rule_prefers_the_given_cavity():
+    """The paper's projectile keeps its two-section cavity, only sized, with no note."""
+    built = setup.projectile(scene.load(None, []))
+    assert built.note == "" and built.shape.step_length == 0.020 and built.shell_density == 7850.0
+
+
+def test_bad_outside_is_refused_without_meshing():
+    """A nose longer than the body is refused by the exact geometry, before gmsh is imported."""
+    import subprocess
+    import sys
+    code = ("import sys; from fepen import scene; from fepen.runs import setup; from fepen.errors import InputError\n"
+            "try:\n    setup.projectile(scene.load(None, ['projectile.length=0.03', 'projectile.mass=0.1']))\n"
+            "except InputError as e:\n    print(e.key, 'gmsh' in sys.modules, 'dolfinx' in sys.modules)")
+    out = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True, check=True).stdout.split()
+    assert out == ["projectile.length", "False", "False"]
 
 
 def test_solid_flat_rod():
