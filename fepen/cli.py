@@ -42,6 +42,15 @@ def _parser() -> argparse.ArgumentParser:
                "results/validation")
     scene_args(sub.add_parser("mesh", help="build the projectile mesh only: mesh.json, mesh.xdmf, mesh.png"),
                "results/mesh")
+    vd = sub.add_parser("validate-depth", help="depth data sets by the rigid fidelity and Forrestal's closed "
+                                               "form: depth.csv, depth.md, depth.png")
+    vd.add_argument("--data", action="append", default=[], metavar="PATH",
+                    help="a depth data set (CSV, docs/validation-depth.md) or a folder of them; repeatable")
+    vd.add_argument("--only", action="store_true", help="run only the --data sets (not table1 and the shipped)")
+    vd.add_argument("--set", dest="sets", action="append", default=[], metavar="KEY=VALUE",
+                    help="override a scene key in every rigid run (e.g. target.strength_model=forrestal-S)")
+    vd.add_argument("--out", default="results/validate-depth", help="results directory")
+    vd.add_argument("--workers", type=int, default=1, help="processes at once (default 1)")
     st = sub.add_parser("study", help="accuracy-cost: what accuracy costs in time (study.md, pareto.png)")
     st.add_argument("which", choices=["accuracy-cost"])
     st.add_argument("--out", default="results/study", help="results directory (default results/study)")
@@ -71,7 +80,11 @@ def cmd_mesh(args) -> int:
 
     comm = MPI.COMM_WORLD
     sc = fscene.load(args.scene, args.sets)
-    setup.projectile_shape(sc)  # geometry errors before anything is written
+    note = setup.projectile(sc).note  # geometry errors before anything is written
+    if note and comm.rank == 0:
+        import logging
+
+        logging.getLogger("fepen").warning(note)
     pm = setup.mesh(sc, comm)
     info = setup.mesh_metrics(pm, sc)
     out = files.prepare(args.out, comm)
@@ -124,6 +137,18 @@ def cmd_validate(args) -> int:
     return 0
 
 
+def cmd_validate_depth(args) -> int:
+    """Depth data sets: the table per set and the predicted-against-measured figure."""
+    from fepen.studies import depth
+
+    table = depth.validate_depth(args.data, args.sets, args.out, args.workers, shipped=not args.only)
+    _say(*(f"{r['set']}: {r['count']} shots; mean |error| default {100 * r['default mean_abs']:.1f} % "
+           f"(bias {100 * r['default bias']:+.1f} %), forrestal-S {100 * r['forrestal-S mean_abs']:.1f} %, "
+           f"closed form {100 * r['closed form mean_abs']:.1f} %" for r in table),
+         f"written: {args.out}/depth.csv, depth.md, depth.png")
+    return 0
+
+
 def cmd_study(args) -> int:
     """The accuracy-cost study (each run its own process, on --ranks MPI ranks)."""
     from mpi4py import MPI
@@ -147,7 +172,8 @@ def cmd_keys(args) -> int:
     return 0
 
 
-COMMANDS = {"run": cmd_run, "mesh": cmd_mesh, "validate": cmd_validate, "study": cmd_study, "keys": cmd_keys}
+COMMANDS = {"run": cmd_run, "mesh": cmd_mesh, "validate": cmd_validate, "validate-depth": cmd_validate_depth,
+            "study": cmd_study, "keys": cmd_keys}
 
 
 def main(argv: list[str] | None = None) -> int:
@@ -168,12 +194,7 @@ def _quiet() -> None:
     import logging
 
     logging.getLogger("dolfinx").setLevel(logging.WARNING)
-    try:
-        import dolfinx.log
-
-        dolfinx.log.set_log_level(dolfinx.log.LogLevel.WARNING)
-    except Exception:  # pragma: no cover - logging is cosmetic
-        pass
+    logging.basicConfig(format="fepen: %(message)s", level=logging.INFO)
 
 
 def _error(line: str) -> None:

@@ -6,6 +6,7 @@ Scene (the deformable model on top of them: fepen.runs.model). No module below f
 from __future__ import annotations
 
 import math
+from dataclasses import replace
 
 import numpy as np
 from mpi4py import MPI
@@ -13,7 +14,7 @@ from mpi4py import MPI
 from fepen.errors import InputError
 from fepen.geometry import gmsh_model, tags, tetra
 from fepen.geometry import mesh as fmesh
-from fepen.geometry.shape import Shape
+from fepen.geometry.shape import Built, Shape, reach_mass
 from fepen.laws import materials as M
 from fepen.laws import target as tg
 
@@ -24,9 +25,10 @@ from fepen.laws import target as tg
 def projectile_material(scene) -> M.Material:
     """The projectile material: elastic or Johnson-Cook by effects.fidelity."""
     m = scene.projectile.material
+    rho = projectile(scene).shell_density
     if scene.effects.fidelity == "elastic":
-        return M.elastic(m.youngs_modulus, m.poisson_ratio, m.density)
-    return M.johnson_cook(m.youngs_modulus, m.poisson_ratio, m.density, m.A, m.B, m.n, m.C, m.m,
+        return M.elastic(m.youngs_modulus, m.poisson_ratio, rho)
+    return M.johnson_cook(m.youngs_modulus, m.poisson_ratio, rho, m.A, m.B, m.n, m.C, m.m,
                           m.melt_temperature, m.room_temperature, m.reference_strain_rate, m.specific_heat,
                           m.taylor_quinney, scene.effects.strain_rate, scene.effects.thermal)
 
@@ -40,12 +42,17 @@ def charge_material(scene) -> M.Material:
 def target_law(scene) -> tg.TargetLaw:
     """The concrete target law (docs/theory.md §8)."""
     t, e = scene.target, scene.effects
-    Y, E, T, lam = t.compressive_strength, t.youngs_modulus, t.tensile_strength, t.pressure_hardening
+    Y, T, lam = t.compressive_strength, t.tensile_strength, t.pressure_hardening
+    E = scene.get("target.youngs_modulus") or tg.youngs_modulus_aci(Y)
     given = scene.get("target.quasi_static_stress")
     if given is not None:
         sigma_s = given
-    elif t.strength_model == "forrestal-S":
-        sigma_s = tg.forrestal_S(Y) * Y
+    elif t.strength_model in tg.S_MODELS:
+        a, b, size = tg.S_MODELS[t.strength_model]
+        a = scene.get("target.S_coefficient") or a
+        b = scene.get("target.S_exponent") if scene.get("target.S_exponent") is not None else b
+        size = scene.get("target.S_size") or size
+        sigma_s = tg.strength_S(Y, scene.projectile.diameter, a, b, size) * Y
     else:
         sigma_s = float(tg.quasi_static_stress(Y, E, T, lam))
     return tg.TargetLaw(
@@ -55,14 +62,25 @@ def target_law(scene) -> tg.TargetLaw:
         free_surface=e.free_surface, friction=e.friction, mu=t.friction,
         mu_dynamic=scene.get("target.friction_dynamic"), mu_decay=t.friction_decay,
         lock_density=t.lock_density, crush_strain=1.0 - t.density / t.lock_density,
-        c_over_a=tg.cavity_ratio(Y, E, T), given_sigma_s=given is not None,
+        c_over_a=tg.cavity_ratio(Y, E, T),
+        given_sigma_s=given is not None or t.strength_model != "cavity-expansion",
         onset=math.radians(t.onset_angle_deg))
 
 
-def projectile_shape(scene) -> Shape:
-    """The checked exact geometry (cavity sized from projectile.mass if given); InputError if impossible."""
+#: cavity keys that, when the user gives any of them, fix the cavity (its length is still sized to the mass)
+CAVITY_KEYS = ("projectile.cavity_diameter", "projectile.cavity_length", "projectile.cavity_step_diameter",
+               "projectile.cavity_step_length")
+
+
+def projectile(scene) -> Built:
+    """The checked exact projectile built to projectile.mass by the mass-reaching rule
+    (fepen.geometry.shape.reach_mass): the given cavity sized, else reduced or dropped, with one line in
+    Built.note saying what was chosen. A cavity the user gave explicitly is only sized (InputError if the
+    mass is out of its reach). InputError on impossible geometry, in well under a second."""
     p = scene.projectile
     solid = p.cavity_diameter == 0.0
+    explicit = any(k in scene.explicit for k in CAVITY_KEYS)
+    mass = scene.get("projectile.mass")
     shape = Shape(
         diameter=p.diameter, length=p.length, nose=p.nose, crh=p.crh,
         cavity_diameter=p.cavity_diameter,
@@ -71,12 +89,19 @@ def projectile_shape(scene) -> Shape:
         step_length=0.0 if solid else p.cavity_step_length,
         base_thickness=p.base_thickness,
     )
-    shape.check()
-    mass = scene.get("projectile.mass")
-    if mass is not None and not solid:
-        rho_c = scene.charge.material.density if scene.effects.charge else None
-        shape = shape.with_mass(mass, p.material.density, rho_c)
-    return shape
+    if mass is None or explicit:
+        shape.check()
+    else:  # the outside only: a default cavity that does not fit is left to the mass rule
+        replace(shape, cavity_diameter=0.0).check()
+    if mass is None or (solid and explicit):
+        return Built(shape, p.material.density)
+    rho_c = scene.charge.material.density if scene.effects.charge else None
+    return reach_mass(shape, mass, p.material.density, rho_c, adapt=not explicit and not scene.effects.charge)
+
+
+def projectile_shape(scene) -> Shape:
+    """The exact geometry of projectile(scene)."""
+    return projectile(scene).shape
 
 
 def placement(scene) -> tuple[np.ndarray, np.ndarray]:
@@ -112,24 +137,24 @@ def mesh(scene, comm: MPI.Comm = MPI.COMM_WORLD, use_cache: bool = True,
     Args:
         split: give the charge its own wall nodes; default: a deformable charge in frictional contact.
     """
-    shape = projectile_shape(scene)  # InputError on impossible geometry, on every rank
+    built = projectile(scene)  # InputError on impossible geometry, on every rank
     charge = bool(scene.effects.charge)
     if split is None:
         split = charge and scene.charge.contact == "frictional" and scene.effects.fidelity != "rigid"
     opts = gmsh_model.MeshOptions(scene.mesh.size, scene.get("mesh.nose_size"), scene.mesh.optimize)
-    return fmesh.create(shape, opts, comm, charge=charge, mass=scene.get("projectile.mass"),
-                        shell_density=scene.projectile.material.density,
+    return fmesh.create(built.shape, opts, comm, charge=charge, mass=scene.get("projectile.mass"),
+                        shell_density=built.shell_density,
                         charge_density=scene.charge.material.density, split=split, use_cache=use_cache)
 
 
 def densities(scene) -> dict[int, float]:
     """Density (kg/m^3) per volume tag."""
-    return {tags.SHELL: scene.projectile.material.density, tags.CHARGE: scene.charge.material.density}
+    return {tags.SHELL: projectile(scene).shell_density, tags.CHARGE: scene.charge.material.density}
 
 
 def mesh_metrics(pm: fmesh.ProjectileMesh, scene) -> dict:
     """The figures of mesh.json for a scene's mesh (fepen.geometry.mesh.metrics)."""
     p, c = scene.projectile.material, scene.charge.material
-    speed = {tags.SHELL: tetra.dilatational_speed(p.youngs_modulus, p.poisson_ratio, p.density),
+    speed = {tags.SHELL: tetra.dilatational_speed(p.youngs_modulus, p.poisson_ratio, projectile(scene).shell_density),
              tags.CHARGE: tetra.dilatational_speed(c.youngs_modulus, c.poisson_ratio, c.density)}
     return fmesh.metrics(pm, densities(scene), speed, scene.run.safety_factor, scene.mesh.size)

@@ -11,11 +11,14 @@ import numpy as np
 import ufl
 from dolfinx import cpp as _cpp
 from dolfinx import fem, la
+from dolfinx import log as _log
 from mpi4py import MPI
 
 from fepen.errors import SimulationError
 from fepen.laws import materials as M
 from fepen.solver import ckernel, kernels
+
+_log.set_log_level(_log.LogLevel.WARNING)  # quiet dolfinx wherever the solver is used
 
 
 @dataclass
