@@ -1,7 +1,7 @@
 """The rigid fidelity (``effects.fidelity = "rigid"``): the projectile as one rigid body in the concrete
-target law (docs/theory.md §9). By default the volume mesh gives the mass properties (exact for tetrahedra)
-and the load points (its outer facets on the exact surface); any other set can be handed in, such as the
-mesh-free rings of fepen.geometry.revolution. Every rank integrates the same ODE on all the points. The
+target law (docs/theory.md §9). By default without any mesh: the mass properties of the exact solid of
+revolution and load points in rings on its exact surface (fepen.geometry.revolution); the volume mesh's
+(mesh_points) on request. Every rank integrates the same ODE on all the points. The
 stop rules are fepen.runs.events'; a stop on V·a ≤ 0 is interpolated to where the speed along the axis
 vanishes.
 """
@@ -14,7 +14,7 @@ import numpy as np
 from mpi4py import MPI
 
 from fepen.geometry import mesh as fmesh
-from fepen.geometry import tags
+from fepen.geometry import revolution, tags
 from fepen.io import files, results
 from fepen.laws import target as tg
 from fepen.laws.rigid_body import (
@@ -31,6 +31,8 @@ from fepen.runs import events, setup
 #: 1/STOP_STEPS of the time the quasi-static force alone would take to stop the projectile
 STEP_FRACTION = 0.1
 STOP_STEPS = 300
+#: load points per ring of the default (mesh-free) rigid body
+RING_SECTORS = 12
 
 
 def mesh_points(scene, comm) -> tuple[dict, tuple, int]:
@@ -47,7 +49,7 @@ def mesh_points(scene, comm) -> tuple[dict, tuple, int]:
 
     pm = setup.mesh(scene, comm)
     p = fmesh.cell_points(pm.mesh)
-    rho = np.full(len(p), scene.projectile.material.density)
+    rho = np.full(len(p), setup.projectile(scene).shell_density)
     if pm.charge:
         rho[fmesh.owned_cells_tagged(pm, tags.CHARGE)] = scene.charge.material.density
     key = pm.mesh.topology.original_cell_index[: len(p)]
@@ -62,6 +64,14 @@ def mesh_points(scene, comm) -> tuple[dict, tuple, int]:
     return points, (m, c, inertia), pm.mesh.topology.index_map(3).size_global
 
 
+def ring_points(scene, shape) -> dict:
+    """The default load points: rings on the exact surface (fepen.geometry.revolution.load_points), meridian
+    panels of mesh.rigid_panel (absent: a sixth of the diameter) with two Gauss rings each, RING_SECTORS
+    points per ring."""
+    panel = scene.get("mesh.rigid_panel") or shape.diameter / 6.0
+    return revolution.load_points(shape, panel, RING_SECTORS)
+
+
 class RigidRun:
     """One rigid-projectile penetration.
 
@@ -69,20 +79,25 @@ class RigidRun:
         scene: resolved Scene (fidelity rigid, concrete target).
         out: results directory (None: write nothing, for sweeps and tests).
         comm: MPI communicator.
-        points: load points (dict as fepen.geometry.revolution.load_points returns), e.g. the rings on the
-            exact surface; default: the volume mesh's outer facets (mesh_points).
-        mass_properties: (mass, centre, inertia); default: the volume mesh's (mesh_points).
+        points: load points (dict as fepen.geometry.revolution.load_points returns); default: the rings on
+            the exact surface (ring_points); "mesh": the volume mesh's outer facets and its mass properties
+            (mesh_points).
+        mass_properties: (mass, centre, inertia); default: the exact solid of revolution's.
     """
 
     def __init__(self, scene, out, comm=MPI.COMM_WORLD, points: dict | None = None,
                  mass_properties: tuple | None = None):
         self.scene, self.comm = scene, comm
         self.t0 = time.perf_counter()
-        self.cells = 0  # no volume mesh when both are given
-        if points is None or mass_properties is None:
-            meshed = mesh_points(scene, comm)
-            points, mass_properties = points or meshed[0], mass_properties or meshed[1]
-            self.cells = meshed[2]
+        self.cells = 0  # no volume mesh unless asked for
+        if points == "mesh":
+            points, mass_properties, self.cells = mesh_points(scene, comm)
+        built = setup.projectile(scene)
+        if points is None:
+            points = ring_points(scene, built.shape)
+        if mass_properties is None:
+            rho_c = scene.charge.material.density if scene.effects.charge else None
+            mass_properties = revolution.mass_properties(built.shape, built.shell_density, rho_c)
         self.shape = setup.projectile_shape(scene)
         self.mass, c0, inertia = mass_properties
         self.pts = g = points
