@@ -13,6 +13,12 @@ import numpy as np
 
 SIN_TOL = 1e-9  # v̂·n below this counts as zero (a surface parallel to the motion is not loaded)
 
+#: fepen's calibrated "scaled-S" strength model (docs/validation-depth.md: one fit, rigid fidelity, on the
+#: calibration sets listed there); S = coefficient (f_c/MPa)^-exponent / sqrt(1 + D/size)
+SCALED_S_COEFFICIENT = 89.47
+SCALED_S_EXPONENT = 0.544
+SCALED_S_SIZE = 0.05953
+
 
 # ---------------------------------------------------------------------------------------------------------
 # §4.1 quasi-static cavity expansion
@@ -48,9 +54,40 @@ def quasi_static_stress(Y, E, T, lam, c_over_a=None):
     return Y * ((2.0 / alpha) * g + 1.0)
 
 
+def strength_S(fc_pa: float, diameter: float, coefficient: float, exponent: float, size: float) -> float:
+    """Empirical strength factor S of σ_s = S f_c (docs/theory.md §8.1):
+
+        S = coefficient (f_c / 1 MPa)^(−exponent) / √(1 + D / size)
+
+    Forrestal's power law in f_c (Frew et al. 1998) times Bažant's size-effect law (1984) in the projectile
+    diameter D; size = inf gives no size effect.
+
+    Args:
+        fc_pa: unconfined compressive strength (Pa). diameter: projectile diameter D (m).
+        coefficient, exponent: the power law's constants. size: Bažant's transitional size D0 (m).
+
+    Returns:
+        S (dimensionless).
+    """
+    scale = 1.0 if math.isinf(size) else 1.0 / math.sqrt(1.0 + diameter / size)
+    return coefficient * (fc_pa / 1e6) ** -exponent * scale
+
+
+#: strength models of σ_s = S f_c: (coefficient, exponent, size (m)). "forrestal-S" is Frew et al.'s (1998)
+#: fit to Sandia data; "scaled-S" is fepen's, calibrated once (docs/validation-depth.md)
+S_MODELS = {"forrestal-S": (82.6, 0.544, math.inf), "scaled-S": (SCALED_S_COEFFICIENT, SCALED_S_EXPONENT,
+                                                                 SCALED_S_SIZE)}
+
+
 def forrestal_S(fc_pa: float) -> float:
     """Forrestal's empirical S = 82.6 fc^−0.544 (fc in MPa): σ_s = S fc."""
-    return 82.6 * (fc_pa / 1e6) ** -0.544
+    return strength_S(fc_pa, 0.0, *S_MODELS["forrestal-S"])
+
+
+def youngs_modulus_aci(fc_pa: float) -> float:
+    """Young's modulus of normal-weight concrete from its cylinder strength, E = 4700 √(f_c / 1 MPa) MPa
+    (ACI 318-19 §19.2.2.1), in Pa."""
+    return 4.7e9 * math.sqrt(fc_pa / 1e6)
 
 
 def ogive_nose_factor(crh: float) -> float:

@@ -156,8 +156,10 @@ def test_scene_builds_the_law():
     sc = scene.load(None, ["effects.crater=linear", "target.quasi_static_stress=4.4e8"])
     L = setup.target_law(sc)
     assert L.sigma_s == 4.4e8 and L.crater == "linear" and L.given_sigma_s
-    L2 = setup.target_law(scene.load())
-    assert L2.sigma_s == pytest.approx(float(tg.quasi_static_stress(40e6, 32.5e9, 4e6, 0.67)))
+    L2 = setup.target_law(scene.load(None, ["target.strength_model=cavity-expansion"]))
+    E = 4.7e9 * math.sqrt(40.0)  # ACI 318 from fc when target.youngs_modulus is absent
+    assert L2.E == pytest.approx(E) and not L2.given_sigma_s
+    assert L2.sigma_s == pytest.approx(float(tg.quasi_static_stress(40e6, E, 4e6, 0.67)))
     assert L2.crush_strain == pytest.approx(1 - 2400 / 2650)
 
 
@@ -206,5 +208,31 @@ def test_forrestal_strength_model_gives_s_fc():
         law = setup.target_law(scene.load(None, ["target.strength_model=forrestal-S",
                                                  f"target.compressive_strength={fc}"]))
         assert law.sigma_s == pytest.approx(82.6 * (fc / 1e6) ** -0.544 * fc, rel=1e-12)
-    cavity = setup.target_law(scene.load(None, []))
+    cavity = setup.target_law(scene.load(None, ["target.strength_model=cavity-expansion",
+                                                "target.youngs_modulus=32.5e9"]))
     assert cavity.sigma_s == pytest.approx(369e6, rel=0.01)  # theory.md §8.1, the paper's concrete
+
+
+def test_scaled_strength_has_forrestal_power_law_and_bazant_size_effect():
+    """S = a fc^-b / sqrt(1 + D/D0): the power law in fc at any D, Bažant's 1/sqrt(1 + D/D0) in D (half
+    the square root at D = 3 D0, none as D0 -> inf), and Forrestal's S at D0 = inf."""
+    a, b, D0 = 70.0, 0.5, 0.1
+    s1 = tg.strength_S(20e6, 0.03, a, b, D0)
+    assert tg.strength_S(80e6, 0.03, a, b, D0) / s1 == pytest.approx(4.0**-0.5, rel=1e-14)
+    assert tg.strength_S(20e6, 3 * D0, a, b, D0) / tg.strength_S(20e6, 0.0, a, b, D0) == pytest.approx(0.5)
+    assert tg.strength_S(20e6, 1.0, a, b, math.inf) == pytest.approx(a * 20.0**-0.5, rel=1e-14)
+    assert tg.forrestal_S(40e6) == pytest.approx(82.6 * 40.0**-0.544, rel=1e-14)
+
+
+def test_concrete_from_its_strength_alone():
+    """target.compressive_strength and target.density are enough: E from ACI 318 (4.7 sqrt(fc) GPa),
+    T = fc/10, and the scaled-S sigma_s; a given E is used as given."""
+    for fc in (13.5e6, 40e6, 160e6):
+        L = setup.target_law(scene.load(None, [f"target.compressive_strength={fc}"]))
+        assert L.E == pytest.approx(4.7e9 * math.sqrt(fc / 1e6), rel=1e-14) and L.T == pytest.approx(fc / 10)
+        a, b, D0 = tg.S_MODELS["scaled-S"]
+        assert L.sigma_s == pytest.approx(tg.strength_S(fc, 0.0236, a, b, D0) * fc, rel=1e-14)
+        assert L.given_sigma_s  # the free surface scales it, does not replace it by the cavity expansion
+    L = setup.target_law(scene.load(None, ["target.youngs_modulus=20e9", "target.S_coefficient=50",
+                                           "target.S_exponent=0", "target.S_size=1e6"]))
+    assert L.E == 20e9 and L.sigma_s == pytest.approx(50 * 40e6, rel=1e-6)
