@@ -1,0 +1,301 @@
+"""Depth of penetration against published tests (docs/validation-depth.md): data sets of normal (or
+oblique) shots read from CSV, each predicted by the rigid fidelity (no mesh: a fraction of a second a
+shot) and by Forrestal's closed form, with the errors per set, a table and a predicted-against-measured
+figure.
+
+A data set is one CSV file, one shot a row, with the columns (units in the names):
+
+    shot, d_mm, m_kg, crh, L_mm, v_ms, fc_mpa, rho_kgm3, depth_m
+
+and optionally ``obliquity_deg``, ``attack_deg`` (absent: 0), ``source`` and ``notes`` (kept, not read).
+The shipped sets are in ``fepen/data/depth/``; ``table1`` is the paper's eight shots (docs/paper.md).
+"""
+
+from __future__ import annotations
+
+import csv
+import math
+from dataclasses import dataclass
+from importlib import resources
+from pathlib import Path
+
+import numpy as np
+
+from fepen.experiments import SHOTS
+from fepen.laws import target as tg
+
+__all__ = ["Row", "read_set", "table1_set", "shipped_sets", "scene_sets", "rigid_depth", "closed_form_depth",
+           "errors", "predict_sets", "gather_sets", "summary_table", "markdown", "figure", "validate_depth",
+           "COLUMNS", "METHODS"]
+
+COLUMNS = ("shot", "d_mm", "m_kg", "crh", "L_mm", "v_ms", "fc_mpa", "rho_kgm3", "depth_m")
+
+
+@dataclass(frozen=True)
+class Row:
+    """One shot of a depth data set (SI units).
+
+    Attributes:
+        name: the shot's label. D, L, mass, crh: projectile diameter, length (m), mass (kg), ogive CRH.
+        V: striking speed (m/s). fc, rho: target strength (Pa) and density (kg/m^3). depth: measured
+        depth of the nose (m). obliquity_deg, attack_deg: striking angles (degrees).
+    """
+
+    name: str
+    D: float
+    L: float
+    mass: float
+    crh: float
+    V: float
+    fc: float
+    rho: float
+    depth: float
+    obliquity_deg: float = 0.0
+    attack_deg: float = 0.0
+
+
+def read_set(path) -> list[Row]:
+    """The rows of one CSV data set (columns: COLUMNS, optionally obliquity_deg and attack_deg).
+
+    Raises:
+        ValueError naming the file, row and column of a missing or non-numeric value.
+    """
+    path = Path(path)
+    rows = []
+    with open(path, newline="") as f:
+        reader = csv.DictReader(f)
+        missing = [c for c in COLUMNS if c not in (reader.fieldnames or [])]
+        if missing:
+            raise ValueError(f"{path}: missing columns {', '.join(missing)} (needs {', '.join(COLUMNS)})")
+        for i, r in enumerate(reader, start=2):
+            try:
+                num = {c: float(r[c]) for c in COLUMNS[1:]}
+                rows.append(Row(r["shot"], num["d_mm"] / 1e3, num["L_mm"] / 1e3, num["m_kg"], num["crh"],
+                                num["v_ms"], num["fc_mpa"] * 1e6, num["rho_kgm3"], num["depth_m"],
+                                float(r.get("obliquity_deg") or 0.0), float(r.get("attack_deg") or 0.0)))
+            except (TypeError, ValueError) as err:
+                raise ValueError(f"{path}:{i}: {err}") from None
+    return rows
+
+
+def table1_set() -> list[Row]:
+    """The paper's eight shots (Table 1) with its projectile and target (docs/paper.md): depth = Hy."""
+    return [Row(s.name, 0.0236, 0.144, 0.367, 3.0, s.v0, 40e6, 2400.0, s.Hy_mm / 1e3, s.obliquity_deg,
+                s.attack_deg) for s in SHOTS.values()]
+
+
+def shipped_sets() -> dict[str, Path]:
+    """The data sets shipped with fepen (fepen/data/depth/*.csv), by name."""
+    base = resources.files("fepen").joinpath("data/depth")
+    return {Path(str(p)).stem: Path(str(p)) for p in sorted(base.iterdir(), key=str) if str(p).endswith(".csv")}
+
+
+def scene_sets(row: Row) -> list[str]:
+    """The --set lines of a rigid scene for one shot: the projectile's outside and mass, the target's
+    strength and density only (everything else from fepen's defaults), the striking conditions."""
+    return ["effects.fidelity=rigid", f"projectile.diameter={row.D!r}", f"projectile.length={row.L!r}",
+            f"projectile.crh={row.crh!r}", f"projectile.mass={row.mass!r}", f"impact.velocity={row.V!r}",
+            f"impact.obliquity_deg={row.obliquity_deg!r}", f"impact.attack_deg={row.attack_deg!r}",
+            f"target.compressive_strength={row.fc!r}", f"target.density={row.rho!r}"]
+
+
+def rigid_depth(row: Row, sets=()) -> float:
+    """Depth of the nose (m) of the rigid fidelity for one shot (no mesh; this process only).
+
+    Args:
+        row: the shot. sets: further --set lines (e.g. a strength model), after the shot's own.
+    """
+    from mpi4py import MPI
+
+    from fepen import scene
+    from fepen.runs.rigid import RigidRun
+
+    sc = scene.load(None, [*scene_sets(row), *sets])
+    return RigidRun(sc, None, MPI.COMM_SELF).run()["Hy_mm"] / 1e3
+
+
+def closed_form_depth(row: Row, S: float | None = None, k: float = 2.0) -> float:
+    """Forrestal et al.'s (1994) closed form for a rigid ogive at normal incidence (m), with a crater k
+    diameters deep in which the force grows linearly with depth:
+
+        P = (m / (2π a² ρ N*)) ln(1 + N* ρ V1² / (S f_c)) + k D,
+        V1² = (m V² − π a² k D S f_c) / (m + π a² k D N* ρ)   (P > k D; else the crater alone)
+
+    with Forrestal's S = 82.6 f_c^−0.544 unless S is given, and k = 2 (their 4a).
+    """
+    S = tg.forrestal_S(row.fc) if S is None else S
+    a, m, N, rho = 0.5 * row.D, row.mass, tg.ogive_nose_factor(row.crh), row.rho
+    R, kD = S * row.fc, k * row.D
+    V1sq = (m * row.V**2 - math.pi * a * a * kD * R) / (m + math.pi * a * a * kD * N * rho)
+    if V1sq <= 0.0:  # stops in the crater, where the force is c z, c = π a² R/(k D): m V² = c P²
+        return math.sqrt(m * row.V**2 * kD / (math.pi * a * a * R))
+    return m / (2.0 * math.pi * a * a * rho * N) * math.log(1.0 + N * rho * V1sq / R) + kD
+
+
+def errors(pred, meas) -> dict:
+    """count, mean |error|, bias (mean error) and worst error of P_pred/P_meas − 1 (NaN predictions, shots
+    that could not be built, are left out of all four)."""
+    e = np.asarray(pred, dtype=float) / np.asarray(meas, dtype=float) - 1.0
+    e = e[np.isfinite(e)]
+    worst = float(e[np.argmax(np.abs(e))]) if len(e) else math.nan
+    return {"count": len(e), "mean_abs": float(np.mean(np.abs(e))) if len(e) else math.nan,
+            "bias": float(np.mean(e)) if len(e) else math.nan, "worst": worst}
+
+
+#: the predictions compared: name -> extra --set lines of the rigid fidelity (None: the closed form)
+METHODS = {"default": [], "forrestal-S": ["target.strength_model=forrestal-S"], "closed form": None}
+
+
+def predict_sets(sets: dict[str, list[Row]], extra=(), workers: int = 1) -> dict[str, list[dict]]:
+    """Every shot of every set by every METHODS entry.
+
+    Args:
+        sets: name -> rows. extra: --set lines added to every rigid run. workers: processes at once.
+
+    Returns:
+        name -> list of per-shot dicts (the row's fields, measured and predicted depths in m).
+    """
+    jobs = [(name, i, row, method) for name, rows in sets.items() for i, row in enumerate(rows)
+            for method in METHODS]
+    if workers > 1:
+        from concurrent.futures import ProcessPoolExecutor
+
+        with ProcessPoolExecutor(workers) as pool:
+            depths = list(pool.map(_predict_one, [(row, method, tuple(extra)) for _, _, row, method in jobs],
+                                   chunksize=4))
+    else:
+        depths = [_predict_one((row, method, tuple(extra))) for _, _, row, method in jobs]
+    out: dict[str, list[dict]] = {name: [dict(row.__dict__) for row in rows] for name, rows in sets.items()}
+    for (name, i, _, method), p in zip(jobs, depths):
+        out[name][i][method] = p
+    return out
+
+
+def _predict_one(job) -> float:
+    from fepen.errors import InputError
+
+    row, method, extra = job
+    sets = METHODS[method]
+    if sets is None:
+        return closed_form_depth(row)
+    try:
+        return rigid_depth(row, [*sets, *extra])
+    except InputError:  # a shot fepen cannot build (e.g. an impossible mass): left out of the errors
+        return math.nan
+
+
+def gather_sets(paths=(), shipped: bool = True) -> dict[str, list[Row]]:
+    """The data sets to run: table1 and the shipped sets (unless shipped is False), then every CSV file
+    given or found in a given folder, by file stem.
+
+    Raises:
+        InputError (key --data) on a path that is not there or a file that is not a data set.
+    """
+    from fepen.errors import InputError
+
+    files: dict[str, Path] = dict(shipped_sets()) if shipped else {}
+    for p in paths:
+        p = Path(p)
+        if p.is_dir():
+            found = sorted(p.glob("*.csv"))
+            if not found:
+                raise InputError("--data", f"{p}: no .csv data set in this folder")
+            files.update({f.stem: f for f in found})
+        elif p.is_file():
+            files[p.stem] = p
+        else:
+            raise InputError("--data", f"{p}: no such file or folder")
+    out = {"table1": table1_set()} if shipped else {}
+    for name, f in files.items():
+        try:
+            out[name] = read_set(f)
+        except ValueError as err:
+            raise InputError("--data", str(err)) from None
+    return out
+
+
+def summary_table(results: dict[str, list[dict]]) -> list[dict]:
+    """Per set and method: count, mean |error|, bias, worst."""
+    rows = []
+    for name, shots in results.items():
+        row = {"set": name, "count": len(shots)}
+        for method in METHODS:
+            e = errors([s[method] for s in shots], [s["depth"] for s in shots])
+            row.update({f"{method} {k}": v for k, v in e.items() if k != "count"})
+        rows.append(row)
+    return rows
+
+
+def markdown(table: list[dict], header: str = "") -> str:
+    """The summary table as Markdown: per set, mean |error| / bias / worst of each method."""
+    cols = " | ".join(f"{m}: mean abs / bias / worst" for m in METHODS)
+    lines = [header, "", f"| set | shots | {cols} |", "|---|---|" + "---|" * len(METHODS)] if header else \
+        [f"| set | shots | {cols} |", "|---|---|" + "---|" * len(METHODS)]
+    for r in table:
+        cells = " | ".join(f"{100 * r[f'{m} mean_abs']:.1f} % / {100 * r[f'{m} bias']:+.1f} % / "
+                           f"{100 * r[f'{m} worst']:+.1f} %" for m in METHODS)
+        lines.append(f"| {r['set']} | {r['count']} | {cells} |")
+    return "\n".join(lines) + "\n"
+
+
+def figure(results: dict[str, list[dict]], path, method: str = "default") -> None:
+    """Predicted against measured depth, one marker per set, with the ±10 % and ±20 % bands."""
+    import matplotlib
+
+    matplotlib.use("Agg")
+    import matplotlib.pyplot as plt
+
+    fig, ax = plt.subplots(figsize=(6.4, 6.0))
+    hi = max(max(max(s["depth"], s[method]) for s in shots) for shots in results.values()) * 1.1
+    lo = min(min(min(s["depth"], s[method]) for s in shots) for shots in results.values()) / 1.1
+    line = np.geomspace(lo, hi, 50)
+    ax.plot(line, line, "k-", lw=1)
+    for f, style in ((0.1, "--"), (0.2, ":")):
+        ax.plot(line, line * (1 + f), "k" + style, lw=0.8, label=f"±{f:.0%}")
+        ax.plot(line, line * (1 - f), "k" + style, lw=0.8)
+    markers = "osD^v<>pXh*P"
+    for i, (name, shots) in enumerate(results.items()):
+        ax.plot([s["depth"] for s in shots], [s[method] for s in shots], markers[i % len(markers)], ms=5,
+                mfc="none", label=f"{name} ({len(shots)})")
+    ax.set_xscale("log")
+    ax.set_yscale("log")
+    ax.set_xlim(lo, hi)
+    ax.set_ylim(lo, hi)
+    ax.set_xlabel("measured depth (m)")
+    ax.set_ylabel(f"predicted depth (m), rigid fidelity, {method} law")
+    ax.legend(fontsize=7, loc="upper left")
+    ax.grid(True, which="both", lw=0.3)
+    fig.tight_layout()
+    fig.savefig(path, dpi=130)
+    plt.close(fig)
+
+
+def validate_depth(paths=(), sets=(), out="results/validate-depth", workers: int = 1,
+                   shipped: bool = True) -> list[dict]:
+    """Run the data sets (gather_sets) by every method; write DIR/depth.csv (per shot), DIR/depth.md (the
+    table per set) and DIR/depth.png (predicted against measured); return the table.
+
+    Args:
+        paths: CSV files or folders of them. sets: --set lines for every rigid run (checked first).
+        out: results folder. workers: processes at once. shipped: include table1 and the shipped sets.
+    """
+    from fepen import scene
+
+    scene.load(None, ["effects.fidelity=rigid", *sets])  # bad --set: InputError before any run
+    data = gather_sets(paths, shipped)
+    results = predict_sets(data, sets, workers)
+    out = Path(out)
+    out.mkdir(parents=True, exist_ok=True)
+    fields = ["set", *Row.__dataclass_fields__, *METHODS]
+    with open(out / "depth.csv", "w", newline="") as f:
+        w = csv.DictWriter(f, fieldnames=fields)
+        w.writeheader()
+        for name, shots in results.items():
+            for s in shots:
+                w.writerow({"set": name, **s})
+    table = summary_table(results)
+    note = (f"Rigid fidelity, default scene but for each shot's projectile, target strength and density"
+            f"{' and ' + ', '.join(sets) if sets else ''}; errors P_pred/P_meas - 1.")
+    (out / "depth.md").write_text(markdown(table, note))
+    figure(results, out / "depth.png")
+    return table
