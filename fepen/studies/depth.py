@@ -86,8 +86,8 @@ def table1_set() -> list[Row]:
 
 def shipped_sets() -> dict[str, Path]:
     """The data sets shipped with fepen (fepen/data/depth/*.csv), by name."""
-    base = resources.files("fepen").joinpath("data/depth")
-    return {Path(str(p)).stem: Path(str(p)) for p in sorted(base.iterdir(), key=str) if str(p).endswith(".csv")}
+    base = Path(str(resources.files("fepen").joinpath("data/depth")))
+    return {p.stem: p for p in sorted(base.glob("*.csv"))} if base.is_dir() else {}
 
 
 def scene_sets(row: Row) -> list[str]:
