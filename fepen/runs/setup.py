@@ -15,15 +15,16 @@ from fepen.errors import InputError
 from fepen.geometry import gmsh_model, tags, tetra
 from fepen.geometry import mesh as fmesh
 from fepen.geometry.shape import Built, Shape, reach_mass
-from fepen.laws import materials as M
 from fepen.laws import target as tg
 
 
 # ---------------------------------------------------------------------------------------------------------
 # laws and shape from the scene
 # ---------------------------------------------------------------------------------------------------------
-def projectile_material(scene) -> M.Material:
-    """The projectile material: elastic or Johnson-Cook by effects.fidelity."""
+def projectile_material(scene):
+    """The projectile material (fepen.laws.materials.Material): elastic or Johnson-Cook by effects.fidelity."""
+    from fepen.laws import materials as M  # numba: only a deformable run pays for importing it
+
     m = scene.projectile.material
     rho = projectile(scene).shell_density
     if scene.effects.fidelity == "elastic":
@@ -33,8 +34,10 @@ def projectile_material(scene) -> M.Material:
                           m.taylor_quinney, scene.effects.strain_rate, scene.effects.thermal)
 
 
-def charge_material(scene) -> M.Material:
+def charge_material(scene):
     """The explosive charge material (bilinear, docs/charge.md)."""
+    from fepen.laws import materials as M
+
     c = scene.charge.material
     return M.bilinear(c.youngs_modulus, c.poisson_ratio, c.density, c.yield_stress, c.tangent_modulus)
 
