@@ -29,8 +29,8 @@ from fepen.runs import events, setup
 
 #: default RK4 step: the time to travel this fraction of a diameter at the striking speed, and at most
 #: 1/STOP_STEPS of the time the quasi-static force alone would take to stop the projectile
-STEP_FRACTION = 0.1
-STOP_STEPS = 300
+STEP_FRACTION = 0.2
+STOP_STEPS = 150
 #: load points per ring of the default (mesh-free) rigid body
 RING_SECTORS = 12
 
