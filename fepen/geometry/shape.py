@@ -354,49 +354,59 @@ def reach_mass(shape: Shape, mass: float, shell_density: float, charge_density: 
             first = err
     if not adapt and first is not None:
         raise first
-    # rule 2: one cylinder of the longest length that fits, its diameter sized (mass is linear in r²)
-    rho_fill = charge_density or 0.0
     solid = replace(shape, cavity_diameter=0.0, cavity_length=0.0, step_diameter=0.0, step_length=0.0)
+    widest, length = _widest_cavity(shape)
+    built = _one_cylinder(shape, solid, widest, length, mass, shell_density, charge_density)
+    if built is not None:
+        return built
     m_solid = solid.mass(shell_density)
-    widest = shape.diameter - 2.0 * shape._min_wall()
-    narrowest = MIN_CAVITY_FRACTION * shape.diameter
-    if widest > narrowest and shape.base_thickness < shape.length - shape.nose_length:
-        z_rear = shape.length - shape.base_thickness
-        # the longest length is set by the widest cavity; narrower ones fit that length too
-        length = max(0.0, z_rear - shape.front_limit(0.5 * widest * (1.0 - 1e-9)))
-        if length > 0.0:
-            need = (m_solid - mass) / ((shell_density - rho_fill) * math.pi * length)  # r²
-            if need > 0.0 and narrowest <= 2.0 * math.sqrt(need) <= widest:
-                d = 2.0 * math.sqrt(need)
-                out = replace(solid, cavity_diameter=d, cavity_length=length)
-                out.check()
-                return Built(out, shell_density,
-                             f"projectile.mass {mass:g} kg: cavity {1e3 * d:.2f} mm x {1e3 * length:.1f} mm "
-                             f"(one section; the given {1e3 * shape.cavity_diameter:g} mm cavity"
-                             f"{' with its step' if shape.step_length > 0 else ''} cannot reach it)")
-            if need > 0.0 and 2.0 * math.sqrt(need) > widest and charge_density is None:
-                # lighter than the widest cavity: keep it, lighten the steel
-                out = replace(solid, cavity_diameter=widest * (1.0 - 1e-9), cavity_length=length)
-                rho = mass / out.shell_volume()
-                if rho >= shell_density * (1.0 - MAX_DENSITY_CHANGE):
-                    out.check()
-                    return Built(out, rho, f"projectile.mass {mass:g} kg: widest cavity {1e3 * widest:.2f} mm x "
-                                           f"{1e3 * length:.1f} mm and steel density adjusted to {rho:.1f} kg/m^3 "
-                                           f"({rho / shell_density - 1:+.1%}; lighter than any cavity makes it)")
     if charge_density is not None:
         raise first or InputError("projectile.mass", f"{mass:g} kg cannot be reached with a charge-filled "
                                                      f"cavity in this outside (solid: {m_solid:.4g} kg)")
     rho = mass / solid.outer_volume()
     if abs(rho / shell_density - 1.0) > MAX_DENSITY_CHANGE:
-        lightest = min(m_solid, shell_density * (1.0 - MAX_DENSITY_CHANGE) * solid.outer_volume())
-        if widest > narrowest:
-            lightest = min(lightest, (1.0 - MAX_DENSITY_CHANGE) * replace(
-                solid, cavity_diameter=widest * (1.0 - 1e-9),
-                cavity_length=max(0.0, shape.length - shape.base_thickness
-                                  - shape.front_limit(0.5 * widest * (1.0 - 1e-9)))).mass(shell_density))
+        lightest = (1.0 - MAX_DENSITY_CHANGE) * (
+            replace(solid, cavity_diameter=widest, cavity_length=length).mass(shell_density) if length > 0.0
+            else m_solid)
         raise InputError("projectile.mass", f"{mass:g} kg cannot be reached in this outside: must be in "
                                             f"[{lightest:.4g}, {m_solid * (1.0 + MAX_DENSITY_CHANGE):.4g}] kg "
                                             f"(a cavity, or the steel density changed by at most "
                                             f"{MAX_DENSITY_CHANGE:.0%})")
     return Built(solid, rho, f"projectile.mass {mass:g} kg: solid body, steel density adjusted to "
                              f"{rho:.1f} kg/m^3 ({rho / shell_density - 1:+.1%}; no cavity reaches it)")
+
+
+def _widest_cavity(shape: Shape) -> tuple[float, float]:
+    """Diameter of the widest cavity that keeps the minimum wall, and the longest length it fits (0 if none):
+    narrower cavities fit that length too."""
+    widest = (shape.diameter - 2.0 * shape._min_wall()) * (1.0 - 1e-9)
+    if widest <= MIN_CAVITY_FRACTION * shape.diameter or shape.base_thickness >= shape.length - shape.nose_length:
+        return widest, 0.0
+    return widest, max(0.0, shape.length - shape.base_thickness - shape.front_limit(0.5 * widest))
+
+
+def _one_cylinder(shape, solid, widest, length, mass, shell_density, charge_density) -> Built | None:
+    """Rules 2 and 3 (light side) of reach_mass: one cylinder of the longest length, its diameter sized (mass
+    is linear in r²); lighter than the widest, that one with the steel lightened. None if neither applies."""
+    if length <= 0.0:
+        return None
+    need = (solid.mass(shell_density) - mass) / ((shell_density - (charge_density or 0.0)) * math.pi * length)
+    if need <= 0.0:
+        return None
+    d = 2.0 * math.sqrt(need)
+    given = (f"the given {1e3 * shape.cavity_diameter:g} mm cavity"
+             f"{' with its step' if shape.step_length > 0 else ''} cannot reach it")
+    if MIN_CAVITY_FRACTION * shape.diameter <= d <= widest:
+        out = replace(solid, cavity_diameter=d, cavity_length=length)
+        out.check()
+        return Built(out, shell_density, f"projectile.mass {mass:g} kg: cavity {1e3 * d:.2f} mm x "
+                                         f"{1e3 * length:.1f} mm (one section; {given})")
+    if d > widest and charge_density is None:
+        out = replace(solid, cavity_diameter=widest, cavity_length=length)
+        rho = mass / out.shell_volume()
+        if rho >= shell_density * (1.0 - MAX_DENSITY_CHANGE):
+            out.check()
+            return Built(out, rho, f"projectile.mass {mass:g} kg: widest cavity {1e3 * widest:.2f} mm x "
+                                   f"{1e3 * length:.1f} mm and steel density adjusted to {rho:.1f} kg/m^3 "
+                                   f"({rho / shell_density - 1:+.1%}; lighter than any cavity makes it)")
+    return None

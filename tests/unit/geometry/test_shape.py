@@ -6,7 +6,7 @@ import pytest
 
 from fepen import scene
 from fepen.errors import InputError
-from fepen.geometry.shape import Shape
+from fepen.geometry.shape import Shape, reach_mass
 from fepen.runs import setup
 
 
@@ -127,3 +127,18 @@ def test_solid_flat_rod():
     assert not sh.has_cavity and sh.nose_length == 0.0
     assert sh.outer_volume() == pytest.approx(math.pi * 0.0118**2 * 0.144, rel=1e-14)
     assert sc.get("projectile.mass") is None
+
+
+def test_mass_rule_ends_of_the_range():
+    """Lighter than the widest cavity: that cavity with lighter steel (at most 25 %); beyond either end
+    of the range, InputError naming projectile.mass and the reachable range."""
+    rho = 7850.0
+    shape = Shape(0.025, 0.168, "ogive", 6.0, 0.012, 0.0, 0.008, 0.020, 0.015)
+    built = reach_mass(shape, 0.246, rho)  # a thin-walled 25 mm body (Sun et al. 2010)
+    assert built.shape.has_cavity and built.shell_density < rho and "widest cavity" in built.note
+    assert built.shape.mass(built.shell_density) == pytest.approx(0.246, rel=1e-12)
+    solid = Shape(0.025, 0.168, "ogive", 6.0).mass(rho)
+    for m in (0.1, 1.3 * solid):
+        with pytest.raises(InputError, match=r"must be in \[") as err:
+            reach_mass(shape, m, rho)
+        assert err.value.key == "projectile.mass"
