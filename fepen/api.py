@@ -113,11 +113,7 @@ def run(scene, out=None, comm=None, progress: bool = False) -> Result:
     comm = _comm(comm)
     sc = scene if isinstance(scene, Scene) else Scene(scene)
     setup.check_supported(sc)
-    note = setup.projectile(sc).note
-    if note and comm.rank == 0:
-        import logging
-
-        logging.getLogger("fepen").warning(note)
+    setup.announce(sc, comm)
     if out is None:
         out = comm.bcast(tempfile.mkdtemp(prefix="fepen-") if comm.rank == 0 else None, root=0)
     out = files.prepare(out, comm)

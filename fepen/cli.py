@@ -80,11 +80,7 @@ def cmd_mesh(args) -> int:
 
     comm = MPI.COMM_WORLD
     sc = fscene.load(args.scene, args.sets)
-    note = setup.projectile(sc).note  # geometry errors before anything is written
-    if note and comm.rank == 0:
-        import logging
-
-        logging.getLogger("fepen").warning(note)
+    setup.announce(sc, comm)  # geometry errors before anything is written
     pm = setup.mesh(sc, comm)
     info = setup.mesh_metrics(pm, sc)
     out = files.prepare(args.out, comm)

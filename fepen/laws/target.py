@@ -69,8 +69,7 @@ def strength_S(fc_pa: float, diameter: float, coefficient: float, exponent: floa
     Returns:
         S (dimensionless).
     """
-    scale = 1.0 if math.isinf(size) else 1.0 / math.sqrt(1.0 + diameter / size)
-    return coefficient * (fc_pa / 1e6) ** -exponent * scale
+    return coefficient * (fc_pa / 1e6) ** -exponent / math.sqrt(1.0 + diameter / size)  # D/inf = 0
 
 
 #: strength models of σ_s = S f_c: (coefficient, exponent, size (m)). "forrestal-S" is Frew et al.'s (1998)

@@ -98,7 +98,7 @@ class RigidRun:
         if mass_properties is None:
             rho_c = scene.charge.material.density if scene.effects.charge else None
             mass_properties = revolution.mass_properties(built.shape, built.shell_density, rho_c)
-        self.shape = setup.projectile_shape(scene)
+        self.shape = built.shape
         self.mass, c0, inertia = mass_properties
         self.pts = g = points
         self.setup_s = time.perf_counter() - self.t0

@@ -102,6 +102,16 @@ def projectile(scene) -> Built:
     return reach_mass(shape, mass, p.material.density, rho_c, adapt=not explicit and not scene.effects.charge)
 
 
+def announce(scene, comm) -> Built:
+    """projectile(scene), with its note (if any) logged once, on rank 0: the front door of a run or a mesh."""
+    built = projectile(scene)
+    if built.note and comm.rank == 0:
+        import logging
+
+        logging.getLogger("fepen").warning(built.note)
+    return built
+
+
 def projectile_shape(scene) -> Shape:
     """The exact geometry of projectile(scene)."""
     return projectile(scene).shape

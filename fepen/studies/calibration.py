@@ -21,6 +21,7 @@ from pathlib import Path
 
 import numpy as np
 
+from fepen.laws import target as tg
 from fepen.studies import depth
 
 __all__ = ["CALIBRATION_SETS", "GRID", "depth_curves", "fit", "main"]
@@ -35,7 +36,7 @@ CALIBRATION_SETS = {
 }
 #: the exponent b of f_c, held at Frew, Hanchak, Green and Forrestal's (1998) published value: the
 #: calibration sets have no small-calibre shot below 32 MPa, where b matters most
-EXPONENT = 0.544
+EXPONENT = tg.S_MODELS["forrestal-S"][1]
 #: S = σ_s/f_c at which every calibration shot is run
 GRID = np.geomspace(1.5, 40.0, 15)
 

@@ -229,8 +229,7 @@ def summary_table(results: dict[str, list[dict]]) -> list[dict]:
 def markdown(table: list[dict], header: str = "") -> str:
     """The summary table as Markdown: per set, mean |error| / bias / worst of each method."""
     cols = " | ".join(f"{m}: mean abs / bias / worst" for m in METHODS)
-    lines = [header, "", f"| set | shots | {cols} |", "|---|---|" + "---|" * len(METHODS)] if header else \
-        [f"| set | shots | {cols} |", "|---|---|" + "---|" * len(METHODS)]
+    lines = ([header, ""] if header else []) + [f"| set | shots | {cols} |", "|---|---|" + "---|" * len(METHODS)]
     for r in table:
         cells = " | ".join(f"{100 * r[f'{m} mean_abs']:.1f} % / {100 * r[f'{m} bias']:+.1f} % / "
                            f"{100 * r[f'{m} worst']:+.1f} %" for m in METHODS)
