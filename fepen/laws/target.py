@@ -7,7 +7,9 @@ from __future__ import annotations
 
 import functools
 import math
+import os
 from dataclasses import dataclass
+from pathlib import Path
 
 import numpy as np
 
@@ -295,7 +297,7 @@ def forces(law: TargetLaw, s: SurfaceState):
 
 def sliding_friction(law: TargetLaw, speed_t):
     """The friction coefficient at tangential sliding speed |v_t| (m/s): μ_d + (μ_s − μ_d) e^(−c |v_t|),
-    LS-DYNA's FS, FD, DC form (docs/theory.md §8.5), with μ_s = law.mu, μ_d = law.mu_dynamic, c =
+    LS-DYNA's FS, FD, DC form (docs/theory.md §8.4), with μ_s = law.mu, μ_d = law.mu_dynamic, c =
     law.mu_decay; the constant Coulomb coefficient law.mu when c = 0 or μ_d = μ_s."""
     mu_d = law.mu if law.mu_dynamic is None else law.mu_dynamic
     if law.mu_decay == 0.0 or mu_d == law.mu:
@@ -324,7 +326,8 @@ def load_on_points(law: TargetLaw, x, v, n, area, radius, R_meridian, sin_phi0, 
     """The target's forces on surface points: immersion, the law on the immersed points, the linear crater.
 
     The one implementation for the rigid and the deformable projectile (they differ only in where their
-    points come from and in ``reduce``).
+    points come from and in ``reduce``). The point forces come from the C transcription of the law
+    (fepen/laws/target_kernel.c) when it builds, else from :func:`point_forces` (numpy, the reference).
 
     Args:
         law: the TargetLaw. x, v, n, area, radius, R_meridian, sin_phi0, axis: as SurfaceState, over all of
@@ -336,14 +339,8 @@ def load_on_points(law: TargetLaw, x, v, n, area, radius, R_meridian, sin_phi0, 
     Returns:
         The PointLoad.
     """
-    f = np.zeros_like(x)
-    idx = np.flatnonzero(immersion(law, x, area) > 0.0)
-    sig = np.zeros(0)
-    if len(idx):
-        st = SurfaceState(x[idx], v[idx], n[idx], area[idx], radius[idx], R_meridian[idx], sin_phi0[idx], axis)
-        f[idx], sig = forces(law, st)
-    loaded = sig > 0.0
-    sums = np.array([*f.sum(axis=0), float(loaded.sum()), float(area[idx][loaded].sum()) if len(idx) else 0.0])
+    kernel = _point_kernel()
+    f, sums = (kernel or point_forces)(law, x, v, n, area, radius, R_meridian, sin_phi0, axis)
     if reduce is not None:
         sums = reduce(sums)
     total = sums[:3]
@@ -352,6 +349,71 @@ def load_on_points(law: TargetLaw, x, v, n, area, radius, R_meridian, sin_phi0, 
         f *= scale
         total = total * scale
     return PointLoad(f, total, int(sums[3]), float(sums[4]))
+
+
+def point_forces(law: TargetLaw, x, v, n, area, radius, R_meridian, sin_phi0, axis):
+    """The law's forces on every point (k, 3) (zero where not immersed) and their sums (force (3), loaded
+    points, loaded area), before any crater scaling: numpy, the reference of the C kernel."""
+    f = np.zeros_like(x)
+    idx = np.flatnonzero(immersion(law, x, area) > 0.0)
+    sig = np.zeros(0)
+    if len(idx):
+        st = SurfaceState(x[idx], v[idx], n[idx], area[idx], radius[idx], R_meridian[idx], sin_phi0[idx], axis)
+        f[idx], sig = forces(law, st)
+    loaded = sig > 0.0
+    sums = np.array([*f.sum(axis=0), float(loaded.sum()), float(area[idx][loaded].sum()) if len(idx) else 0.0])
+    return f, sums
+
+
+_KERNEL = {}
+
+
+def _point_kernel():
+    """point_forces in C (fepen/laws/target_kernel.c), or None when it does not build or FEPEN_KERNEL=numpy
+    (the numpy reference) is set."""
+    if "fn" not in _KERNEL:
+        _KERNEL["fn"] = None
+        if os.environ.get("FEPEN_KERNEL", "").lower() not in ("numpy", "numba"):
+            from fepen import native
+
+            lib, _KERNEL["why_not"] = native.load(Path(__file__).with_name("target_kernel.c"))
+            if lib is not None:
+                _KERNEL["fn"] = _bind(lib)
+    return _KERNEL["fn"]
+
+
+@functools.lru_cache(maxsize=16)
+def _law_numbers(law: TargetLaw) -> np.ndarray:
+    """The law as the C kernel's parameter array (the order of its enum)."""
+    return np.array([law.density, law.Y, law.E, law.T, law.lam, law.sigma_s, law.B,
+                     -1.0 if law.thickness is None else law.thickness,
+                     {"none": 0.0, "linear": 1.0, "energy": 2.0}[law.crater], law.k, law.D, float(law.separation),
+                     law.phi_min, float(law.free_surface), float(law.friction), law.mu,
+                     law.mu if law.mu_dynamic is None else law.mu_dynamic, law.mu_decay, law.lock_density,
+                     law.crush_strain, law.c_over_a, float(law.given_sigma_s), law.onset])
+
+
+def _bind(lib):
+    import ctypes
+
+    vp, i32 = ctypes.c_void_p, ctypes.c_int32
+    lib.point_forces.argtypes = [i32, *[vp] * 10, i32, vp, vp, vp]
+    lib.point_forces.restype = i32
+    xg, wg = _gauss_legendre(8)
+    gauss = np.ascontiguousarray(np.concatenate([xg, wg]))
+    def c_point_forces(law, x, v, n, area, radius, R_meridian, sin_phi0, axis):
+        p = _law_numbers(law)
+        arrays = [np.ascontiguousarray(a, dtype=float) for a in (x, v, n, area, radius, R_meridian, sin_phi0)]
+        ax = None if axis is None else np.ascontiguousarray(axis, dtype=float)
+        k = len(arrays[0])
+        f, sig, sums = np.empty((k, 3)), np.empty(k), np.empty(5)
+        count = lib.point_forces(k, *[a.ctypes.data for a in arrays], None if ax is None else ax.ctypes.data,
+                                 p.ctypes.data, gauss.ctypes.data, len(xg), f.ctypes.data, sig.ctypes.data,
+                                 sums.ctypes.data)
+        assert count == len(p), "target_kernel.c and _law_numbers disagree on the parameters"
+        return f, sums
+
+    return c_point_forces
 
 
 @dataclass

@@ -4,52 +4,17 @@ with ctypes; the numba kernel (fepen.solver.kernels.stress_update) stays the ref
 from __future__ import annotations
 
 import ctypes
-import hashlib
 import os
-import subprocess
 from pathlib import Path
 
 import numpy as np
 
-from fepen.atomic import replacing
+from fepen import native
 
 SOURCE = Path(__file__).with_name("cell_kernel.c")
-FLAGS = ["-O3", "-march=native", "-fopenmp-simd", "-fPIC", "-shared"]
 
 _lib = None
 _why_not = None
-
-
-def _cpu_flags() -> str:
-    try:
-        for line in Path("/proc/cpuinfo").read_text().splitlines():
-            if line.startswith("flags"):
-                return line
-    except OSError:
-        pass
-    return os.uname().machine
-
-
-def cache_dir() -> Path:
-    """Where the built kernel is kept."""
-    env = os.environ.get("FEPEN_KERNEL_CACHE")
-    if env:
-        return Path(env)
-    base = os.environ.get("XDG_CACHE_HOME") or str(Path.home() / ".cache")
-    return Path(base) / "fepen"
-
-
-def _build(cc: str) -> Path:
-    version = subprocess.run([cc, "--version"], capture_output=True, text=True, check=True).stdout
-    src = SOURCE.read_bytes()
-    key = hashlib.sha256(src + " ".join(FLAGS).encode() + version.encode() + _cpu_flags().encode())
-    out = cache_dir() / f"cell_kernel-{key.hexdigest()[:16]}.so"
-    if out.exists():
-        return out
-    out.parent.mkdir(parents=True, exist_ok=True)
-    with replacing(out, ".so") as tmp:
-        subprocess.run([cc, *FLAGS, str(SOURCE), "-o", str(tmp)], capture_output=True, text=True, check=True)
-    return out
 
 
 def library():
@@ -60,11 +25,9 @@ def library():
     if os.environ.get("FEPEN_KERNEL", "").lower() == "numba":
         _why_not = "FEPEN_KERNEL=numba"
         return None
-    try:
-        lib = ctypes.CDLL(str(_build(os.environ.get("CC", "cc"))))
-    except (OSError, subprocess.CalledProcessError) as err:
-        detail = getattr(err, "stderr", "") or str(err)
-        _why_not = f"C kernel not built ({detail.strip().splitlines()[-1] if detail.strip() else err})"
+    lib, why = native.load(SOURCE)
+    if lib is None:
+        _why_not = why
         return None
     vp, i32, dbl = ctypes.c_void_p, ctypes.c_int32, ctypes.c_double
     lib.trial_pass.argtypes = [i32, vp, vp, vp, dbl, vp, vp, vp, vp, vp, i32, vp, vp, vp, vp]

@@ -180,13 +180,21 @@ def load_sets(folder) -> dict[str, list]:
 
 
 def main(argv=None) -> int:
-    """``python -m fepen.studies.calibration DIR [CURVES_PREFIX]``: run (or reuse, from
-    CURVES_PREFIX-<crater>.npz) the curves of each crater, fit, choose the crater, report."""
-    argv = sys.argv[1:] if argv is None else argv
-    sets = load_sets(argv[0])
-    prefix = argv[1] if len(argv) > 1 else "calibration-curves"
+    """``python -m fepen.studies.calibration DIR [CURVES_PREFIX] [--set KEY=VALUE ...]``: run (or reuse, from
+    CURVES_PREFIX-<crater>.npz) the curves of each crater, fit, choose the crater, report. ``--set`` lines go
+    to every run: the refit of σ_s for a friction law, e.g. ``--set effects.friction=true``."""
+    import argparse
+
+    ap = argparse.ArgumentParser(prog="python -m fepen.studies.calibration")
+    ap.add_argument("data")
+    ap.add_argument("prefix", nargs="?", default="calibration-curves")
+    ap.add_argument("--set", dest="sets", action="append", default=[], metavar="KEY=VALUE")
+    args = ap.parse_args(sys.argv[1:] if argv is None else argv)
+    sets = load_sets(args.data)
+    prefix = args.prefix
     chosen, all_curves = {}, {}
     for crater, settings in CRATERS.items():
+        settings = (*settings, *args.sets)
         path = Path(f"{prefix}-{crater}.npz")
         if path.exists():
             z = np.load(path)
