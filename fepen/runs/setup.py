@@ -52,6 +52,8 @@ def target_law(scene) -> tg.TargetLaw:
         sigma_s = given
     elif t.strength_model in tg.S_MODELS:
         a, b, size = tg.S_MODELS[t.strength_model]
+        if t.strength_model == "scaled-S" and e.friction:  # refitted with friction on (theory.md §8.1)
+            a, b, size = tg.SCALED_S_FRICTION
         a = scene.get("target.S_coefficient") or a
         b = scene.get("target.S_exponent") if scene.get("target.S_exponent") is not None else b
         size = scene.get("target.S_size") or size
@@ -102,13 +104,30 @@ def projectile(scene) -> Built:
     return reach_mass(shape, mass, p.material.density, rho_c, adapt=not explicit and not scene.effects.charge)
 
 
+def friction_note(scene) -> str | None:
+    """A line when friction is on with the calibrated strength but not with the friction law its constants
+    were refitted for (Coulomb target.friction = 0.1)."""
+    t = scene.target
+    if not scene.effects.friction or t.strength_model != "scaled-S" or scene.get("target.S_coefficient"):
+        return None
+    mu_d = scene.get("target.friction_dynamic")
+    if t.friction == tg.SCALED_S_FRICTION_MU and (t.friction_decay == 0.0 or mu_d in (None, t.friction)):
+        return None
+    return (f"target: the scaled-S constants were refitted for Coulomb friction {tg.SCALED_S_FRICTION_MU:g}, "
+            "not for this friction law; refit them with `python -m fepen.studies.calibration DATA --set ...` "
+            "and give target.S_coefficient and target.S_size (docs/validation-depth.md)")
+
+
 def announce(scene, comm) -> Built:
-    """projectile(scene), with its note (if any) logged once, on rank 0: the front door of a run or a mesh."""
+    """projectile(scene), with its note (if any) and the friction note logged once, on rank 0: the front door
+    of a run or a mesh."""
     built = projectile(scene)
-    if built.note and comm.rank == 0:
+    if comm.rank == 0:
         import logging
 
-        logging.getLogger("fepen").warning(built.note)
+        for note in (built.note, friction_note(scene)):
+            if note:
+                logging.getLogger("fepen").warning(note)
     return built
 
 

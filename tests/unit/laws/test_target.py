@@ -163,6 +163,24 @@ def test_scene_builds_the_law():
     assert L2.crush_strain == pytest.approx(1 - 2400 / 2650)
 
 
+def test_friction_on_takes_the_constants_refitted_with_friction():
+    """σ_s must not count the interface twice: with friction on, scaled-S uses its friction refit, and a
+    friction law it was not refitted for is named in a note (no note for the refitted one)."""
+    D = 0.0236
+    off = setup.target_law(scene.load(None, []))
+    on = setup.target_law(scene.load(None, ["effects.friction=true"]))
+    assert off.sigma_s == pytest.approx(tg.strength_S(40e6, D, *tg.S_MODELS["scaled-S"]) * 40e6, rel=1e-12)
+    assert on.sigma_s == pytest.approx(tg.strength_S(40e6, D, *tg.SCALED_S_FRICTION) * 40e6, rel=1e-12)
+    assert on.sigma_s < off.sigma_s  # friction carries part of the resistance
+    assert setup.friction_note(scene.load(None, ["effects.friction=true"])) is None
+    assert setup.friction_note(scene.load(None, [])) is None
+    note = setup.friction_note(scene.load(None, ["effects.friction=true", "target.friction=0.3"]))
+    assert "target.S_coefficient" in note and "refit" in note
+    given = setup.target_law(scene.load(None, ["effects.friction=true", "target.S_coefficient=80"]))
+    assert given.sigma_s == pytest.approx(80 / 89.47 * off.sigma_s * math.sqrt(
+        (1 + D / tg.SCALED_S_SIZE) / (1 + D / tg.SCALED_S_FRICTION[2])), rel=1e-12)
+
+
 def test_immersion_is_the_submerged_fraction_of_a_patch():
     L = law(thickness=0.1)
     A = 4e-6  # a 2 mm patch
