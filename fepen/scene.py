@@ -20,6 +20,7 @@ from typing import Any
 
 from fepen.errors import InputError
 from fepen.experiments import SHOTS, shot
+from fepen.steels import STEELS
 
 _ABSENT = object()  # marks an optional key whose absence means something (e.g. semi-infinite target)
 
@@ -118,6 +119,9 @@ SCHEMA: dict[str, Key] = {
                                           doc="length of the narrower forward cavity section; 0: no step"),
     "projectile.base_thickness": _pos(0.015, "m", 10.0, doc="solid rear wall behind the cavity"),
     # --- projectile material: 45 steel, Johnson-Cook (Table 2) ---
+    "projectile.material.name": _choice("45-steel", *STEELS, doc="a named steel of fepen/data/steels.toml: sets "
+                                        "every projectile.material key not given explicitly (sources: "
+                                        "docs/theory.md §4)"),
     "projectile.material.density": _num(7850.0, "kg/m^3", 100.0, 30000.0),
     "projectile.material.youngs_modulus": _num(210.0e9, "Pa", 1.0e6, 1.0e13),
     "projectile.material.poisson_ratio": _num(0.3, "", 0.0, 0.5, hi_open=True),
@@ -378,6 +382,7 @@ def resolve(given: dict[str, Any]) -> Scene:
             flat[name] = key.default
 
     _resolve_shot(flat, given)
+    _resolve_steel(flat, given)
     _check_consistency(flat, given)
 
     tree: dict[str, Any] = {}
@@ -401,6 +406,14 @@ def _resolve_shot(flat: dict, given: dict) -> None:
             raise InputError(key, f"conflicts with impact.shot = {name!r}, which sets it to {value:g}; "
                                   "give one of the two")
         flat[key] = value
+
+
+def _resolve_steel(flat: dict, given: dict) -> None:
+    """The named steel's constants for every projectile.material key the user did not give."""
+    for key, value in STEELS[flat["projectile.material.name"]].items():
+        name = f"projectile.material.{key}"
+        if name in SCHEMA and name not in given:
+            flat[name] = SCHEMA[name].check(name, value)
 
 
 def _check_consistency(flat: dict, given: dict) -> None:

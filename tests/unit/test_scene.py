@@ -110,3 +110,22 @@ def test_sliding_friction_must_not_exceed_the_static_one():
         scene.load(None, ["target.friction=0.1", "target.friction_dynamic=0.2"])
     assert err.value.key == "target.friction_dynamic"
     assert scene.load(None, ["target.friction_dynamic=0.05"]).target.friction_dynamic == 0.05
+
+
+def test_named_steels_fill_the_material_and_explicit_keys_win():
+    from fepen.steels import STEELS
+
+    default = scene.load(None, [])
+    assert default.projectile.material.name == "45-steel"
+    for key, value in STEELS["45-steel"].items():  # the paper's steel is the default material, key by key
+        if key != "source":
+            assert getattr(default.projectile.material, key) == value, key
+    for name, steel in STEELS.items():
+        assert steel["source"].strip()
+        m = scene.load(None, [f"projectile.material.name={name}"]).projectile.material
+        assert all(getattr(m, k) == v for k, v in steel.items() if k != "source")
+        assert 0.0 < m.A < 3e9 and 1000.0 < m.melt_temperature < 2000.0
+    m = scene.load(None, ["projectile.material.name=aisi-4340", "projectile.material.A=800e6"]).projectile.material
+    assert m.A == 800e6 and m.B == STEELS["aisi-4340"]["B"]
+    with pytest.raises(InputError, match="projectile.material.name"):
+        scene.load(None, ["projectile.material.name=unobtainium"])
