@@ -135,6 +135,12 @@ SCHEMA: dict[str, Key] = {
     "projectile.material.reference_strain_rate": _pos(1.0, "1/s", 1.0e9),
     "projectile.material.specific_heat": _pos(470.0, "J/(kg K)", 1.0e5),
     "projectile.material.taylor_quinney": _num(0.9, "", 0.0, 1.0),
+    "projectile.wear.efficiency": _num(1.0, "", 0.0, 1.0,
+                                       doc="eta: the fraction of the interface heat that melts the surface off "
+                                           "(effects.wear; docs/theory.md §10)"),
+    "projectile.wear.friction": _num(_ABSENT, "", 0.0, 2.0,
+                                     doc="mu of the interface heat mu sigma_n |v_t|; absent: target.friction"),
+    "projectile.wear.latent_heat": _num(2.7e5, "J/kg", 0.0, 1.0e7, doc="latent heat of fusion of the steel"),
     "projectile.failure_strain": _num(0.5, "", 0.0, 100.0, lo_open=True,
                                       doc="PEEQ beyond which the projectile would fracture or erode: a concrete-"
                                           "target run stops, beyond the method (docs/theory.md)"),
@@ -185,6 +191,8 @@ SCHEMA: dict[str, Key] = {
     "effects.separation": _flag(True),
     "effects.free_surface": _flag(True),
     "effects.friction": _flag(False),
+    "effects.wear": _flag(False, doc="nose wear: the interface heat melts mass off the surface (rigid fidelity: "
+                                     "the mass loss; docs/theory.md §10)"),
     "effects.thermal": _flag(True),
     "effects.strain_rate": _flag(True),
     "effects.charge": _flag(False),
@@ -431,6 +439,9 @@ def _check_consistency(flat: dict, given: dict) -> None:
         flat.pop("projectile.cavity_length", None)
     if flat["effects.charge"] and flat["projectile.cavity_diameter"] == 0.0:
         raise InputError("effects.charge", "needs a cavity to fill: projectile.cavity_diameter must be > 0")
+    if flat["effects.wear"] and flat["effects.fidelity"] != "rigid":
+        raise InputError("effects.wear", "the deformable projectile's wear (surface recession) is not built yet: "
+                                         "use it with effects.fidelity = 'rigid' (mass loss only)")
     if flat["target.lock_density"] <= flat["target.density"]:
         raise InputError("target.lock_density", f"{flat['target.lock_density']:g} kg/m^3: must exceed "
                                                 f"target.density = {flat['target.density']:g} kg/m^3")

@@ -25,6 +25,8 @@ COL = {k: i for i, k in enumerate(HISTORY_COLUMNS)}
 #: appended with a charge: mass-averaged acceleration of each body along the axis (tail to nose), in g
 #: (negative while the projectile decelerates)
 CHARGE_COLUMNS = ["shell_acc_g", "charge_acc_g"]
+#: appended with effects.wear: the projectile's mass and the interface heat so far (fepen.laws.wear)
+WEAR_COLUMNS = ["mass_kg", "wear_heat_J"]
 #: appended with a charge in frictional contact (fepen.solver.shell_charge): friction dissipation, the largest gap,
 #: interpenetration and slip over the wall's node pairs, the fractions of pairs open and sliding
 INTERFACE_COLUMNS = ["friction_J", "interface_gap_max_mm", "interface_penetration_max_mm", "interface_slip_max_mm",

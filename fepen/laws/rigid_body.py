@@ -163,5 +163,21 @@ class RigidBody:
         new.q /= np.linalg.norm(new.q)
         return new, F0, M0, dt / 6.0 * work
 
+    def remove_mass(self, s: RigidState, dm: float) -> tuple[RigidState, float]:
+        """Take dm (kg) off the body uniformly (mass and inertia scaled alike; the centre and the velocities
+        unchanged, so the removed material leaves at the body's own velocity and exerts no thrust).
+
+        Returns:
+            (the state with the angular momentum scaled to keep ω, the kinetic energy the removed mass carries
+            away (J)).
+        """
+        f = (self.mass - dm) / self.mass
+        ke = self.kinetic_energy(s)
+        self.mass -= dm
+        self.I_body = self.I_body * f
+        self.I_body_inv = self.I_body_inv / f
+        new = RigidState(s.c.copy(), s.q.copy(), s.V.copy(), s.L * f)
+        return new, ke - self.kinetic_energy(new)
+
     def kinetic_energy(self, s: RigidState) -> float:
         return 0.5 * self.mass * float(s.V @ s.V) + 0.5 * float(self.omega(s) @ s.L)

@@ -17,6 +17,7 @@ from fepen.geometry import mesh as fmesh
 from fepen.geometry import revolution, tags
 from fepen.io import files, results
 from fepen.laws import target as tg
+from fepen.laws import wear
 from fepen.laws.rigid_body import (
     RigidBody,
     RigidState,
@@ -120,6 +121,7 @@ class RigidRun:
         self.ke0 = self.body.kinetic_energy(self.state)
         self.loaded = 0
         self.area = 0.0
+        self.wear = Wear(scene) if scene.effects.wear else None
 
     # ------------------------------------------------------------------------------------------------
     def force_fn(self, s: RigidState, x, v, n):
@@ -129,6 +131,8 @@ class RigidRun:
         load = tg.load_on_points(self.law, x, v, n, g["area0"], g["radius"], g["R_meridian"], g["sin_phi0"],
                                  self.axis(s), self.crater, -tip[1])
         self.loaded, self.area = load.loaded, load.area
+        if self.wear is not None:
+            self.wear.stage(load.force, n, v)
         return load.force
 
     def axis(self, s: RigidState) -> np.ndarray:
@@ -139,11 +143,14 @@ class RigidRun:
         tip = self.body.to_world(s, self.tip_ref[None])[0]
         tail = self.body.to_world(s, self.tail_ref[None])[0]
         ke = self.body.kinetic_energy(s)
-        err = abs(ke - self.ke0 - self.w_ext) / self.ke0
+        removed = self.wear.kinetic_removed if self.wear is not None else 0.0
+        err = abs(ke + removed - self.ke0 - self.w_ext) / self.ke0
         en = dict(kinetic=ke, internal_work=0.0, external_work=self.w_ext, elastic=0.0, plastic=0.0, heat=0.0,
                   energy_error=err)
         row = results.history_row(self.t, tip, tail, s.V, force, self.mass, en, self.loaded, self.dt, 0.0,
                                   self.area)
+        if self.wear is not None:
+            row += [self.body.mass, self.wear.heat]
         results.finite_row(row, self.steps, self.t)
         self.rows.append(row)
 
@@ -161,8 +168,12 @@ class RigidRun:
         self.record(s, F)
         while self.t < hard_end:
             prev = s
+            if self.wear is not None:
+                self.wear.stages.clear()
             s, F, M, work = body.rk4_step(s, self.dt, self.force_fn)  # F, M: at the start of the step
             self.w_ext += work
+            if self.wear is not None:
+                s = self.wear.step(body, s, self.dt)
             self.t += self.dt
             self.steps += 1
             y = body.points(s)[0][:, 1]
@@ -188,8 +199,49 @@ class RigidRun:
                  "cells": self.cells, "ranks": self.comm.size,
                  "peak_memory_bytes": files.peak_memory_bytes(self.comm),
                  "load_points": len(self.pts["area0"]), "fidelity": "rigid"}
+        if self.wear is not None:
+            extra.update(self.wear.summary(self.mass, body.mass))
         summary = results.summary(self.scene, self.rows, outcome or "ended", extra)
         if self.out is not None:
-            results.write_history(self.rows, self.out, self.comm)
+            results.write_history(self.rows, self.out, self.comm, results.HISTORY_COLUMNS
+                                  + (results.WEAR_COLUMNS if self.wear is not None else []))
             files.write_json(self.out / "summary.json", summary, self.comm)
         return summary
+
+
+class Wear:
+    """The scalar nose wear of the rigid fidelity (docs/theory.md §10): the interface heat μ σ_n |v_t| summed
+    over the load points with the RK4 weights of the step's four stages, and the mass η Q/h it melts, taken
+    off the body after each step (fepen.laws.wear)."""
+
+    def __init__(self, scene):
+        m = scene.projectile.material
+        mu = scene.get("projectile.wear.friction")
+        self.mu = scene.target.friction if mu is None else mu
+        self.efficiency = scene.projectile.wear.efficiency
+        self.enthalpy = wear.melt_enthalpy(m.specific_heat, m.melt_temperature, m.room_temperature,
+                                           scene.projectile.wear.latent_heat)
+        self.stages: list[float] = []
+        self.heat = self.mass_lost = self.kinetic_removed = 0.0
+
+    def stage(self, force, n, v) -> None:
+        """Record one RK4 stage's heat rate (W)."""
+        self.stages.append(wear.heat_rate(force, n, v, self.mu))
+
+    def step(self, body, s, dt: float):
+        """Add the step's heat, take its melted mass off the body; the state after."""
+        q = self.stages
+        heat = dt / 6.0 * (q[0] + 2.0 * q[1] + 2.0 * q[2] + q[3])
+        dm = wear.melted_mass(heat, self.efficiency, self.enthalpy)
+        self.heat += heat
+        if dm <= 0.0:
+            return s
+        s, ke = body.remove_mass(s, dm)
+        self.mass_lost += dm
+        self.kinetic_removed += ke
+        return s
+
+    def summary(self, mass0: float, remaining: float) -> dict:
+        return {"mass_loss_kg": self.mass_lost, "mass_loss_percent": 100.0 * self.mass_lost / mass0,
+                "remaining_mass_kg": remaining,
+                "wear_heat_J": self.heat, "removed_kinetic_J": self.kinetic_removed}
