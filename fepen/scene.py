@@ -137,7 +137,7 @@ SCHEMA: dict[str, Key] = {
     "projectile.material.taylor_quinney": _num(0.9, "", 0.0, 1.0),
     "projectile.wear.efficiency": _num(1.0, "", 0.0, 1.0,
                                        doc="eta: the fraction of the interface heat that melts the surface off "
-                                           "(effects.wear; docs/theory.md §10)"),
+                                           "(effects.wear; docs/theory.md §14)"),
     "projectile.wear.friction": _num(_ABSENT, "", 0.0, 2.0,
                                      doc="mu of the interface heat mu sigma_n |v_t|; absent: target.friction"),
     "projectile.wear.latent_heat": _num(2.7e5, "J/kg", 0.0, 1.0e7, doc="latent heat of fusion of the steel"),
@@ -192,7 +192,7 @@ SCHEMA: dict[str, Key] = {
     "effects.free_surface": _flag(True),
     "effects.friction": _flag(False),
     "effects.wear": _flag(False, doc="nose wear: the interface heat melts mass off the surface (rigid fidelity: "
-                                     "the mass loss; docs/theory.md §10)"),
+                                     "the mass loss; docs/theory.md §14)"),
     "effects.thermal": _flag(True),
     "effects.strain_rate": _flag(True),
     "effects.charge": _flag(False),

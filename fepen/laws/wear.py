@@ -1,4 +1,4 @@
-"""Nose wear on plain arrays (docs/theory.md §10): the interface heat of the sliding target, and the mass it
+"""Nose wear on plain arrays (docs/theory.md §14): the interface heat of the sliding target, and the mass it
 melts off the projectile's surface.
 
 The heat: every loaded surface point slides past the target at |v_t| under the normal stress σ_n; the

@@ -147,7 +147,7 @@ class RigidRun:
         err = abs(ke + removed - self.ke0 - self.w_ext) / self.ke0
         en = dict(kinetic=ke, internal_work=0.0, external_work=self.w_ext, elastic=0.0, plastic=0.0, heat=0.0,
                   energy_error=err)
-        row = results.history_row(self.t, tip, tail, s.V, force, self.mass, en, self.loaded, self.dt, 0.0,
+        row = results.history_row(self.t, tip, tail, s.V, force, self.body.mass, en, self.loaded, self.dt, 0.0,
                                   self.area)
         if self.wear is not None:
             row += [self.body.mass, self.wear.heat]
@@ -210,7 +210,7 @@ class RigidRun:
 
 
 class Wear:
-    """The scalar nose wear of the rigid fidelity (docs/theory.md §10): the interface heat μ σ_n |v_t| summed
+    """The scalar nose wear of the rigid fidelity (docs/theory.md §14): the interface heat μ σ_n |v_t| summed
     over the load points with the RK4 weights of the step's four stages, and the mass η Q/h it melts, taken
     off the body after each step (fepen.laws.wear)."""
 
