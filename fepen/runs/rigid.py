@@ -168,8 +168,6 @@ class RigidRun:
         self.record(s, F)
         while self.t < hard_end:
             prev = s
-            if self.wear is not None:
-                self.wear.stages.clear()
             s, F, M, work = body.rk4_step(s, self.dt, self.force_fn)  # F, M: at the start of the step
             self.w_ext += work
             if self.wear is not None:
@@ -229,8 +227,10 @@ class Wear:
         self.stages.append(wear.heat_rate(force, n, v, self.mu))
 
     def step(self, body, s, dt: float):
-        """Add the step's heat, take its melted mass off the body; the state after."""
-        q = self.stages
+        """Add the step's heat (its four RK4 stages, the last recorded), take its melted mass off the body; the
+        state after."""
+        q = self.stages[-4:]
+        self.stages.clear()
         heat = dt / 6.0 * (q[0] + 2.0 * q[1] + 2.0 * q[2] + q[3])
         dm = wear.melted_mass(heat, self.efficiency, self.enthalpy)
         self.heat += heat
