@@ -141,9 +141,15 @@ SCHEMA: dict[str, Key] = {
     "projectile.wear.friction": _num(_ABSENT, "", 0.0, 2.0,
                                      doc="mu of the interface heat mu sigma_n |v_t|; absent: target.friction"),
     "projectile.wear.latent_heat": _num(2.7e5, "J/kg", 0.0, 1.0e7, doc="latent heat of fusion of the steel"),
-    "projectile.failure_strain": _num(0.5, "", 0.0, 100.0, lo_open=True,
-                                      doc="PEEQ beyond which the projectile would fracture or erode: a concrete-"
-                                          "target run stops, beyond the method (docs/theory.md)"),
+    "projectile.erosion.strain": _num(1.0, "", 0.0, 100.0, lo_open=True,
+                                      doc="equivalent plastic strain at which a cell erodes (effects.erosion; "
+                                          "docs/theory.md §15)"),
+    "projectile.erosion.step_ratio": _num(0.1, "", 0.0, 1.0, hi_open=True,
+                                          doc="a cell whose own stable step falls below this times the initial "
+                                              "step erodes (effects.erosion; 0: never)"),
+    "projectile.failure_strain": _num(_ABSENT, "", 0.0, 100.0, lo_open=True,
+                                      doc="PEEQ at which a concrete-target run stops, beyond the method "
+                                          "(docs/theory.md); absent: never (a mushrooming nose keeps running)"),
     # --- explosive charge (Table 4) ---
     "charge.material.density": _num(1850.0, "kg/m^3", 100.0, 30000.0),
     "charge.material.youngs_modulus": _num(10.1e9, "Pa", 1.0e5, 1.0e13),
@@ -192,7 +198,9 @@ SCHEMA: dict[str, Key] = {
     "effects.free_surface": _flag(True),
     "effects.friction": _flag(False),
     "effects.wear": _flag(False, doc="nose wear: the interface heat melts mass off the surface (rigid fidelity: "
-                                     "the mass loss; docs/theory.md §14)"),
+                                     "the mass loss; deformable: the surface recedes; docs/theory.md §14)"),
+    "effects.erosion": _flag(False, doc="element erosion of the meshed projectile: cells past projectile.erosion.* "
+                                        "are removed, the faces they expose loaded (docs/theory.md §15)"),
     "effects.thermal": _flag(True),
     "effects.strain_rate": _flag(True),
     "effects.charge": _flag(False),
@@ -439,9 +447,9 @@ def _check_consistency(flat: dict, given: dict) -> None:
         flat.pop("projectile.cavity_length", None)
     if flat["effects.charge"] and flat["projectile.cavity_diameter"] == 0.0:
         raise InputError("effects.charge", "needs a cavity to fill: projectile.cavity_diameter must be > 0")
-    if flat["effects.wear"] and flat["effects.fidelity"] != "rigid":
-        raise InputError("effects.wear", "the deformable projectile's wear (surface recession) is not built yet: "
-                                         "use it with effects.fidelity = 'rigid' (mass loss only)")
+    if flat["effects.erosion"] and flat["effects.fidelity"] == "rigid":
+        raise InputError("effects.erosion", "removes cells of the meshed projectile: use it with effects.fidelity "
+                                            "= 'elastic' or 'plastic' (the rigid fidelity has the scalar wear)")
     if flat["target.lock_density"] <= flat["target.density"]:
         raise InputError("target.lock_density", f"{flat['target.lock_density']:g} kg/m^3: must exceed "
                                                 f"target.density = {flat['target.density']:g} kg/m^3")

@@ -27,6 +27,9 @@ COL = {k: i for i, k in enumerate(HISTORY_COLUMNS)}
 CHARGE_COLUMNS = ["shell_acc_g", "charge_acc_g"]
 #: appended with effects.wear: the projectile's mass and the interface heat so far (fepen.laws.wear)
 WEAR_COLUMNS = ["mass_kg", "wear_heat_J"]
+#: appended in a deformable run with effects.wear or effects.erosion: the mass, the interface heat, the
+#: eroded cells and the kinetic energy the removed material carried away, so far
+REMOVAL_COLUMNS = ["mass_kg", "wear_heat_J", "eroded_cells", "removed_kinetic_J"]
 #: appended with a charge in frictional contact (fepen.solver.shell_charge): friction dissipation, the largest gap,
 #: interpenetration and slip over the wall's node pairs, the fractions of pairs open and sliding
 INTERFACE_COLUMNS = ["friction_J", "interface_gap_max_mm", "interface_penetration_max_mm", "interface_slip_max_mm",

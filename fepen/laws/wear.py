@@ -13,7 +13,7 @@ from __future__ import annotations
 
 import numpy as np
 
-__all__ = ["LATENT_HEAT_STEEL", "heat_rate", "melt_enthalpy", "melted_mass"]
+__all__ = ["LATENT_HEAT_STEEL", "heat_rate", "heat_rates", "melt_enthalpy", "melted_mass", "recession_depth"]
 
 #: latent heat of fusion of carbon and low-alloy steels, J/kg (about 2.7e5; e.g. Smithells Metals Reference
 #: Book: about 250–280 kJ/kg for iron and plain carbon steels)
@@ -32,6 +32,21 @@ def melt_enthalpy(specific_heat: float, melt_temperature: float, room_temperatur
         h (J/kg).
     """
     return specific_heat * (melt_temperature - room_temperature) + latent_heat
+
+
+def heat_rates(force: np.ndarray, n: np.ndarray, v: np.ndarray, mu: float) -> np.ndarray:
+    """Each point's interface heat per unit time (W): μ σ_n A |v_t| (see heat_rate), (k,)."""
+    normal = np.maximum(-np.einsum("ij,ij->i", force, n), 0.0)
+    vn = np.einsum("ij,ij->i", v, n)
+    vt = np.linalg.norm(v - vn[:, None] * n, axis=1)
+    return mu * normal * vt
+
+
+def recession_depth(heat: np.ndarray, area: np.ndarray, efficiency: float, enthalpy: float,
+                    density: float) -> np.ndarray:
+    """Depth (m) by which a surface recedes when the heat (J) it took over its area (m²) melts its mass off:
+    d = η Q / (h ρ A); 0 where the area is 0."""
+    return np.where(area > 0.0, efficiency * heat / (enthalpy * density * np.where(area > 0.0, area, 1.0)), 0.0)
 
 
 def heat_rate(force: np.ndarray, n: np.ndarray, v: np.ndarray, mu: float) -> float:

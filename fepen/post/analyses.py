@@ -133,7 +133,7 @@ def deformed_picture(solver, path: Path, title: str = "") -> None:
     x = solver.positions()
     p = x[solver.dofs]
     centres0 = solver.X[solver.dofs].mean(axis=1)
-    keep = centres0[:, 2] <= 0.0
+    keep = (centres0[:, 2] <= 0.0) & (solver.mat >= 0)  # eroded cells are gone
     parts = comm.gather((p[keep], solver.eps_p[keep]), root=0)
     if comm.rank:
         return
@@ -155,6 +155,68 @@ def deformed_picture(solver, path: Path, title: str = "") -> None:
     plotter.add_text(f"{title}\nPEEQ colour scale: black 0 ... yellow {hi:.3g}", font_size=10, color="black")
     plotter.screenshot(str(path))
     plotter.close()
+
+
+#: axial bin of the nose profile (m)
+PROFILE_BIN = 0.5e-3
+
+
+def nose_profile(solver, model, out: Path) -> dict | None:
+    """nose_profile.csv and nose_profile.png: the nose's outer radius against the distance behind the
+    original tip, before (the exact shape) and after (the largest radius of the final surface's nodes in
+    each PROFILE_BIN, in the frame of the deformed axis: tail node to tip node), over the nose and one
+    calibre behind it (collective; rank 0 writes). Returns {"tip_recession_mm", "max_radius_mm"} on every rank.
+    """
+    from fepen.io import files
+
+    comm = solver.comm
+    shape = model.pm.shape
+    x = solver.positions()
+    tip, tail = solver.node_value(model.tip, x), solver.node_value(model.tail, x)
+    axis = unit_axis(tip, tail)  # tail to nose
+    nodes = np.unique(model.surface.tri)
+    nodes = nodes[~solver.orphans[nodes]]
+    rel = x[nodes] - tail
+    along = rel @ axis
+    behind = shape.length - along  # distance behind the original tip position
+    radius = np.linalg.norm(rel - along[:, None] * axis, axis=1)
+    parts = comm.gather((behind, radius), root=0)
+    result = None
+    if comm.rank == 0:
+        behind = np.concatenate([p[0] for p in parts])
+        radius = np.concatenate([p[1] for p in parts])
+        reach = shape.nose_length + shape.diameter
+        z0 = np.arange(0.0, reach + 1e-12, 0.25e-3)
+        r0 = shape.outer_radius(z0)
+        sel = behind <= reach
+        k = np.floor(np.maximum(behind[sel], 0.0) / PROFILE_BIN).astype(int)
+        r_after = np.zeros(k.max(initial=-1) + 1)
+        np.maximum.at(r_after, k, radius[sel])
+        z_after = (np.arange(len(r_after)) + 0.5) * PROFILE_BIN
+        z_after, r_after = z_after[r_after > 0.0], r_after[r_after > 0.0]
+        lines = ["state,behind_tip_mm,radius_mm"]
+        lines += [f"before,{a * 1e3:.4f},{b * 1e3:.4f}" for a, b in zip(z0, r0)]
+        lines += [f"after,{a * 1e3:.4f},{b * 1e3:.4f}" for a, b in zip(z_after, r_after)]
+        files.write_text(Path(out) / "nose_profile.csv", "\n".join(lines) + "\n", MPI.COMM_SELF)
+        result = {"tip_recession_mm": float(behind.min() * 1e3) if len(behind) else 0.0,
+                  "max_radius_mm": float(radius[sel].max() * 1e3) if sel.any() else 0.0}
+        import matplotlib
+
+        matplotlib.use("Agg")
+        import matplotlib.pyplot as plt
+
+        fig, ax = plt.subplots(figsize=(8, 3.2))
+        for sign in (1, -1):
+            ax.plot(z0 * 1e3, sign * r0 * 1e3, "k--", lw=1, label="before" if sign > 0 else None)
+            ax.plot(z_after * 1e3, sign * r_after * 1e3, "C3", lw=1.5, label="after" if sign > 0 else None)
+        ax.set(xlabel="distance behind the original tip (mm)", ylabel="radius (mm)", aspect="equal",
+               title=f"nose profile: tip {result['tip_recession_mm']:.2f} mm behind, "
+                     f"largest radius {result['max_radius_mm']:.2f} mm")
+        ax.legend(loc="lower right", fontsize=8)
+        fig.tight_layout()
+        fig.savefig(Path(out) / "nose_profile.png", dpi=120)
+        plt.close(fig)
+    return comm.bcast(result, root=0)
 
 
 class ChargeSections:

@@ -18,6 +18,7 @@ from fepen.io import files, results
 from fepen.io.fields import FieldWriter
 from fepen.post import analyses, signals, slices
 from fepen.runs import checkpoint, events, model, outputs
+from fepen.solver import explicit
 
 #: steps between two checks of the stop rules in the target (each costs a few reductions)
 EVENT_EVERY = 20
@@ -45,13 +46,16 @@ class DeformableRun:
         self.pm, self.solver, self.load, self.contact = m.pm, m.solver, m.load, m.contact
         self.gauges = analyses.Gauges(self.solver, self.pm)
         self.sections = analyses.ChargeSections(self.solver, self.pm) if self.pm.charge else None
+        self.removal = m.erosion is not None or m.recession is not None
         self.columns = (results.HISTORY_COLUMNS + (results.CHARGE_COLUMNS if self.pm.charge else [])
-                        + (results.INTERFACE_COLUMNS if self.contact is not None else []))
+                        + (results.INTERFACE_COLUMNS if self.contact is not None else [])
+                        + (results.REMOVAL_COLUMNS if self.removal else []))
         self.rows: list[list[float]] = []
         self.end = scene.get("run.end_time")
         self.rules = events.StopRules(m.law.thickness if m.law is not None else None, self.end is None)
         self.peaks: dict | None = None
         self.charge: dict | None = None
+        self.profile: dict | None = None
         self.output_s = 0.0
         self.wall_before = 0.0
         sc = scene.run
@@ -78,12 +82,17 @@ class DeformableRun:
         s = self.solver
         t_loop = time.perf_counter()
         outcome, completed = None, False
+        m = self.model
         try:
             while outcome is None and s.t < self.hard_end:
                 for o in self.outputs:
                     if o.due(self):
                         o.write(self)
                 s.step()
+                if m.recession is not None and s.step_count % m.recession.every == 0:
+                    m.recession.apply()
+                if m.erosion is not None and s.step_count % explicit.STEP_EVERY == 1 and m.erosion.check():
+                    self._after_erosion()
                 outcome = self.stop_rules()
             self.record()  # the final state
             if self.fields is not None:
@@ -106,7 +115,9 @@ class DeformableRun:
             return self.rules.rebound(s.t, self.load.contact_nodes)
         if s.step_count % EVENT_EVERY:
             return None
-        if events.beyond_method(s.max_peeq(), self.scene.projectile.failure_strain):
+        if m.erosion is not None and s.total_mass < events.ERODED_FRACTION * s.initial_mass:
+            return "eroded"
+        if events.beyond_method(s.max_peeq(), self.scene.get("projectile.failure_strain")):
             self._beyond_method()
         x = s.positions()
         pts = m.surface.kinematics(x, s.Vel)[0]
@@ -117,13 +128,31 @@ class DeformableRun:
         axis = unit_axis(s.node_value(m.tip, x), s.node_value(m.tail, x))
         return self.rules.penetration(y_min, y_max, s.momentum_velocity(), axis, s.total_mass, s.ke0)
 
+    def _after_erosion(self) -> None:
+        """If the nose-tip (tail) node lost its last cell, the foremost (rearmost) live node along the axis
+        takes its place (collective)."""
+        s, m = self.solver, self.model
+        x = s.positions()
+        axis = unit_axis(s.node_value(m.tip, x), s.node_value(m.tail, x))
+        for name, sign in (("tip", 1.0), ("tail", -1.0)):
+            owner, local = getattr(m, name)
+            dead = self.comm.bcast(bool(s.orphans[local]) if self.comm.rank == owner else None, root=owner)
+            if not dead:
+                continue
+            ahead = np.where(s.orphans[: s.n_owned], -np.inf, sign * (x[: s.n_owned] @ axis))
+            k = int(np.argmax(ahead)) if len(ahead) else -1
+            best = float(ahead[k]) if k >= 0 else -np.inf
+            _, owner = self.comm.allreduce((best, self.comm.rank), op=MPI.MAXLOC)
+            setattr(m, name, (owner, k if self.comm.rank == owner else -1))
+        self.load.tip, self.load.tail = m.tip, m.tail
+
     def _beyond_method(self):
         """Stop: the equivalent plastic strain passed projectile.failure_strain (where, when)."""
         s = self.solver
         peeq, where = s.max_peeq_where()
         raise BeyondMethod(
             f"the equivalent plastic strain reached {peeq:.3g} > projectile.failure_strain = "
-            f"{self.scene.projectile.failure_strain:g}, {where[1] * 1e3:.1f} mm behind the nose tip "
+            f"{self.scene.get('projectile.failure_strain'):g}, {where[1] * 1e3:.1f} mm behind the nose tip "
             f"(radius {np.hypot(where[0], where[2]) * 1e3:.1f} mm), at t = {s.t * 1e6:.1f} us, step "
             f"{s.step_count}: the projectile would fracture or erode, which projectile-target separation "
             "does not model; no result is reported")
@@ -146,6 +175,9 @@ class DeformableRun:
             i = self.contact.summary()
             row += [e.friction, i["gap_max_mm"], i["penetration_max_mm"], i["slip_max_mm"], i["free_fraction"],
                     i["sliding_fraction"]]
+        if self.removal:
+            heat = self.comm.allreduce(m.recession.heat_total, op=MPI.SUM) if m.recession is not None else 0.0
+            row += [s.total_mass, heat, m.erosion.count if m.erosion is not None else 0, e.removed_kinetic]
         results.finite_row(row, s.step_count, s.t)
         self.rows.append(row)
         self.gauges.record()
@@ -163,6 +195,8 @@ class DeformableRun:
         if self.pm.charge:
             names.append("body")  # 1 shell, 2 charge: for ParaView's Threshold
         scalars = ["interface_gap_m", "interface_slip_m"] if self.contact is not None else []
+        if self.model.recession is not None:
+            scalars.append("wear_depth_m")
         return FieldWriter(self.out, self.solver, ["displacement", "velocity"], names, times, scalars)
 
     def write_fields(self) -> None:
@@ -174,6 +208,8 @@ class DeformableRun:
                   "body": s.mat + 1.0}
         if self.contact is not None:
             values.update(self.contact.nodal_gap_and_slip())
+        if m.recession is not None:
+            values["wear_depth_m"] = m.recession.depth
         self.fields.write(s.t, values)
 
     def write_analyses(self) -> None:
@@ -190,6 +226,8 @@ class DeformableRun:
             self.charge = self.comm.bcast(report, root=0)
         s = self.solver
         analyses.deformed_picture(s, self.out / "deformed.png", f"t = {s.t * 1e6:.0f} us, max PEEQ {s.max_peeq():.3g}")
+        if self.model.surface is not None:
+            self.profile = analyses.nose_profile(s, self.model, self.out)
 
     def _write_accelerations(self) -> dict:
         """accelerations.csv: the target deceleration (and with a charge each body's axial acceleration),
@@ -224,9 +262,24 @@ class DeformableRun:
                  "peak_memory_bytes": files.peak_memory_bytes(self.comm),
                  "peak_accelerations": self.peaks, "charge": self.charge,
                  "acceleration_filter_hz": self.scene.run.acceleration_filter_hz}
+        extra.update(self.removal_summary())
+        extra["nose_profile"] = self.profile
         summary = results.summary(self.scene, self.rows, outcome, extra)
         files.write_json(self.out / "summary.json", summary, self.comm)
         return summary
+
+    def removal_summary(self) -> dict:
+        """Mass loss, length change, eroded cells, the wear heat and the removed energies (every deformable
+        run; zero when wear and erosion are off)."""
+        s, m = self.solver, self.model
+        e = s.energies()
+        lost = s.initial_mass - s.total_mass
+        length = self.rows[-1][results.COL["length_mm"]] if self.rows else self.pm.shape.length * 1e3
+        heat = self.comm.allreduce(m.recession.heat_total, op=MPI.SUM) if m.recession is not None else 0.0
+        return {"mass_loss_kg": lost, "mass_loss_percent": 100.0 * lost / s.initial_mass,
+                "remaining_mass_kg": s.total_mass, "length_change_mm": length - self.pm.shape.length * 1e3,
+                "eroded_cells": m.erosion.count if m.erosion is not None else 0, "wear_heat_J": heat,
+                "removed_kinetic_J": e.removed_kinetic, "removed_elastic_J": e.removed_internal}
 
     # ------------------------------------------------------------------------------------------------
     #: arrays held by rank 0 only in a checkpoint: the run's tables and the load's last state
@@ -236,6 +289,12 @@ class DeformableRun:
         """A checkpoint of the state between two steps (collective)."""
         s = self.solver
         arrays = dict(s.state())
+        m = self.model
+        if m.surface is not None and (m.erosion is not None or m.recession is not None):
+            arrays.update({f"surface_{k}": getattr(m.surface, k) for k in m.surface.FIELDS})
+        if m.recession is not None:
+            arrays.update(wear_heat_nodes=m.recession.heat_nodes, wear_depth=m.recession.depth,
+                          wear_heat=np.array([m.recession.heat_total]))
         if self.comm.rank == 0:
             arrays["rows"] = np.array(self.rows, dtype=float)
             arrays["gauge_rows"] = np.array(self.gauges.rows, dtype=float)
@@ -244,7 +303,9 @@ class DeformableRun:
             arrays["load"] = np.array([*self.load.force, self.load.contact_nodes, self.load.area])
         loop = {"next_hist": self.history.clock.next,
                 "next_out": self.fields_out.clock.next if self.fields_out is not None else 0.0,
-                "next_ckpt": self.checkpoints.clock.next, **self.rules.state()}
+                "next_ckpt": self.checkpoints.clock.next, **self.rules.state(),
+                "eroded_cells": m.erosion.count if m.erosion is not None else 0,
+                "tip": self._tip_reference()}
         meta = {"wall_s": self.wall_before + time.perf_counter() - self.wall_t0, "loop": loop,
                 "field_times_s": list(self.fields.times) if self.fields is not None else []}
         checkpoint.write(self.out, self.comm, s.step_count, s.t, arrays, meta)
@@ -252,11 +313,20 @@ class DeformableRun:
     def restore(self, state: dict) -> list[float]:
         """Put a checkpoint back into this freshly built run (collective). Returns the field output times."""
         z = checkpoint.read_arrays(self.out, self.comm, state, self.ROOT_ARRAYS)
-        same = z["X"].shape == self.solver.X.shape and np.array_equal(z["X"], self.solver.X)
+        X0 = z["X0"] if "X0" in z else z["X"]
+        same = X0.shape == self.solver.X0.shape and np.array_equal(X0, self.solver.X0)
         if not self.comm.allreduce(same, op=MPI.LAND):
             raise InputError("--resume", "the mesh rebuilt from scene.toml differs from the checkpointed one "
                                          "(another fepen or gmsh version, or another partition)")
         self.solver.restore(z)
+        m = self.model
+        if "surface_tri" in z:
+            for k in m.surface.FIELDS:
+                setattr(m.surface, k, np.ascontiguousarray(z[f"surface_{k}"]))
+        if m.recession is not None:
+            m.recession.heat_nodes[:] = z["wear_heat_nodes"]
+            m.recession.depth[:] = z["wear_depth"]
+            m.recession.heat_total = float(z["wear_heat"][0])
         self.rows = [list(r) for r in z["rows"]]
         self.gauges.rows = [list(r) for r in z["gauge_rows"]]
         if self.sections is not None and "section_rows" in z:
@@ -269,8 +339,19 @@ class DeformableRun:
             self.fields_out.clock.next = loop["next_out"]
         self.checkpoints.clock.next = loop["next_ckpt"]
         self.rules.restore(loop)
+        if m.erosion is not None:
+            m.erosion.count = int(loop.get("eroded_cells", 0))
+        if "tip" in loop:
+            m.tip = self.solver.node_at(loop["tip"])
+            self.load.tip = m.tip
         self.wall_before = float(state["wall_s"])
         return state["field_times_s"]
+
+    def _tip_reference(self) -> list[float]:
+        """The initial reference position of the current nose-tip node (to find it again on resume)."""
+        owner, local = self.model.tip
+        return self.comm.bcast([float(c) for c in self.solver.X0[local]] if self.comm.rank == owner else None,
+                               root=owner)
 
     def drop_checkpoints(self) -> None:
         checkpoint.drop(self.out, self.comm)

@@ -6,7 +6,9 @@
     perforated   every load point is beyond the rear face of a finite target
     ricochet     after entering, every load point is back above the face and the centre moves away
     rebound      on the rigid wall: no node has touched it for REBOUND_FREE_S after a contact
-    beyond the method   the equivalent plastic strain passed projectile.failure_strain (fepen.errors)
+    eroded       erosion left less than ERODED_FRACTION of the projectile's mass (effects.erosion)
+    beyond the method   the equivalent plastic strain passed projectile.failure_strain, when the scene
+                 gives one (fepen.errors)
 
 The rules are pure functions of a few reduced numbers; ``StopRules`` keeps their memory (entered,
 touched) for a run and its checkpoints.
@@ -39,9 +41,13 @@ def ricochet(y_min: float, vy: float) -> bool:
     return y_min > 0.0 and vy > 0.0
 
 
-def beyond_method(max_peeq: float, failure_strain: float) -> bool:
-    """The projectile would fracture or erode: what projectile-target separation does not model."""
-    return max_peeq > failure_strain
+#: the run stops ("eroded") when erosion has left less than this fraction of the projectile's mass
+ERODED_FRACTION = 0.05
+
+
+def beyond_method(max_peeq: float, failure_strain: float | None) -> bool:
+    """The user's projectile.failure_strain is passed (None: never)."""
+    return failure_strain is not None and max_peeq > failure_strain
 
 
 @dataclass

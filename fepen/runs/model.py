@@ -12,8 +12,9 @@ from mpi4py import MPI
 from fepen.geometry import mesh as fmesh
 from fepen.geometry import tags
 from fepen.laws import target as tg
+from fepen.laws import wear
 from fepen.runs import setup
-from fepen.solver import explicit, rigid_wall, shell_charge, surface, target_load
+from fepen.solver import erosion, explicit, recession, rigid_wall, shell_charge, surface, target_load
 
 
 # ---------------------------------------------------------------------------------------------------------
@@ -28,6 +29,8 @@ class Model:
         tip, tail: node handles of the nose tip and the tail centre (ExplicitSolver.node_at).
         v0: striking speed (m/s). surface: the target's load points (None on the rigid wall).
         law: the target law (None on the rigid wall). mesh_s, setup_s: wall seconds meshing and building.
+        erosion: element erosion (effects.erosion) or None. recession: the surface recession of the nose
+            (effects.wear, in the target) or None.
     """
 
     pm: fmesh.ProjectileMesh
@@ -41,6 +44,8 @@ class Model:
     law: tg.TargetLaw | None
     mesh_s: float
     setup_s: float
+    erosion: erosion.Erosion | None = None
+    recession: recession.Recession | None = None
 
 
 def solver(scene, pm: fmesh.ProjectileMesh, kernel: str | None = None) -> explicit.ExplicitSolver:
@@ -83,5 +88,18 @@ def build(scene, comm: MPI.Comm = MPI.COMM_WORLD) -> Model:
     else:
         load = rigid_wall.RigidWall(s)
     s.external = load
+    eroding = receding = None
+    if scene.effects.erosion:
+        pe = scene.projectile.erosion
+        eroding = erosion.Erosion(s, surf, pe.strain, pe.step_ratio)
+    if scene.effects.wear and surf is not None:
+        m = scene.projectile.material
+        mu = scene.get("projectile.wear.friction")
+        h = wear.melt_enthalpy(m.specific_heat, m.melt_temperature, m.room_temperature,
+                               scene.projectile.wear.latent_heat)
+        receding = recession.Recession(s, surf, scene.target.friction if mu is None else mu,
+                                       scene.projectile.wear.efficiency, h, m.density)
+        load.wear = receding
     s.set_initial(displacement=lambda X: X @ R.T - X, velocity=lambda X: np.tile(v, (len(X), 1)))
-    return Model(pm, s, load, contact, tip, tail, v0, surf, law, mesh_s, time.perf_counter() - t0)
+    return Model(pm, s, load, contact, tip, tail, v0, surf, law, mesh_s, time.perf_counter() - t0, eroding,
+                 receding)

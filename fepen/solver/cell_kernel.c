@@ -33,7 +33,8 @@ int32_t trial_pass(int32_t n, const double *restrict x, const double *restrict v
 #pragma omp simd
         for (int32_t k = 0; k < nb; k++) {
             int32_t e = e0 + k;
-            int32_t m = mat[e];
+            int32_t live = mat[e] >= 0;  /* eroded cells (material -1): P and s stay 0, never yielding */
+            int32_t m = live ? mat[e] : 0;
             int32_t n0 = dofs[4 * e + 0];
             int32_t n1 = dofs[4 * e + 1];
             int32_t n2 = dofs[4 * e + 2];
@@ -116,8 +117,14 @@ int32_t trial_pass(int32_t n, const double *restrict x, const double *restrict v
             double C20 = (k20 * R00 + k21 * R01 + k22 * R02) * r;
             double C21 = (k20 * R10 + k21 * R11 + k22 * R12) * r;
             double C22 = (k20 * R20 + k21 * R21 + k22 * R22) * r;
+            s0 = live ? s0 : 0.0; s1 = live ? s1 : 0.0; s2 = live ? s2 : 0.0;
+            s3 = live ? s3 : 0.0; s4 = live ? s4 : 0.0; s5 = live ? s5 : 0.0;
+            pm = live ? pm : 0.0;
+            C00 = live ? C00 : 0.0; C01 = live ? C01 : 0.0; C02 = live ? C02 : 0.0;
+            C10 = live ? C10 : 0.0; C11 = live ? C11 : 0.0; C12 = live ? C12 : 0.0;
+            C20 = live ? C20 : 0.0; C21 = live ? C21 : 0.0; C22 = live ? C22 : 0.0;
             s[0 * n + e] = s0; s[1 * n + e] = s1; s[2 * n + e] = s2; s[3 * n + e] = s3; s[4 * n + e] = s4; s[5 * n + e] = s5;
-            excess[k] = 1.5 * (s0 * s0 + s1 * s1 + s2 * s2 + 2.0 * (s3 * s3 + s4 * s4 + s5 * s5)) - sy0[e] * sy0[e];
+            excess[k] = live ? 1.5 * (s0 * s0 + s1 * s1 + s2 * s2 + 2.0 * (s3 * s3 + s4 * s4 + s5 * s5)) - sy0[e] * sy0[e] : -1.0;
             double p00 = s0 + pm, p11 = s1 + pm, p22 = s2 + pm;
             PT[0 * BLOCK + k] = p00 * C00 + s3 * C10 + s5 * C20;
             PT[1 * BLOCK + k] = p00 * C01 + s3 * C11 + s5 * C21;

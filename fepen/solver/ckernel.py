@@ -76,6 +76,12 @@ class TrialPass:
                       nodal_p.shape[1], addr(sT), addr(sy0), addr(P_out), addr(self.yielding))
         self._lib = lib
 
+    def refresh(self, mat: np.ndarray, det_R: np.ndarray) -> None:
+        """Take the cells' new materials (−1: eroded) and reference edge determinants, in place (after an
+        erosion or a surface recession changed them)."""
+        self._mat[:] = mat
+        np.divide(1.0, det_R, out=self._inv_det)
+
     def __call__(self, dt: float) -> np.ndarray:
         """Trial state of every cell over a step dt; returns the cells over their flow stress."""
         k = self._lib.trial_pass(*self._head, dt, *self._tail)

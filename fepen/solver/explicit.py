@@ -34,14 +34,19 @@ class Energies:
     initial_kinetic: float
     interface_normal_work: float = 0.0
     friction: float = 0.0
+    removed_kinetic: float = 0.0
+    removed_internal: float = 0.0
 
     @property
     def balance_error(self) -> float:
-        """Relative energy-balance error: KE + W_int − KE_0 − W_ext − W_interface, with W_interface the
-        work of the shell–charge contact forces (normal work − friction dissipation; fepen.solver.shell_charge)."""
+        """Relative energy-balance error: KE + KE_removed + W_int − KE_0 − W_ext − W_interface, with
+        W_interface the work of the shell–charge contact forces (normal work − friction dissipation;
+        fepen.solver.shell_charge) and KE_removed the kinetic energy the removed material carried away when
+        it was removed (erosion, surface recession; W_int keeps the work done on it)."""
         scale = max(self.initial_kinetic, abs(self.external_work), self.kinetic, 1e-300)
         w_if = self.interface_normal_work - self.friction
-        return abs(self.kinetic + self.internal_work - self.initial_kinetic - self.external_work - w_if) / scale
+        return abs(self.kinetic + self.removed_kinetic + self.internal_work - self.initial_kinetic
+                   - self.external_work - w_if) / scale
 
 
 @dataclass
@@ -86,7 +91,7 @@ class Interface(Protocol):
 
 #: the solver's state between two steps (checkpoints): nodal and cell arrays, and scalars; the work sums
 #: are each rank's own partial sums
-STATE_ARRAYS = ("U", "Vel", "acc", "fint", "fext", "s", "eps_p", "temp", "sy0")
+STATE_ARRAYS = ("U", "Vel", "acc", "fint", "fext", "s", "eps_p", "temp", "sy0", "X", "mat", "_removed")
 STATE_SCALARS = ("t", "step_count", "dt", "dt_prev", "dt0", "dt_min", "_w_int", "_w_ext", "_plastic", "_heat",
                  "ke0", "_w_if_n", "_w_if_t")
 
@@ -125,11 +130,22 @@ class ExplicitSolver:
         self.n_cells = n_cells
         self.dofs = np.ascontiguousarray(V.dofmap.list.array.reshape(-1, 4)[:n_cells]).astype(np.int64)
         self.X = V.tabulate_dof_coordinates()[: self.n_nodes].copy()
+        self.X0 = self.X.copy()  # X moves only where a surface recedes (fepen.solver.recession)
+        # the mesh geometry's node of each dof, so that a moved reference reaches the assembled form
+        gdofs = mesh.geometry.dofmap.array.reshape(-1, 4)
+        self._geometry_node = np.zeros(self.n_nodes, dtype=np.int64)
+        self._geometry_node[V.dofmap.list.array.reshape(-1, 4).ravel()] = gdofs.ravel()
+        self.geometry_x = mesh.geometry.x
+        assert np.allclose(self.geometry_x[self._geometry_node, :3], self.X)
         self.grad0, self.vol0, self.orient = kernels.reference_gradients(self.X, self.dofs)
         self.materials = materials
         self.params = np.stack([m.params for m in materials])
-        self.mat = np.ascontiguousarray(cell_material, dtype=np.int64)
+        self.mat = np.ascontiguousarray(cell_material, dtype=np.int64)  # −1: an eroded cell
         assert len(self.mat) == n_cells
+        self.cell_dt = np.full(n_cells, np.inf)  # each cell's altitude / wave speed, every STEP_EVERY steps
+        #: this rank's removed mass (owned nodes), kinetic energy carried away, stored elastic energy of
+        #: the removed cells (J); see remove_cells and change_reference
+        self._removed = np.zeros(3)
         self.speed = np.array([float(np.sqrt((m.bulk_modulus + 4.0 * m.shear_modulus / 3.0) / m.density))
                                for m in materials])
         self.bulk = np.array([m.bulk_modulus for m in materials])
@@ -137,6 +153,7 @@ class ExplicitSolver:
 
         self._nodal_arrays(V, imap, nm)
         self._lumped_mass(imap, nm)
+        self.initial_mass = self.total_mass
 
         # cell state
         self._sT = np.zeros((6, n_cells))  # component-major for the C trial pass
@@ -190,9 +207,11 @@ class ExplicitSolver:
         kernels.volumes_and_step(self.X, self.dofs, self.orient, self.vol0, self.mat, self.speed, self.nodal_vol0)
         self._ghost_sum(self._nvol0)
 
-    def _lumped_mass(self, imap, nm: int) -> None:
+    def _lumped_mass(self, imap, nm: int, orphans_allowed: bool = False) -> None:
         """Lumped mass: ρ_e V0_e / 4 to each node, per material (the bodies' masses, for their mass-averaged
-        accelerations) and in all."""
+        accelerations) and in all; eroded cells give none. ``_mass_div`` is the mass the accelerations are
+        divided by: the mass itself, or after an erosion a copy with 1 on the nodes left without a cell
+        (their force is zero, their velocity held at zero)."""
         materials = self.materials
         rho = np.array([m.density for m in materials])[self.mat]
         mvec = la.vector(imap, bs=nm)
@@ -204,8 +223,12 @@ class ExplicitSolver:
         self.mass_by_material = arr[: self.n_nodes].copy()
         self.mass = self.mass_by_material.sum(axis=1)
         self.body_mass = self.comm.allreduce(self.mass_by_material[: self.n_owned].sum(axis=0), op=MPI.SUM)
-        if np.any(self.mass[: self.n_owned] <= 0.0):
+        self.orphans = self.mass <= 0.0
+        if not orphans_allowed and np.any(self.orphans[: self.n_owned]):
             raise SimulationError("a node has no mass (an orphan node in the mesh)")
+        self._mass_div = self.mass
+        if np.any(self.orphans):
+            self._mass_div = np.where(self.orphans, 1.0, self.mass)
         self.total_mass = self.comm.allreduce(float(self.mass[: self.n_owned].sum()), op=MPI.SUM)
 
     def _internal_force_form(self, V, Q) -> None:
@@ -315,7 +338,7 @@ class ExplicitSolver:
             self.Vel[self.fixed] = 0.0
         self._forces(0.0)
         n = self.n_owned
-        self.acc[:n] = (self.fext[:n] - self.fint[:n]) / self.mass[:n, None]
+        self.acc[:n] = (self.fext[:n] - self.fint[:n]) / self._mass_div[:n, None]
         if self.fixed is not None:
             self.acc[self.fixed] = 0.0
         self.a_fn.x.scatter_forward()
@@ -342,7 +365,7 @@ class ExplicitSolver:
         x = np.add(self.X, self.U, out=self.x)
         with_step = self.step_count % STEP_EVERY == 0
         jmin, worst, h_c, self._step_cell = kernels.volumes_and_step(
-            x, self.dofs, self.orient, self.vol0, self.mat, self.speed, self.nodal_vol, with_step)
+            x, self.dofs, self.orient, self.vol0, self.mat, self.speed, self.nodal_vol, with_step, self.cell_dt)
         bad = not (jmin > 0.0)
         if self.comm.size > 1:  # every rank must stop together (and rank 0 must be able to say why)
             self._flag[0] = 1.0 if bad else 0.0
@@ -418,7 +441,7 @@ class ExplicitSolver:
         t0 = perf_counter()
         n = self.n_owned
         f = self.fext[:n] - self.fint[:n]
-        self.acc[:n] = f / self.mass[:n, None]
+        self.acc[:n] = f / self._mass_div[:n, None]
         if self.fixed is not None:
             self.acc[self.fixed] = 0.0
         self.a_fn.x.scatter_forward()
@@ -450,23 +473,89 @@ class ExplicitSolver:
         self.dt_min = min(self.dt_min, new)
 
     # ------------------------------------------------------------------------------------------------
+    def remove_cells(self, cells: np.ndarray) -> None:
+        """Erode owned cells (collective; ``cells`` may be empty on some ranks): their stress and force go,
+        their mass leaves their nodes, and a node left without a live cell stops (docs/theory.md §15).
+
+        The removed mass, the kinetic energy it carried (½ Δm_a |v_a|² at the integer step) and the elastic
+        energy stored in the removed cells are added to this rank's ``_removed`` sums.
+        """
+        cells = np.asarray(cells, dtype=np.int64)
+        if len(cells):
+            J = np.empty(self.n_cells)
+            kernels.cell_jacobians(self.positions(), self.dofs, self.orient, self.vol0, self.mat, J)
+            G = np.array([m.shear_modulus for m in self.materials])[self.mat[cells]]
+            self._removed[2] += kernels.deviatoric_energy(self.s[cells], J[cells], self.vol0[cells], G)
+            self.mat[cells] = -1
+            self.s[cells] = 0.0
+            self.P_packed[cells] = 0.0
+            self.sy0[cells] = np.inf
+            self.cell_dt[cells] = np.inf
+        self._new_reference(np.zeros(0, dtype=np.int64))
+
+    def change_reference(self, dX: np.ndarray) -> None:
+        """Move the reference positions of nodes by dX (n_nodes, 3), ghosts included and equal on every rank
+        that holds a node: material removed from a receding surface (fepen.solver.recession). The
+        displacement is kept, so the current positions move with the reference ones; the cells touched get
+        their new reference gradients and volumes, the nodes their new masses (collective)."""
+        moved = np.any(dX != 0.0, axis=1)
+        cells = np.flatnonzero(moved[self.dofs].any(axis=1))
+        self.X += dX
+        self._new_reference(cells)
+
+    def _new_reference(self, cells: np.ndarray) -> None:
+        """Recompute the reference data of ``cells`` and every nodal mass and volume (collective)."""
+        if len(cells):
+            g, v, o = kernels.reference_gradients(self.X, self.dofs[cells])
+            self.grad0[cells], self.vol0[cells], self.orient[cells] = g, v, o
+            if self.geometry_x is not None:
+                self.geometry_x[self._geometry_node, :3] = self.X
+        if self._trial is not None:
+            self._trial.refresh(self.mat, 6.0 * self.vol0 * self.orient)
+        old = self.mass.copy()
+        v = self.velocity_at_step()
+        kernels.volumes_and_step(self.X, self.dofs, self.orient, self.vol0, self.mat, self.speed,
+                                 self.nodal_vol0, False)
+        self._ghost_sum(self._nvol0)
+        nm = len(self.materials)
+        self._lumped_mass(self.V.dofmap.index_map, nm, orphans_allowed=True)
+        n = self.n_owned
+        dm = old[:n] - self.mass[:n]
+        self._removed[0] += float(dm.sum())
+        self._removed[1] += 0.5 * float(np.sum(dm[:, None] * v[:n] ** 2))
+        if np.any(self.orphans):
+            for a in (self.Vel, self.acc):
+                a[self.orphans] = 0.0
+
+    @property
+    def removed_mass(self) -> float:
+        """Mass removed so far (kg), all ranks."""
+        return self.comm.allreduce(float(self._removed[0]), op=MPI.SUM)
+
     def state(self) -> dict[str, np.ndarray]:
         """This rank's state between two steps: STATE_ARRAYS, the reference positions ``X`` and the
         STATE_SCALARS packed in ``scalars`` (for checkpoints; the arrays are views, copy to keep)."""
         out = {k: getattr(self, k) for k in STATE_ARRAYS}
-        out["X"] = self.X
+        out["X0"] = self.X0
         out["scalars"] = np.array([float(getattr(self, k)) for k in STATE_SCALARS])
         return out
 
     def restore(self, state) -> None:
         """Put back what state() returned (any mapping of the same names), in place: the compiled kernels
         hold these arrays' addresses. The mesh must be the same, node for node (ValueError if not)."""
-        if not (state["X"].shape == self.X.shape and np.array_equal(state["X"], self.X)):
+        X0 = state["X0"] if "X0" in state else state["X"]
+        if not (X0.shape == self.X0.shape and np.array_equal(X0, self.X0)):
             raise ValueError("the state was taken on another mesh or partition")
         for k in STATE_ARRAYS:
-            np.copyto(getattr(self, k), state[k])
+            if k in state:
+                np.copyto(getattr(self, k), state[k])
         for k, v in zip(STATE_SCALARS, state["scalars"]):
             setattr(self, k, int(v) if k == "step_count" else float(v))
+        if np.any(self.mat < 0) or not np.array_equal(self.X, self.X0):  # eroded or receded: rebuild
+            removed = self._removed.copy()
+            self._new_reference(np.arange(self.n_cells))
+            self.P_packed[: self.n_cells][self.mat < 0] = 0.0
+            self._removed[:] = removed
 
     def add_interface_work(self, normal: float, tangential: float) -> None:
         """Add this rank's share of the interface forces' work over the step (J)."""
@@ -490,11 +579,17 @@ class ExplicitSolver:
 
     def max_peeq(self) -> float:
         """The largest equivalent plastic strain, all ranks."""
-        return self.comm.allreduce(float(self.eps_p.max()) if self.n_cells else 0.0, op=MPI.MAX)
+        return self.comm.allreduce(float(self.live_peeq().max()) if self.n_cells else 0.0, op=MPI.MAX)
+
+    def live_peeq(self) -> np.ndarray:
+        """The owned cells' equivalent plastic strain, 0 on eroded cells."""
+        return self.eps_p if self._removed[0] == 0.0 and self.mat.min(initial=0) >= 0 else \
+            np.where(self.mat >= 0, self.eps_p, 0.0)
 
     def max_peeq_where(self) -> tuple[float, np.ndarray]:
         """The largest equivalent plastic strain and its cell's centre in the reference body, all ranks."""
-        local = (float(self.eps_p.max()), self.comm.rank, int(np.argmax(self.eps_p))) if self.n_cells else (-1.0, 0, -1)
+        ep = self.live_peeq()
+        local = (float(ep.max()), self.comm.rank, int(np.argmax(ep))) if self.n_cells else (-1.0, 0, -1)
         peeq, owner, cell = self.comm.allreduce(local, op=MPI.MAX)
         where = self.X[self.dofs[cell]].mean(axis=0) if self.comm.rank == owner else None
         return peeq, self.comm.bcast(where, root=owner)
@@ -508,7 +603,8 @@ class ExplicitSolver:
     def axial_stress(self, axis: np.ndarray) -> np.ndarray:
         """Normal Cauchy stress along the axis of the owned cells (Pa): a·s·a plus the cells' mean stress."""
         sd = self.s
-        pm = self.nodal_p[self.dofs, self.mat[:, None]].mean(axis=1) if self.nodal else 0.0
+        pm = self.nodal_p[self.dofs, np.maximum(self.mat, 0)[:, None]].mean(axis=1) * (self.mat >= 0) \
+            if self.nodal else 0.0
         ax, ay, az = axis
         return (sd[:, 0] * ax * ax + sd[:, 1] * ay * ay + sd[:, 2] * az * az
                 + 2 * (sd[:, 3] * ax * ay + sd[:, 4] * ay * az + sd[:, 5] * ax * az)) + pm
@@ -523,12 +619,13 @@ class ExplicitSolver:
             vol = self._element_volumetric_energy()
         dev = self._deviatoric_energy()
         sums = c.allreduce(np.array([self._w_int, self._w_ext, vol + dev, self._plastic, self._heat,
-                                     self._w_if_n, self._w_if_t]), op=MPI.SUM)
-        return Energies(ke, sums[0], sums[1], sums[2], sums[3], sums[4], self.ke0 or 0.0, sums[5], -sums[6])
+                                     self._w_if_n, self._w_if_t, self._removed[1], self._removed[2]]), op=MPI.SUM)
+        return Energies(ke, sums[0], sums[1], sums[2], sums[3], sums[4], self.ke0 or 0.0, sums[5], -sums[6],
+                        sums[7], sums[8])
 
     def _cell_J(self) -> np.ndarray:
         J = np.empty(self.n_cells)
-        kernels.cell_jacobians(self.positions(), self.dofs, self.orient, self.vol0, J)
+        kernels.cell_jacobians(self.positions(), self.dofs, self.orient, self.vol0, self.mat, J)
         return J
 
     def _deviatoric_energy(self) -> float:
@@ -541,8 +638,9 @@ class ExplicitSolver:
 
     # ------------------------------------------------------------------------------------------------
     def node_at(self, point) -> tuple[int, int]:
-        """(owner rank, local index) of the owned node at a reference point (exact match), or (-1, -1)."""
-        d = np.linalg.norm(self.X[: self.n_owned] - np.asarray(point), axis=1)
+        """(owner rank, local index) of the owned node at a point of the initial reference body (exact match),
+        or (-1, -1)."""
+        d = np.linalg.norm(self.X0[: self.n_owned] - np.asarray(point), axis=1)
         local = int(np.argmin(d)) if len(d) else -1
         mine = local >= 0 and d[local] < 1e-12
         ranks = self.comm.allgather(self.comm.rank if mine else -1)

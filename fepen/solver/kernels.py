@@ -47,8 +47,9 @@ def _six_volume(x, dofs, e):
 
 
 @numba.njit(cache=True, fastmath=_FAST, error_model="numpy")
-def volumes_and_step(x, dofs, orient, vol0, mat, speed, nodal_vol, with_step=True):
+def volumes_and_step(x, dofs, orient, vol0, mat, speed, nodal_vol, with_step=True, cell_dt=None):
     """Current cell volumes into nodal volumes; the smallest J; the stable step of the current mesh.
+    Eroded cells (material −1) are skipped: no volume, no J, no step.
 
     Args:
         x: current positions (n_nodes, 3).
@@ -57,6 +58,7 @@ def volumes_and_step(x, dofs, orient, vol0, mat, speed, nodal_vol, with_step=Tru
         speed: dilatational wave speed per material (m/s).
         nodal_vol: (n_nodes, n_materials) output, zeroed and filled with Σ V_e / 4.
         with_step: also compute the shortest altitudes (else the third result is inf).
+        cell_dt: None, or (n_cells,) output of each live cell's altitude / wave speed (with_step only).
 
     Returns:
         (min J, cell of min J, min over cells of shortest altitude / wave speed, cell of that minimum).
@@ -67,6 +69,9 @@ def volumes_and_step(x, dofs, orient, vol0, mat, speed, nodal_vol, with_step=Tru
     dtmin = np.inf
     dtcell = -1
     for e in range(dofs.shape[0]):
+        m = mat[e]
+        if m < 0:
+            continue
         # J = det(x1 - x0, x2 - x0, x3 - x0) / (6 V0): needs the positions only, not the gradients
         J = _six_volume(x, dofs, e) / (6.0 * vol0[e]) * orient[e]
         if not (J > jmin):
@@ -74,7 +79,6 @@ def volumes_and_step(x, dofs, orient, vol0, mat, speed, nodal_vol, with_step=Tru
                 jmin = J
                 worst = e
         V = J * vol0[e]
-        m = mat[e]
         for a in range(4):
             nodal_vol[dofs[e, a], m] += 0.25 * V
         if not with_step:
@@ -100,6 +104,8 @@ def volumes_and_step(x, dofs, orient, vol0, mat, speed, nodal_vol, with_step=Tru
         if amax > 0.0 and V > 0.0:
             h = 3.0 * V / (0.5 * math.sqrt(amax))
             t = h / speed[m]
+            if cell_dt is not None:
+                cell_dt[e] = t
             if t < dtmin:
                 dtmin = t
                 dtcell = e
@@ -107,10 +113,11 @@ def volumes_and_step(x, dofs, orient, vol0, mat, speed, nodal_vol, with_step=Tru
 
 
 @numba.njit(cache=True, fastmath=_FAST, error_model="numpy")
-def cell_jacobians(x, dofs, orient, vol0, out):
-    """J = V / V0 of every cell into out (for the energies; the same formula as volumes_and_step)."""
+def cell_jacobians(x, dofs, orient, vol0, mat, out):
+    """J = V / V0 of every cell into out (for the energies; the same formula as volumes_and_step); 1 for
+    eroded cells (material −1)."""
     for e in range(dofs.shape[0]):
-        out[e] = _six_volume(x, dofs, e) / (6.0 * vol0[e]) * orient[e]
+        out[e] = _six_volume(x, dofs, e) / (6.0 * vol0[e]) * orient[e] if mat[e] >= 0 else 1.0
 
 
 @numba.njit(cache=True, inline="always", fastmath=_FAST, error_model="numpy")
@@ -308,6 +315,8 @@ def stress_update(x, v, dt, dofs, grad0, vol0, mat, params, nodal_p, nodal, s, e
     totals[:] = 0.0
     for e in range(dofs.shape[0]):
         m = mat[e]
+        if m < 0:  # eroded: its P row was zeroed when it was removed
+            continue
         G = G_m[m]
         F = _gradient(x, 1.0, dofs, grad0, e)
         _trial_stress(_velocity_gradient(F, _gradient(v, dt, dofs, grad0, e)), s, e, G, se, de)
@@ -358,9 +367,9 @@ def plastic_pass(x, dt, dofs, grad0, vol0, mat, params, s, eps_p, temp, sy0, P_o
 
 @numba.njit(cache=True, fastmath=_FAST, error_model="numpy")
 def static_flow_stress(mat, params, eps_p, temp, out):
-    """σ_y(ε_p, ε̇ = 0, T) of every cell into out (inf for elastic materials)."""
+    """σ_y(ε_p, ε̇ = 0, T) of every cell into out (inf for elastic materials and eroded cells)."""
     for e in range(len(mat)):
-        out[e] = M.yield_stress(eps_p[e], 0.0, temp[e], params[mat[e]])
+        out[e] = M.yield_stress(eps_p[e], 0.0, temp[e], params[mat[e]]) if mat[e] >= 0 else np.inf
 
 
 def deviatoric_energy(s: np.ndarray, J: np.ndarray, vol0: np.ndarray, G: np.ndarray) -> float:

@@ -90,6 +90,7 @@ class Surface:
         area0: exact patch areas (f,). flat0: flat reference facet areas (f,).
         N0: exact reference normals at the load points (f, 3). n_flat0: flat reference facet normals (f, 3).
         radius, R_meridian, sin_phi0: shape data for the law (f,).
+        cell: the owned cell each facet bounds (f,).
     """
 
     tri: np.ndarray
@@ -101,6 +102,48 @@ class Surface:
     radius: np.ndarray
     R_meridian: np.ndarray
     sin_phi0: np.ndarray
+    cell: np.ndarray
+
+    FIELDS = ("tri", "X", "area0", "flat0", "N0", "n_flat0", "radius", "R_meridian", "sin_phi0", "cell")
+
+    def keep(self, mask: np.ndarray) -> None:
+        """Keep only the facets where mask is True (in place)."""
+        for k in self.FIELDS:
+            setattr(self, k, np.ascontiguousarray(getattr(self, k)[mask]))
+
+    def append_flat(self, X_ref: np.ndarray, tri: np.ndarray, cell: np.ndarray) -> None:
+        """Add facets exposed inside the body (by erosion): their own flat normals and areas, no exact
+        surface (R_meridian = inf; sin_phi0 = |N_y|, the body axis being y).
+
+        Args:
+            X_ref: the reference node positions. tri: (k, 3) node indices ordered outward. cell: (k,).
+        """
+        av = area_vectors(X_ref, tri)
+        flat = np.linalg.norm(av, axis=1)
+        nf = av / np.maximum(flat, 1e-300)[:, None]
+        c = X_ref[tri].mean(axis=1)
+        new = dict(tri=tri, X=c, area0=flat, flat0=flat, N0=nf, n_flat0=nf, radius=np.hypot(c[:, 0], c[:, 2]),
+                   R_meridian=np.full(len(tri), np.inf), sin_phi0=np.abs(nf[:, 1]), cell=cell)
+        for k in self.FIELDS:
+            old = getattr(self, k)
+            setattr(self, k, np.ascontiguousarray(np.concatenate([old, new[k].astype(old.dtype)])))
+
+    def follow_reference(self, X_old: np.ndarray, X_new: np.ndarray) -> None:
+        """The reference facets moved from X_old to X_new (a receding surface, fepen.solver.recession):
+        turn the exact normals as the flat ones turned, scale the exact areas as the flat ones, move the
+        load points with the centroids, so that the load sees the worn shape."""
+        f = len(self.tri)
+        if not f:
+            return
+        c, n, area = np.empty((f, 3)), np.empty((f, 3)), np.empty(f)
+        _facet_kinematics(X_new, np.zeros_like(X_new), self.tri, self.n_flat0, self.N0, self.area0, self.flat0,
+                          c, np.empty((f, 3)), area, n)
+        av = area_vectors(X_new, self.tri)
+        flat = np.linalg.norm(av, axis=1)
+        self.X = self.X + (c - X_old[self.tri].mean(axis=1))
+        self.N0, self.area0, self.flat0 = n, area, flat
+        self.n_flat0 = av / np.maximum(flat, 1e-300)[:, None]
+        self.radius = np.hypot(self.X[:, 0], self.X[:, 2])
 
     def kinematics(self, x_all: np.ndarray, v_all: np.ndarray):
         """Current load-point positions, velocities, areas and unit normals.
@@ -121,7 +164,7 @@ class Surface:
         _to_nodes(self.tri, f, out)
 
 
-def oriented_facets(V, facet_tags, tag: int) -> np.ndarray:
+def oriented_facets(V, facet_tags, tag: int, with_cells: bool = False):
     """The owned facets carrying ``tag``, as node triples (block indices of V) ordered so that their area
     vectors point out of the cell they bound.
 
@@ -131,7 +174,7 @@ def oriented_facets(V, facet_tags, tag: int) -> np.ndarray:
         tag: the facet tag.
 
     Returns:
-        (n_facets, 3) int64 node indices.
+        (n_facets, 3) int64 node indices; with_cells: also the cell each bounds (n_facets,).
     """
     mesh = V.mesh
     tdim = mesh.topology.dim
@@ -148,13 +191,14 @@ def oriented_facets(V, facet_tags, tag: int) -> np.ndarray:
     facets = facet_tags.find(tag)
     facets = facets[facets < mesh.topology.index_map(tdim - 1).size_local]
     tri = np.array([v2d[f2v.links(f)] for f in facets], dtype=np.int64).reshape(-1, 3)
+    cells = np.zeros(len(facets), dtype=np.int64)
     for i, f in enumerate(facets):  # order each facet so that its area vector points outward
-        cell = f2c.links(f)[0]
+        cell = cells[i] = f2c.links(f)[0]
         opp = [d for d in cdofs[cell] if d not in tri[i]][0]
         p = X[tri[i]]
         if np.dot(np.cross(p[1] - p[0], p[2] - p[0]), p.mean(axis=0) - X[opp]) < 0:
             tri[i, [1, 2]] = tri[i, [2, 1]]
-    return tri
+    return (tri, cells) if with_cells else tri
 
 
 def outer_surface(V, facet_tags, shape, tag: int = tags.OUTER) -> Surface:
@@ -167,7 +211,7 @@ def outer_surface(V, facet_tags, shape, tag: int = tags.OUTER) -> Surface:
     """
     imap = V.dofmap.index_map
     X = V.tabulate_dof_coordinates()[: imap.size_local + imap.num_ghosts]
-    tri = oriented_facets(V, facet_tags, tag)
+    tri, cells = oriented_facets(V, facet_tags, tag, with_cells=True)
     av = area_vectors(X, tri)
     flat = np.linalg.norm(av, axis=1)
     nflat = av / np.maximum(flat, 1e-300)[:, None]
@@ -181,7 +225,7 @@ def outer_surface(V, facet_tags, shape, tag: int = tags.OUTER) -> Surface:
     bad = np.isnan(N[:, 0])  # should not happen for centroids; fall back to the flat normal
     N[bad] = nflat[bad]
     area = _patch_areas(shape, X[tri], patch) if len(tri) else np.zeros(0)
-    return Surface(tri, P, area, flat, N, nflat, radius, Rm, sphi)
+    return Surface(tri, P, area, flat, N, nflat, radius, Rm, sphi, cells)
 
 
 def gather_global(surface: Surface, comm: MPI.Comm) -> dict:

@@ -34,6 +34,7 @@ class TargetLoad:
         self.force = np.zeros(3)
         self.contact_nodes = 0
         self.area = 0.0
+        self.wear = None  # a fepen.solver.recession.Recession fed each step's point loads, or None
 
     def __call__(self, solver) -> None:
         x_all = solver.positions()
@@ -46,6 +47,8 @@ class TargetLoad:
         arr = self.buf.array.reshape(-1, 3)
         arr[:] = 0.0
         self.surf.to_nodes(load.force, arr)
+        if self.wear is not None:
+            self.wear.add(load.force, n, v, solver.dt)
         self.buf.scatter_reverse(la.ScatterMode.add)
         n_own = solver.n_owned
         solver.fext[:n_own] += arr[:n_own]

@@ -65,10 +65,10 @@ def test_hard_case_is_stable(name, tmp_path):
 
 
 def test_case_beyond_the_method_says_so(tmp_path):
-    """A projectile that would fracture: exit 3, one line saying beyond the method, where and when; the
-    history up to then is kept, no summary (no result) is written."""
+    """A projectile that passes the failure strain the user asked to stop at: exit 3, one line saying beyond
+    the method, where and when; the history up to then is kept, no summary (no result) is written."""
     r = run_fepen("run", CASES / "soft_breaks.toml", "--set", "mesh.size=0.005", "--set", "run.fields=false",
-                  "--out", tmp_path)
+                  "--set", "projectile.failure_strain=0.5", "--out", tmp_path)
     assert r.returncode == 3
     line = r.stderr.strip().splitlines()[-1]
     assert "beyond the method" in line and "behind the nose tip" in line and " us" in line
@@ -77,8 +77,8 @@ def test_case_beyond_the_method_says_so(tmp_path):
 
 
 def test_inverted_elements_are_detected(tmp_path):
-    """With the fracture limit lifted, the soft nose collapses: the run stops on the first inverted (or
-    flattened) element with where and when, instead of carrying on with NaN."""
+    """Without erosion and with the failure strain lifted, the soft nose collapses: the run stops on the first
+    inverted (or flattened) element with where and when, instead of carrying on with NaN."""
     with pytest.raises(SimulationError, match=r"inverted|nearly flat") as err:
         run_case("soft_breaks", ["mesh.size=0.005", "projectile.failure_strain=100"], out=tmp_path)
     assert "behind the nose" in str(err.value) and " us" in str(err.value)

@@ -239,6 +239,6 @@ def test_rigid_wear_off_or_without_melting_changes_nothing():
     assert worn["Hy_mm"] < plain["Hy_mm"]  # a lighter projectile stops sooner
 
 
-def test_wear_on_a_deformable_run_is_refused_before_meshing():
-    with pytest.raises(Exception, match="effects.wear"):
-        scene.load(None, ["effects.wear=true"])
+def test_erosion_on_a_rigid_run_is_refused_before_meshing():
+    with pytest.raises(Exception, match="effects.erosion"):
+        scene.load(None, ["effects.erosion=true", "effects.fidelity=rigid"])

@@ -1,0 +1,130 @@
+"""Nose abrasion on the deforming mesh (docs/theory.md §14.2): the interface heat of each load point
+(fepen.laws.wear) melts the surface, which recedes along its normal; a thin layer behind it relaxes.
+
+Each step the target load hands its point forces, normals and velocities to :meth:`Recession.add`, which
+shares each point's heat rate × Δt to its facet's three nodes. Every ``every`` steps :meth:`apply`
+(collective) turns each surface node's heat into a recession depth d_a = η Q_a / (h ρ A_a) (A_a a third of
+its facets' reference areas), moves the node's reference position inward by d_a along its area-weighted
+reference normal, and spreads the move over the ``layers`` node layers behind the surface by Jacobi
+sweeps of the graph Laplacian (the move fixed on the surface, zero beyond the band), so cells shrink
+gradually rather than the surface cells alone. ExplicitSolver.change_reference then takes the melted mass
+off the nodes (mass and carried kinetic energy accounted), and the load points follow the new reference
+facets: the worn nose's own normals and areas feed back into σ_n.
+"""
+
+from __future__ import annotations
+
+import numpy as np
+import scipy.sparse as sp
+from dolfinx import la
+from mpi4py import MPI
+
+from fepen.laws import wear
+
+__all__ = ["Recession"]
+
+#: Jacobi sweeps of the band relaxation per application
+SWEEPS = 12
+
+
+class Recession:
+    """Surface recession of an ExplicitSolver's loaded Surface.
+
+    Args:
+        solver: the ExplicitSolver. surface: its loaded Surface.
+        mu: friction coefficient of the heat μ σ_n |v_t|. efficiency: η. enthalpy: h (J/kg).
+        density: the surface material's density (kg/m³).
+        every: steps between two applications. layers: node layers of the relaxed band.
+    """
+
+    def __init__(self, solver, surface, mu: float, efficiency: float, enthalpy: float, density: float,
+                 every: int = 20, layers: int = 3):
+        self.solver, self.surface = solver, surface
+        self.mu, self.efficiency, self.enthalpy, self.density = mu, efficiency, enthalpy, density
+        self.every, self.layers = every, layers
+        imap = solver.V.dofmap.index_map
+        self._vec3 = la.vector(imap, bs=3)
+        self._vec1 = la.vector(imap, bs=1)
+        self.heat_nodes = np.zeros(solver.n_nodes)  # heat since the last application (J), this rank's facets
+        self.heat_total = 0.0  # this rank's heat so far (J)
+        self.depth = np.zeros(solver.n_nodes)  # total recession of each node (m), ghosts consistent
+        n = solver.n_nodes
+        d = solver.dofs
+        rows = np.concatenate([d[:, i] for i in range(4) for j in range(4) if i != j])
+        cols = np.concatenate([d[:, j] for i in range(4) for j in range(4) if i != j])
+        self._adjacency_all = (rows, cols, n)
+        self._adj = None
+        self._adj_mat = None
+
+    # --------------------------------------------------------------------------------------------------
+    def add(self, force: np.ndarray, n: np.ndarray, v: np.ndarray, dt: float) -> None:
+        """Record one step's heat at the surface's points (their target forces, normals, velocities)."""
+        q = wear.heat_rates(force, n, v, self.mu) * dt
+        self.heat_total += float(q.sum())
+        tri = self.surface.tri
+        for j in range(3):
+            np.add.at(self.heat_nodes, tri[:, j], q / 3.0)
+
+    def _ghost_sum(self, vec, values: np.ndarray) -> np.ndarray:
+        """The sum over ranks of a nodal array (n_nodes, k), ghosts consistent."""
+        arr = vec.array.reshape(len(values), -1)
+        arr[:] = values.reshape(len(values), -1)
+        vec.scatter_reverse(la.ScatterMode.add)
+        vec.scatter_forward()
+        return arr.reshape(values.shape).copy()
+
+    def _adjacency(self) -> sp.csr_matrix:
+        """Node-node adjacency through live cells (each cell sharing an edge counts once), this rank's cells."""
+        s = self.solver
+        rows, cols, n = self._adjacency_all
+        live = np.tile(s.mat >= 0, 12)
+        return sp.csr_matrix((np.ones(int(live.sum())), (rows[live], cols[live])), shape=(n, n))
+
+    def apply(self) -> float:
+        """Recede the surface by the heat gathered since the last call (collective). Returns the largest
+        recession of this application (m), all ranks."""
+        s, surf = self.solver, self.surface
+        heat = self._ghost_sum(self._vec1, self.heat_nodes)
+        self.heat_nodes[:] = 0.0
+        nrm = np.zeros((s.n_nodes, 3))
+        area = np.zeros(s.n_nodes)
+        av = 0.5 * np.cross(s.X[surf.tri[:, 1]] - s.X[surf.tri[:, 0]], s.X[surf.tri[:, 2]] - s.X[surf.tri[:, 0]])
+        a = np.linalg.norm(av, axis=1)
+        for j in range(3):
+            np.add.at(nrm, surf.tri[:, j], av)
+            np.add.at(area, surf.tri[:, j], a / 3.0)
+        packed = self._ghost_sum(self._vec3, nrm)
+        area = self._ghost_sum(self._vec1, area)
+        norm = np.linalg.norm(packed, axis=1)
+        on_surface = area > 0.0
+        unit = np.zeros_like(packed)
+        unit[on_surface] = packed[on_surface] / norm[on_surface, None]
+        d = wear.recession_depth(heat, area, self.efficiency, self.enthalpy, self.density)
+        largest = s.comm.allreduce(float(d.max(initial=0.0)), op=MPI.MAX)
+        if largest <= 0.0:
+            return 0.0
+        dX = -d[:, None] * unit
+        dX = self._relax(dX, on_surface)
+        X_old = s.X.copy()
+        s.change_reference(dX)
+        surf.follow_reference(X_old, s.X)
+        self.depth += d
+        return largest
+
+    def _relax(self, dX: np.ndarray, on_surface: np.ndarray) -> np.ndarray:
+        """Spread the surface move over the band of ``layers`` node layers behind it (Jacobi sweeps of the
+        graph Laplacian; the move held on the surface, zero beyond the band)."""
+        A = self._adjacency()
+        band = on_surface.astype(float)
+        for _ in range(self.layers):
+            band = np.maximum(band, (self._ghost_sum(self._vec1, A @ band) > 0.0).astype(float))
+        inner = (band > 0.0) & ~on_surface
+        if not self.solver.comm.allreduce(bool(inner.any()), op=MPI.LOR):
+            return dX
+        deg = self._ghost_sum(self._vec1, np.asarray(A.sum(axis=1)).ravel())
+        deg[deg == 0.0] = 1.0
+        out = dX.copy()
+        for _ in range(SWEEPS):
+            avg = self._ghost_sum(self._vec3, A @ out) / deg[:, None]
+            out[inner] = avg[inner]
+        return out
