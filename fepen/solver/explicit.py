@@ -137,6 +137,8 @@ class ExplicitSolver:
         self._geometry_node[V.dofmap.list.array.reshape(-1, 4).ravel()] = gdofs.ravel()
         self.geometry_x = mesh.geometry.x
         assert np.allclose(self.geometry_x[self._geometry_node, :3], self.X)
+        self.X[:] = self.geometry_x[self._geometry_node, :3]  # the mesh's own numbers (tabulated ones may
+        self.X0[:] = self.X  # differ in the last bit), so that writing X back into the geometry changes nothing
         self.grad0, self.vol0, self.orient = kernels.reference_gradients(self.X, self.dofs)
         self.materials = materials
         self.params = np.stack([m.params for m in materials])
@@ -551,7 +553,8 @@ class ExplicitSolver:
                 np.copyto(getattr(self, k), state[k])
         for k, v in zip(STATE_SCALARS, state["scalars"]):
             setattr(self, k, int(v) if k == "step_count" else float(v))
-        if np.any(self.mat < 0) or not np.array_equal(self.X, self.X0):  # eroded or receded: rebuild
+        changed = bool(np.any(self.mat < 0)) or not np.array_equal(self.X, self.X0)  # eroded or receded
+        if self.comm.allreduce(changed, op=MPI.LOR):  # rebuild (collective)
             removed = self._removed.copy()
             self._new_reference(np.arange(self.n_cells))
             self.P_packed[: self.n_cells][self.mat < 0] = 0.0

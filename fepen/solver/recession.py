@@ -4,12 +4,13 @@
 Each step the target load hands its point forces, normals and velocities to :meth:`Recession.add`, which
 shares each point's heat rate × Δt to its facet's three nodes. Every ``every`` steps :meth:`apply`
 (collective) turns each surface node's heat into a recession depth d_a = η Q_a / (h ρ A_a) (A_a a third of
-its facets' reference areas), moves the node's reference position inward by d_a along its area-weighted
+its facets' exact reference areas), moves the node's reference position inward by d_a along its area-weighted
 reference normal, and spreads the move over the ``layers`` node layers behind the surface by Jacobi
-sweeps of the graph Laplacian (the move fixed on the surface, zero beyond the band), so cells shrink
-gradually rather than the surface cells alone. ExplicitSolver.change_reference then takes the melted mass
-off the nodes (mass and carried kinetic energy accounted), and the load points follow the new reference
-facets: the worn nose's own normals and areas feed back into σ_n.
+sweeps of the graph Laplacian (the move fixed on the surface, zero beyond the band and on every other
+boundary, such as a cavity wall), so cells shrink gradually rather than the surface cells alone.
+ExplicitSolver.change_reference then takes the melted mass off the nodes (mass and carried kinetic
+energy accounted), and the load points follow the new reference facets: the worn nose's own normals and
+areas feed back into σ_n.
 """
 
 from __future__ import annotations
@@ -17,6 +18,7 @@ from __future__ import annotations
 import numpy as np
 import scipy.sparse as sp
 from dolfinx import la
+from dolfinx import mesh as dmesh
 from mpi4py import MPI
 
 from fepen.laws import wear
@@ -53,8 +55,7 @@ class Recession:
         rows = np.concatenate([d[:, i] for i in range(4) for j in range(4) if i != j])
         cols = np.concatenate([d[:, j] for i in range(4) for j in range(4) if i != j])
         self._adjacency_all = (rows, cols, n)
-        self._adj = None
-        self._adj_mat = None
+        self.boundary = self._boundary_nodes()
 
     # --------------------------------------------------------------------------------------------------
     def add(self, force: np.ndarray, n: np.ndarray, v: np.ndarray, dt: float) -> None:
@@ -73,6 +74,25 @@ class Recession:
         vec.scatter_forward()
         return arr.reshape(values.shape).copy()
 
+    def _boundary_nodes(self) -> np.ndarray:
+        """Nodes on the mesh's boundary (ghosts included): the relaxation holds them, so that no other
+        surface (a cavity wall, the charge's face) moves."""
+        s = self.solver
+        mesh = s.mesh
+        tdim = mesh.topology.dim
+        mesh.topology.create_connectivity(tdim - 1, tdim)
+        mesh.topology.create_connectivity(tdim - 1, 0)
+        mesh.topology.create_connectivity(tdim, 0)
+        facets = dmesh.exterior_facet_indices(mesh.topology)
+        f2v = mesh.topology.connectivity(tdim - 1, 0)
+        c2v = mesh.topology.connectivity(tdim, 0).array.reshape(-1, 4)
+        v2d = np.full(c2v.max() + 1, -1, dtype=np.int64)
+        v2d[c2v.ravel()] = s.V.dofmap.list.array.reshape(-1, 4).ravel()
+        flag = np.zeros(s.n_nodes)
+        for f in facets:
+            flag[v2d[f2v.links(f)]] = 1.0
+        return self._ghost_sum(self._vec1, flag) > 0.0
+
     def _adjacency(self) -> sp.csr_matrix:
         """Node-node adjacency through live cells (each cell sharing an edge counts once), this rank's cells."""
         s = self.solver
@@ -89,7 +109,7 @@ class Recession:
         nrm = np.zeros((s.n_nodes, 3))
         area = np.zeros(s.n_nodes)
         av = 0.5 * np.cross(s.X[surf.tri[:, 1]] - s.X[surf.tri[:, 0]], s.X[surf.tri[:, 2]] - s.X[surf.tri[:, 0]])
-        a = np.linalg.norm(av, axis=1)
+        a = surf.area0  # the load's own (exact-surface) reference areas: heat and area on the same patch
         for j in range(3):
             np.add.at(nrm, surf.tri[:, j], av)
             np.add.at(area, surf.tri[:, j], a / 3.0)
@@ -118,7 +138,7 @@ class Recession:
         band = on_surface.astype(float)
         for _ in range(self.layers):
             band = np.maximum(band, (self._ghost_sum(self._vec1, A @ band) > 0.0).astype(float))
-        inner = (band > 0.0) & ~on_surface
+        inner = (band > 0.0) & ~on_surface & ~self.boundary
         if not self.solver.comm.allreduce(bool(inner.any()), op=MPI.LOR):
             return dX
         deg = self._ghost_sum(self._vec1, np.asarray(A.sum(axis=1)).ravel())

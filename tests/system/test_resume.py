@@ -22,6 +22,12 @@ SETS = ["--set", "mesh.size=0.004", "--set", "run.end_time=1.2e-4", "--set", "ru
 CHARGED = ["--set", "effects.charge=true", "--set", 'charge.contact="frictional"']
 
 
+#: wear and erosion on, a softer steel whose nose cells erode: the moved reference, the eroded cells, the
+#: loaded surface and the wear heat must be restored
+WORN = ["--set", "effects.wear=true", "--set", "effects.erosion=true", "--set", "projectile.material.A=3e8",
+        "--set", "projectile.material.B=1e8", "--set", "projectile.erosion.strain=0.01"]
+
+
 def start(out, ranks, extra=()):
     return processes.start(["run", *SETS, *extra, "--out", out], ranks)
 
@@ -63,7 +69,8 @@ def check_valid_fields(out):
     return sum(1 for g in root.iter("Grid") if g.get("Name") == "displacement" and g.get("GridType") == "Uniform")
 
 
-@pytest.mark.parametrize("ranks,extra", [(1, []), (2, []), (2, CHARGED)], ids=["1", "2", "2-charged"])
+@pytest.mark.parametrize("ranks,extra", [(1, []), (2, []), (2, CHARGED), (2, WORN)],
+                         ids=["1", "2", "2-charged", "2-worn"])
 def test_killed_run_resumes_to_the_same_results(tmp_path, ranks, extra):
     whole, cut = tmp_path / "whole", tmp_path / "cut"
     done = run_fepen("run", *SETS, *extra, "--out", whole, ranks=ranks)
@@ -84,9 +91,11 @@ def test_killed_run_resumes_to_the_same_results(tmp_path, ranks, extra):
     a = json.loads((whole / "summary.json").read_text())
     b = json.loads((cut / "summary.json").read_text())
     for k in ("Hx_mm", "Hy_mm", "Tx_mm", "Ty_mm", "depth_mm", "residual_speed_m_s", "energy_error",
-              "max_peeq", "steps", "dt_s", "outcome"):
+              "max_peeq", "steps", "dt_s", "outcome", "mass_loss_kg", "eroded_cells", "length_change_mm"):
         assert a[k] == b[k], k  # the same operations: equal, not merely close
     assert (whole / "history.csv").read_text() == (cut / "history.csv").read_text()
+    if extra is WORN:
+        assert a["eroded_cells"] > 0 and a["mass_loss_kg"] > 0.0
     assert check_valid_fields(cut) == check_valid_fields(whole) > n_out
     assert not (cut / "checkpoint").exists() and not (cut / "fields.d").exists()
 

@@ -58,3 +58,22 @@ def test_melt_enthalpy_and_mass():
     assert 8e5 < h < 1.1e6  # about 1 MJ/kg for steels
     assert wear.melted_mass(h, 1.0, h) == pytest.approx(1.0)
     assert wear.melted_mass(1e4, 0.0, h) == 0.0
+
+
+def test_point_heat_rates_sum_to_the_heat_rate():
+    rng = np.random.default_rng(3)
+    f, n, v = rng.normal(size=(50, 3)), rng.normal(size=(50, 3)), rng.normal(size=(50, 3)) * 300
+    n /= np.linalg.norm(n, axis=1)[:, None]
+    q = wear.heat_rates(f, n, v, 0.15)
+    assert np.all(q >= 0.0)
+    assert q.sum() == pytest.approx(wear.heat_rate(f, n, v, 0.15), rel=1e-12)
+    assert np.all(q[np.einsum("ij,ij->i", f, n) > 0.0] == 0.0)  # a point pulled outward takes no heat
+
+
+def test_recession_depth_melts_the_heat_s_mass():
+    """d = eta Q / (h rho A): the melted mass over the area's mass per unit depth; zero area, zero depth."""
+    h = wear.melt_enthalpy(470.0, 1765.0, 294.0)
+    heat, area = np.array([1.0e3, 2.0e3, 5.0]), np.array([1e-4, 1e-4, 0.0])
+    d = wear.recession_depth(heat, area, 0.5, h, 7850.0)
+    assert d[:2] * 7850.0 * area[:2] == pytest.approx(wear.melted_mass(heat[:2], 0.5, h), rel=1e-14)
+    assert d[2] == 0.0
