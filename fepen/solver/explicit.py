@@ -220,7 +220,8 @@ class ExplicitSolver:
         arr = mvec.array.reshape(-1, nm)
         for k in range(nm):
             sel = self.mat == k
-            np.add.at(arr[:, k], self.dofs[sel].ravel(), np.repeat(0.25 * rho[sel] * self.vol0[sel], 4))
+            arr[:, k] += np.bincount(self.dofs[sel].ravel(), weights=np.repeat(0.25 * rho[sel] * self.vol0[sel], 4),
+                                     minlength=len(arr))
         self._ghost_sum(mvec)
         self.mass_by_material = arr[: self.n_nodes].copy()
         self.mass = self.mass_by_material.sum(axis=1)

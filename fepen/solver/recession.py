@@ -2,7 +2,7 @@
 (fepen.laws.wear) melts the surface, which recedes along its normal; a thin layer behind it relaxes.
 
 Each step the target load hands its point forces, normals and velocities to :meth:`Recession.add`, which
-shares each point's heat rate × Δt to its facet's three nodes. Every ``every`` steps :meth:`apply`
+shares each point's heat rate × Δt to its facet's three nodes. Every ``every`` (50) steps :meth:`apply`
 (collective) turns each surface node's heat into a recession depth d_a = η Q_a / (h ρ A_a) (A_a a third of
 its facets' exact reference areas), moves the node's reference position inward by d_a along its area-weighted
 reference normal, and spreads the move over the ``layers`` node layers behind the surface by Jacobi
@@ -40,7 +40,7 @@ class Recession:
     """
 
     def __init__(self, solver, surface, mu: float, efficiency: float, enthalpy: float, density: float,
-                 every: int = 20, layers: int = 3):
+                 every: int = 50, layers: int = 3):
         self.solver, self.surface = solver, surface
         self.mu, self.efficiency, self.enthalpy, self.density = mu, efficiency, enthalpy, density
         self.every, self.layers = every, layers
@@ -56,6 +56,7 @@ class Recession:
         cols = np.concatenate([d[:, j] for i in range(4) for j in range(4) if i != j])
         self._adjacency_all = (rows, cols, n)
         self.boundary = self._boundary_nodes()
+        self._adj = None
 
     # --------------------------------------------------------------------------------------------------
     def add(self, force: np.ndarray, n: np.ndarray, v: np.ndarray, dt: float) -> None:
@@ -63,8 +64,7 @@ class Recession:
         q = wear.heat_rates(force, n, v, self.mu) * dt
         self.heat_total += float(q.sum())
         tri = self.surface.tri
-        for j in range(3):
-            np.add.at(self.heat_nodes, tri[:, j], q / 3.0)
+        self.heat_nodes += np.bincount(tri.ravel(), weights=np.repeat(q / 3.0, 3), minlength=len(self.heat_nodes))
 
     def _ghost_sum(self, vec, values: np.ndarray) -> np.ndarray:
         """The sum over ranks of a nodal array (n_nodes, k), ghosts consistent."""
@@ -96,9 +96,12 @@ class Recession:
     def _adjacency(self) -> sp.csr_matrix:
         """Node-node adjacency through live cells (each cell sharing an edge counts once), this rank's cells."""
         s = self.solver
-        rows, cols, n = self._adjacency_all
-        live = np.tile(s.mat >= 0, 12)
-        return sp.csr_matrix((np.ones(int(live.sum())), (rows[live], cols[live])), shape=(n, n))
+        dead = int(np.count_nonzero(s.mat < 0))
+        if self._adj is None or self._adj[0] != dead:  # built once, again only after an erosion
+            rows, cols, n = self._adjacency_all
+            live = np.tile(s.mat >= 0, 12)
+            self._adj = (dead, sp.csr_matrix((np.ones(int(live.sum())), (rows[live], cols[live])), shape=(n, n)))
+        return self._adj[1]
 
     def apply(self) -> float:
         """Recede the surface by the heat gathered since the last call (collective). Returns the largest
@@ -110,9 +113,10 @@ class Recession:
         area = np.zeros(s.n_nodes)
         av = 0.5 * np.cross(s.X[surf.tri[:, 1]] - s.X[surf.tri[:, 0]], s.X[surf.tri[:, 2]] - s.X[surf.tri[:, 0]])
         a = surf.area0  # the load's own (exact-surface) reference areas: heat and area on the same patch
-        for j in range(3):
-            np.add.at(nrm, surf.tri[:, j], av)
-            np.add.at(area, surf.tri[:, j], a / 3.0)
+        idx = surf.tri.ravel()
+        for k in range(3):
+            nrm[:, k] = np.bincount(idx, weights=np.repeat(av[:, k], 3), minlength=s.n_nodes)
+        area = np.bincount(idx, weights=np.repeat(a / 3.0, 3), minlength=s.n_nodes).astype(float)
         packed = self._ghost_sum(self._vec3, nrm)
         area = self._ghost_sum(self._vec1, area)
         norm = np.linalg.norm(packed, axis=1)
