@@ -587,8 +587,7 @@ class ExplicitSolver:
 
     def live_peeq(self) -> np.ndarray:
         """The owned cells' equivalent plastic strain, 0 on eroded cells."""
-        return self.eps_p if self._removed[0] == 0.0 and self.mat.min(initial=0) >= 0 else \
-            np.where(self.mat >= 0, self.eps_p, 0.0)
+        return self.eps_p if self.mat.min(initial=0) >= 0 else np.where(self.mat >= 0, self.eps_p, 0.0)
 
     def max_peeq_where(self) -> tuple[float, np.ndarray]:
         """The largest equivalent plastic strain and its cell's centre in the reference body, all ranks."""
