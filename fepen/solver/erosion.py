@@ -33,18 +33,16 @@ class Erosion:
         self.solver, self.surface = solver, surface
         self.strain, self.step_ratio = strain, step_ratio
         self.count = 0  # cells eroded, all ranks
-        self._codes = None
+        self._codes = None  # every local cell's face codes, built at the first erosion
+        imap = solver.V.dofmap.index_map
+        self._global = np.asarray(imap.local_to_global(np.arange(solver.n_nodes, dtype=np.int32)), dtype=np.int64)
+        self._n_global = imap.size_global
 
     def _face_codes(self, cells: np.ndarray) -> np.ndarray:
         """One int64 code per face (4 per cell, in _FACES order) from its nodes' sorted global numbers."""
-        s = self.solver
-        imap = s.V.dofmap.index_map
-        if not hasattr(self, "_global"):
-            self._global = np.asarray(imap.local_to_global(np.arange(s.n_nodes, dtype=np.int32)), dtype=np.int64)
-            self._n_global = imap.size_global
-            if self._n_global > 2_000_000:
-                raise NotImplementedError("erosion's face matching supports meshes of up to 2 million nodes")
-        g = np.sort(self._global[s.dofs[cells][:, _FACES]], axis=2)  # (k, 4, 3)
+        if self._n_global > 2_000_000:
+            raise NotImplementedError("erosion's face matching supports meshes of up to 2 million nodes")
+        g = np.sort(self._global[self.solver.dofs[cells][:, _FACES]], axis=2)  # (k, 4, 3)
         N = self._n_global
         return ((g[..., 0] * N + g[..., 1]) * N + g[..., 2]).reshape(-1)
 
