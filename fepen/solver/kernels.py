@@ -26,14 +26,37 @@ def reference_gradients(X: np.ndarray, dofs: np.ndarray):
     Returns:
         (grad0 (n_cells, 4, 3), vol0 (n_cells,) > 0 whatever the node ordering, orient (n_cells,) ±1).
     """
-    p = X[dofs]
-    Jm = np.stack([p[:, 1] - p[:, 0], p[:, 2] - p[:, 0], p[:, 3] - p[:, 0]], axis=2)  # columns
-    inv = np.linalg.inv(Jm)  # rows: gradients of phi_1..3
     grad0 = np.empty((len(dofs), 4, 3))
-    grad0[:, 1:] = inv
-    grad0[:, 0] = -inv.sum(axis=1)
-    det = np.linalg.det(Jm)
-    return grad0, np.abs(det) / 6.0, np.sign(det)
+    vol0 = np.empty(len(dofs))
+    orient = np.empty(len(dofs))
+    _reference_gradients(np.ascontiguousarray(X), np.ascontiguousarray(dofs, dtype=np.int64), grad0, vol0, orient)
+    return grad0, vol0, orient
+
+
+@numba.njit(cache=True, error_model="numpy")
+def _reference_gradients(X, dofs, grad0, vol0, orient):
+    """reference_gradients in one pass: with the edges a, b, c from node 0 as the columns of J, the rows of
+    J^{-1} (the gradients of phi_1..3) are (b×c, c×a, a×b) / det J, det J = a·(b×c)."""
+    for e in range(dofs.shape[0]):
+        p0 = dofs[e, 0]
+        a = np.empty(3)
+        b = np.empty(3)
+        c = np.empty(3)
+        for k in range(3):
+            a[k] = X[dofs[e, 1], k] - X[p0, k]
+            b[k] = X[dofs[e, 2], k] - X[p0, k]
+            c[k] = X[dofs[e, 3], k] - X[p0, k]
+        bc = np.array([b[1] * c[2] - b[2] * c[1], b[2] * c[0] - b[0] * c[2], b[0] * c[1] - b[1] * c[0]])
+        ca = np.array([c[1] * a[2] - c[2] * a[1], c[2] * a[0] - c[0] * a[2], c[0] * a[1] - c[1] * a[0]])
+        ab = np.array([a[1] * b[2] - a[2] * b[1], a[2] * b[0] - a[0] * b[2], a[0] * b[1] - a[1] * b[0]])
+        det = a[0] * bc[0] + a[1] * bc[1] + a[2] * bc[2]
+        for k in range(3):
+            grad0[e, 1, k] = bc[k] / det
+            grad0[e, 2, k] = ca[k] / det
+            grad0[e, 3, k] = ab[k] / det
+            grad0[e, 0, k] = -(grad0[e, 1, k] + grad0[e, 2, k] + grad0[e, 3, k])
+        vol0[e] = abs(det) / 6.0
+        orient[e] = 1.0 if det > 0.0 else (-1.0 if det < 0.0 else 0.0)
 
 
 @numba.njit(cache=True, inline="always", fastmath=_FAST, error_model="numpy")
