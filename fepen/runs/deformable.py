@@ -91,8 +91,10 @@ class DeformableRun:
                 s.step()
                 if m.recession is not None and s.step_count % m.recession.every == 0:
                     m.recession.apply()
-                if m.erosion is not None and s.step_count % explicit.STEP_EVERY == 1 and m.erosion.check():
-                    self._after_erosion()
+                if m.erosion is not None:
+                    inside = m.erosion.take_pending()  # cells that inverted within the step, eroded
+                    if (s.step_count % explicit.STEP_EVERY == 1 and m.erosion.check()) or inside:
+                        self._after_erosion()
                 outcome = self.stop_rules()
             self.record()  # the final state
             if self.fields is not None:

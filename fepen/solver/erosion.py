@@ -12,11 +12,15 @@ import numpy as np
 from mpi4py import MPI
 
 from fepen.laws import erosion as law
+from fepen.solver import kernels
 
 __all__ = ["Erosion"]
 
 #: the three nodes of the face opposite each of a tetrahedron's four nodes
 _FACES = np.array([[1, 2, 3], [0, 2, 3], [0, 1, 3], [0, 1, 2]])
+
+#: the largest fraction of the cells that may invert within one step and be eroded; more stops the run
+MAX_INVERTED = 0.01
 
 
 class Erosion:
@@ -37,6 +41,10 @@ class Erosion:
         imap = solver.V.dofmap.index_map
         self._global = np.asarray(imap.local_to_global(np.arange(solver.n_nodes, dtype=np.int32)), dtype=np.int64)
         self._n_global = imap.size_global
+        self._n_cells_global = solver.comm.allreduce(solver.n_cells, op=MPI.SUM)
+        self.inverted = 0  # of which inverted within a step, all ranks
+        self.pending = False  # cells eroded inside a step since the run last looked (take_pending)
+        solver.on_inverted = self._erode_inverted
 
     def _face_codes(self, cells: np.ndarray) -> np.ndarray:
         """One int64 code per face (4 per cell, in _FACES order) from its nodes' sorted global numbers."""
@@ -51,6 +59,34 @@ class Erosion:
         s = self.solver
         step = s.cell_dt * (s.safety * s.step_gain)
         cells = np.flatnonzero(law.failed(s.eps_p, step, s.dt0, self.strain, self.step_ratio) & (s.mat >= 0))
+        return self._remove(cells)
+
+    def _erode_inverted(self, x: np.ndarray) -> bool:
+        """The solver's hook for cells that inverted within a step (collective): a cell that collapses
+        between two checks has passed the step criterion's limit (its stable step reaches zero), so it is
+        eroded like one that failed. More than MAX_INVERTED of the cells at once is not a collapse but an
+        instability: False, and the run stops."""
+        s = self.solver
+        J = np.empty(s.n_cells)
+        kernels.cell_jacobians(x, s.dofs, s.orient, s.vol0, s.mat, J)
+        cells = np.flatnonzero(~(J > 0.0) & (s.mat >= 0))
+        n = s.comm.allreduce(len(cells), op=MPI.SUM)
+        if n == 0 or n > MAX_INVERTED * self._n_cells_global:
+            return False
+        self._remove(cells)
+        self.inverted += n
+        self.pending = True
+        return True
+
+    def take_pending(self) -> bool:
+        """Whether cells were eroded inside a step since the last call (then the run re-elects its tip
+        and tail)."""
+        pending, self.pending = self.pending, False
+        return pending
+
+    def _remove(self, cells: np.ndarray) -> int:
+        """Erode ``cells`` (this rank's; collective). Returns how many, all ranks."""
+        s = self.solver
         n = s.comm.allreduce(len(cells), op=MPI.SUM)
         if n == 0:
             return 0

@@ -185,6 +185,9 @@ class ExplicitSolver:
         self._w_if_n = 0.0  # work of the interface's normal and tangential forces (fepen.solver.shell_charge)
         self._w_if_t = 0.0
         self.interface = None
+        # called with the current positions when a live cell inverts (collective): True if it eroded the
+        # inverted cells (fepen.solver.erosion), False or None to stop the run
+        self.on_inverted = None
         self.ke0 = None
         self.times = StepTimes()
 
@@ -369,13 +372,13 @@ class ExplicitSolver:
         with_step = self.step_count % STEP_EVERY == 0
         jmin, worst, h_c, self._step_cell = kernels.volumes_and_step(
             x, self.dofs, self.orient, self.vol0, self.mat, self.speed, self.nodal_vol, with_step, self.cell_dt)
-        bad = not (jmin > 0.0)
-        if self.comm.size > 1:  # every rank must stop together (and rank 0 must be able to say why)
-            self._flag[0] = 1.0 if bad else 0.0
-            self.comm.Allreduce(MPI.IN_PLACE, self._flag, op=MPI.MAX)
-            bad = self._flag[0] > 0.0
-        if bad:
-            self._raise_inverted(x, jmin, worst)
+        if self._any_inverted(jmin):
+            if self.on_inverted is None or not self.on_inverted(x):
+                self._raise_inverted(x, jmin, worst)
+            jmin, worst, h_c, self._step_cell = kernels.volumes_and_step(  # the inverted cells eroded
+                x, self.dofs, self.orient, self.vol0, self.mat, self.speed, self.nodal_vol, with_step, self.cell_dt)
+            if self._any_inverted(jmin):
+                self._raise_inverted(x, jmin, worst)
         if self.nodal:
             self._ghost_sum(self._nvol)
         t1 = perf_counter()
@@ -414,6 +417,15 @@ class ExplicitSolver:
         self.fint[:] = 0.0
         _cpp.fem.assemble_vector(self.fint_fn.x.array, self.form, self._consts, self._coeffs)
         self.fint_fn.x.scatter_reverse(la.ScatterMode.add)
+
+    def _any_inverted(self, jmin: float) -> bool:
+        """Whether a live cell on any rank is inverted (or NaN); every rank gets the same answer."""
+        bad = not (jmin > 0.0)
+        if self.comm.size > 1:  # every rank must stop together (and rank 0 must be able to say why)
+            self._flag[0] = 1.0 if bad else 0.0
+            self.comm.Allreduce(MPI.IN_PLACE, self._flag, op=MPI.MAX)
+            bad = self._flag[0] > 0.0
+        return bad
 
     def _raise_inverted(self, x: np.ndarray, jmin: float, worst: int) -> None:
         """SimulationError naming the inverted element, where and when (collective)."""

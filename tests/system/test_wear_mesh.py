@@ -142,3 +142,34 @@ def test_wear_and_erosion_are_the_same_on_any_rank_count():
 
 
 
+
+
+@pytest.mark.parametrize("erosion", [True, False])
+def test_a_cell_that_inverts_within_a_step_is_eroded_or_stops_the_run(erosion):
+    """A tip cell pushed through itself between two checks: with erosion on it is removed within the step
+    (mass to 1e-12, the step goes on with every other cell valid); with erosion off the run stops, naming
+    the element."""
+    from fepen.errors import SimulationError
+    from fepen.solver import kernels
+
+    sc = scene.load(None, ["mesh.size=0.005", f"effects.erosion={str(erosion).lower()}"])
+    m = model.build(sc, MPI.COMM_SELF)
+    s = m.solver
+    tip = int(np.argmin(s.X[:, 1]))
+    cell = int(np.flatnonzero((s.dofs == tip).any(axis=1))[0])
+    others = [a for a in s.dofs[cell] if a != tip]
+    centre = s.X[others].mean(axis=0)
+    s.U[tip] = 2.5 * (centre - s.X[tip])  # through the opposite face: this cell (and its neighbours) invert
+    if not erosion:
+        with pytest.raises(SimulationError, match="inverted"):
+            s.step()
+        return
+    s.step()
+    assert s.mat[cell] == -1 and m.erosion.count >= 1 and m.erosion.inverted == m.erosion.count
+    assert m.erosion.take_pending() and not m.erosion.take_pending()
+    J = np.empty(s.n_cells)
+    kernels.cell_jacobians(s.positions(), s.dofs, s.orient, s.vol0, s.mat, J)
+    assert np.all(J[s.mat >= 0] > 0.0)
+    assert abs(s.initial_mass - s.total_mass - s.removed_mass) <= 1e-12 * s.initial_mass
+    assert live_mass(s) == pytest.approx(s.total_mass, rel=1e-12)
+    s.step()  # and the next step runs
