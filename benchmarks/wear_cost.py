@@ -1,6 +1,7 @@
 """Cost of wear and erosion per step: the default shot C3 (plastic, in the target) stepped from impact with
 wear and erosion off, wear on, and wear and erosion on; the same loop as a run (the recession applied every
-``Recession.every`` steps, the erosion checked every 4). Prints the step time of each and its ratio to "off", in one run.
+``Recession.every`` steps, the erosion checked every 4). Prints the step time of each and its ratio to "off",
+in one run.
 
     .venv/bin/python benchmarks/wear_cost.py [mesh size in mm] [variants: off wear wear+erosion]
 

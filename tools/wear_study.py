@@ -45,6 +45,10 @@ def _run_sweep(out: Path) -> None:
                     subprocess.run(cmd, stdout=log, stderr=subprocess.STDOUT, check=False)
 
 
+def _fmt(s: dict | None, key: str, fmt: str) -> str:
+    return format(s[key], fmt) if s is not None else "–"
+
+
 def _profile(d: Path):
     rows = list(csv.DictReader(open(d / "nose_profile.csv")))
     out = {}
@@ -70,13 +74,12 @@ def sweep(out: Path) -> None:
             data[steel, v] = (on, off)
             if on is None and off is None:
                 continue
-            f = (lambda s, k, fmt: format(s[k], fmt) if s is not None else "–")
             nose = on["nose_profile"] if on is not None else None
-            print(f"| `{steel}` | {v} | {f(off, 'Hy_mm', '.1f')} | {f(on, 'Hy_mm', '.1f')} | "
-                  f"{f(on, 'mass_loss_percent', '.2f')} | {f(on, 'length_change_mm', '.2f')} | "
+            print(f"| `{steel}` | {v} | {_fmt(off, 'Hy_mm', '.1f')} | {_fmt(on, 'Hy_mm', '.1f')} | "
+                  f"{_fmt(on, 'mass_loss_percent', '.2f')} | {_fmt(on, 'length_change_mm', '.2f')} | "
                   f"{format(nose['tip_recession_mm'], '.2f') if nose else '–'} | "
-                  f"{format(nose['max_radius_mm'], '.2f') if nose else '–'} | {f(on, 'eroded_cells', 'd')} | "
-                  f"{f(on, 'max_peeq', '.3f')} | {on['outcome'] if on else '–'} |")
+                  f"{format(nose['max_radius_mm'], '.2f') if nose else '–'} | {_fmt(on, 'eroded_cells', 'd')} | "
+                  f"{_fmt(on, 'max_peeq', '.3f')} | {on['outcome'] if on else '–'} |")
     fig, ax = plt.subplots(1, 2, figsize=(11, 4.2))
     for steel, c in zip(STEELS, ("C0", "C3")):
         for wear, ls in (("on", "-"), ("off", "--")):
