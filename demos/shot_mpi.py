@@ -42,8 +42,8 @@ def main():
     with h5py.File(out / "fields.h5", "r") as h5:
         topo = h5["Mesh/mesh/topology"][:]
         geom = h5["Mesh/mesh/geometry"][:]
-        last = sorted(h5["Function/displacement"].keys(), key=lambda k: float(k.replace('_', '.')))[-1]
-        u = h5["Function/displacement"][last][:]
+        last = sorted(h5["Function/displacement_m"].keys(), key=lambda k: float(k.replace('_', '.')))[-1]
+        u = h5["Function/displacement_m"][last][:]
         peeq = h5["Function/peeq"][last][:].ravel()
     n = len(topo)
     cells = np.hstack([np.full((n, 1), 4), topo]).ravel()

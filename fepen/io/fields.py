@@ -1,6 +1,8 @@
-"""Field output (fields.xdmf + fields.h5, dolfinx's XDMF layout, gathered to rank 0) that a killed run never
-leaves half-written: one file per output time while the run goes on, one self-contained file at its end
-(docs/theory.md §12).
+"""Field output (fields.xdmf + fields.h5, gathered to rank 0) that a killed run never leaves half-written:
+one HDF5 file per output time while the run goes on, one self-contained file at its end (docs/theory.md §12,
+docs/results.md). fields.xdmf is one temporal collection with one grid per output time carrying the mesh
+and every field of that time, all data items declared with their precision, so that ParaView (Xdmf3 and
+legacy XDMF readers), pyvista and meshio's TimeSeriesReader read it as one dataset per time.
 """
 
 from __future__ import annotations
@@ -13,6 +15,14 @@ import numpy as np
 from mpi4py import MPI
 
 from fepen.atomic import replacing
+
+
+#: what fields.xdmf says of its own frame and units (an Information element of its Domain)
+FRAME = ("fepen field output. Frame: the target's, in metres; the target face is the plane y = 0 and the target "
+         "lies at y < 0 (depth = -y); the impact plane is x-y, z is normal to it; the geometry is the undeformed "
+         "projectile (tip at the origin, axis +y towards the tail) placed at t = 0 by displacement_m, which is the "
+         "total displacement from that geometry (warp by it for the deformed body). Units are in the names "
+         "(Pa, K, m, m/s); peeq is dimensionless; cell_tag: 1 shell, 2 charge, 0 eroded.")
 
 
 def _time_name(t: float) -> str:
@@ -30,12 +40,14 @@ class FieldWriter:
         cell: names of cell scalar fields, in writing order.
         nodal_scalar: names of nodal scalar fields, written after the cell fields.
         times: output times already written (when resuming a run; later step files are deleted).
+        integer: the names (of any kind) whose values are integers (written as int64).
     """
 
     def __init__(self, out: Path, solver, nodal: list[str], cell: list[str], times: list[float] = (),
-                 nodal_scalar: list[str] = ()):
+                 nodal_scalar: list[str] = (), integer: tuple[str, ...] = ()):
         self.out, self.comm = Path(out), solver.comm
         self.nodal, self.cell, self.nodal_scalar = list(nodal), list(cell), list(nodal_scalar)
+        self.integer = set(integer)
         self.times = list(times)
         self.dir = self.out / "fields.d"
         imap = solver.V.dofmap.index_map
@@ -48,7 +60,7 @@ class FieldWriter:
         # global topology: each rank's cells in global node numbering
         l2g = np.asarray(imap.local_to_global(np.arange(solver.n_nodes, dtype=np.int32)), dtype=np.int64)
         topo = self._gather(l2g[solver.dofs])
-        geom = self._gather(solver.X[: self._n_owned])
+        geom = self._gather(solver.X0[: self._n_owned])  # the undeformed, unworn body
         if self.comm.rank == 0:
             assert sum(counts_n) == self.n_nodes_global and sum(counts_c) == self.n_cells_global
             self.dir.mkdir(parents=True, exist_ok=True)
@@ -97,6 +109,7 @@ class FieldWriter:
             data[name] = self._gather(values[name][: self._n_cells])
         if self.comm.rank == 0:
             data = {k: (v.reshape(-1, 1) if v.ndim == 1 else v) for k, v in data.items()}
+            data = {k: (np.rint(v).astype(np.int64) if k in self.integer else v) for k, v in data.items()}
             self._write_h5(self._step_file(len(self.times)), data)
         self.times.append(float(t))
         if self.comm.rank == 0:
@@ -116,36 +129,41 @@ class FieldWriter:
                         f"fields.d/{self._step_file(k).name}", f"/{name}")
         self._write_xdmf()
 
-    def _write_xdmf(self) -> None:
+    def _write_xdmf(self, consolidated: bool = False) -> None:
+        """fields.xdmf: one temporal collection of one grid per output time, each with the mesh and every
+        field of that time (ParaView sees one dataset). While the run goes on, the data items name the
+        per-time files of fields.d directly (no HDF5 external links, which not every reader follows); once
+        consolidated, fields.h5."""
         nc, nn = self.n_cells_global, self.n_nodes_global
-        lines = ['<?xml version="1.0"?>', '<!DOCTYPE Xdmf SYSTEM "Xdmf.dtd" []>',
-                 '<Xdmf Version="3.0" xmlns:xi="http://www.w3.org/2001/XInclude">', "  <Domain>",
-                 '    <Grid Name="mesh" GridType="Uniform">',
-                 f'      <Topology TopologyType="Tetrahedron" NumberOfElements="{nc}" NodesPerElement="4">',
-                 f'        <DataItem Dimensions="{nc} 4" NumberType="Int" Precision="8" Format="HDF">'
-                 'fields.h5:/Mesh/mesh/topology</DataItem>',
-                 "      </Topology>", '      <Geometry GeometryType="XYZ">',
-                 f'        <DataItem Dimensions="{nn} 3" Format="HDF">fields.h5:/Mesh/mesh/geometry</DataItem>',
-                 "      </Geometry>", "    </Grid>"]
-        ref = ("        <xi:include xpointer=\"xpointer(/Xdmf/Domain/Grid[@GridType='Uniform'][1]"
-               "/*[self::Topology or self::Geometry])\" />")
-        for name in self.names:
-            lines.append(f'    <Grid Name={quoteattr(name)} GridType="Collection" CollectionType="Temporal">')
-            for t in self.times:
+        if consolidated:
+            mesh = {"geometry": "fields.h5:/Mesh/mesh/geometry", "topology": "fields.h5:/Mesh/mesh/topology"}
+        else:
+            mesh = {k: f"fields.d/mesh.h5:/{k}" for k in ("geometry", "topology")}
+        lines = ['<?xml version="1.0"?>', '<!DOCTYPE Xdmf SYSTEM "Xdmf.dtd" []>', '<Xdmf Version="3.0">',
+                 "  <Domain>", f"    <Information Name=\"fepen\" Value={quoteattr(FRAME)} />",
+                 '    <Grid Name="fields" GridType="Collection" CollectionType="Temporal">']
+        for k, t in enumerate(self.times):
+            lines += [f'      <Grid Name="t{k:06d}" GridType="Uniform">', f'        <Time Value="{float(t)!r}" />',
+                      f'        <Topology TopologyType="Tetrahedron" NumberOfElements="{nc}" NodesPerElement="4">',
+                      f'          <DataItem Dimensions="{nc} 4" NumberType="Int" Precision="8" Format="HDF">'
+                      f'{mesh["topology"]}</DataItem>', "        </Topology>", '        <Geometry GeometryType="XYZ">',
+                      f'          <DataItem Dimensions="{nn} 3" NumberType="Float" Precision="8" Format="HDF">'
+                      f'{mesh["geometry"]}</DataItem>', "        </Geometry>"]
+            for name in self.names:
                 if name in self.nodal:
                     dims, kind, centre = f"{nn} 3", "Vector", "Node"
                 elif name in self.cell:
                     dims, kind, centre = f"{nc} 1", "Scalar", "Cell"
                 else:
                     dims, kind, centre = f"{nn} 1", "Scalar", "Node"
-                lines += [f'      <Grid Name={quoteattr(name)} GridType="Uniform">', ref,
-                          f'        <Time Value="{float(t)!r}" />',
-                          f'        <Attribute Name={quoteattr(name)} AttributeType="{kind}" Center="{centre}">',
-                          f'          <DataItem Dimensions="{dims}" Format="HDF">'
-                          f"fields.h5:/Function/{name}/{_time_name(t)}</DataItem>",
-                          "        </Attribute>", "      </Grid>"]
-            lines.append("    </Grid>")
-        lines += ["  </Domain>", "</Xdmf>", ""]
+                number = 'NumberType="Int" Precision="8"' if name in self.integer else 'NumberType="Float" Precision="8"'
+                where = (f"fields.h5:/Function/{name}/{_time_name(t)}" if consolidated
+                         else f"fields.d/{self._step_file(k).name}:/{name}")
+                lines += [f'        <Attribute Name={quoteattr(name)} AttributeType="{kind}" Center="{centre}">',
+                          f'          <DataItem Dimensions="{dims}" {number} Format="HDF">{where}</DataItem>',
+                          "        </Attribute>"]
+            lines.append("      </Grid>")
+        lines += ["    </Grid>", "  </Domain>", "</Xdmf>", ""]
         path = self.out / "fields.xdmf"
         with replacing(path) as tmp:
             tmp.write_text("\n".join(lines))
@@ -165,5 +183,6 @@ class FieldWriter:
                     with h5py.File(self._step_file(k), "r") as src:
                         for name in self.names:
                             dst.create_dataset(f"/Function/{name}/{_time_name(t)}", data=src[name][()])
+            self._write_xdmf(consolidated=True)
             shutil.rmtree(self.dir)
         self.comm.barrier()

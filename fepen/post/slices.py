@@ -102,7 +102,7 @@ def output_times(out: Path) -> np.ndarray:
 
 def _axis_frame(state: dict):
     """Current nose tip, unit axis (tail to nose) and the two map planes' (normal, basis)."""
-    X, x = state["X"], state["X"] + state["displacement"]
+    X, x = state["X"], state["X"] + state["displacement_m"]
     tip = x[np.argmin(np.linalg.norm(X, axis=1))]
     L = X[:, 1].max()
     tail = x[np.argmin(np.linalg.norm(X - [0.0, L, 0.0], axis=1))]
@@ -140,9 +140,9 @@ def stress_maps(out: Path, path: Path, time: float | None = None) -> dict:
     from matplotlib.collections import PolyCollection
 
     st = read_state(out, time)
-    x = st["X"] + st["displacement"]
+    x = st["X"] + st["displacement_m"]
     tip, _, planes = _axis_frame(st)
-    body = st.get("body", np.ones(len(st["cells"])))
+    body = st.get("cell_tag", np.ones(len(st["cells"])))
     quantities = [("von_mises_Pa", "equivalent stress (MPa)", 1e-6, "viridis")]
     if "peeq" in st:
         quantities.append(("peeq", "PEEQ", 1.0, "inferno"))
@@ -207,8 +207,8 @@ def cross_sections(out: Path, path: Path, sections: dict, time: float | None = N
 
     st = read_state(out, time)
     X, cells = st["X"], st["cells"]
-    strain = _strain_axial(X, X + st["displacement"], cells)
-    body = st.get("body", np.ones(len(cells)))
+    strain = _strain_axial(X, X + st["displacement_m"], cells)
+    body = st.get("cell_tag", np.ones(len(cells)))
     fig, axes = plt.subplots(1, len(sections), figsize=(4.2 * len(sections), 4.0), squeeze=False)
     basis = np.array([[1.0, 0.0, 0.0], [0.0, 0.0, 1.0]])
     report = {}

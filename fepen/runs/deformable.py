@@ -194,20 +194,20 @@ class DeformableRun:
             names.append("peeq")
             if self.scene.effects.thermal:
                 names.append("temperature_K")
-        if self.pm.charge:
-            names.append("body")  # 1 shell, 2 charge: for ParaView's Threshold
+        names.append("cell_tag")  # 1 shell, 2 charge, 0 eroded: for ParaView's Threshold
         scalars = ["interface_gap_m", "interface_slip_m"] if self.contact is not None else []
         if self.model.recession is not None:
             scalars.append("wear_depth_m")
-        return FieldWriter(self.out, self.solver, ["displacement", "velocity"], names, times, scalars)
+        return FieldWriter(self.out, self.solver, ["displacement_m", "velocity_m_s"], names, times, scalars,
+                           integer=("cell_tag",))
 
     def write_fields(self) -> None:
         s, m = self.solver, self.model
         x = s.positions()
         axis = unit_axis(s.node_value(m.tip, x), s.node_value(m.tail, x))
-        values = {"displacement": s.U, "velocity": s.Vel, "von_mises_Pa": s.von_mises(),
-                  "axial_stress_Pa": s.axial_stress(axis), "peeq": s.eps_p, "temperature_K": s.temp,
-                  "body": s.mat + 1.0}
+        values = {"displacement_m": x - s.X0, "velocity_m_s": s.velocity_at_step(), "von_mises_Pa": s.von_mises(),
+                  "axial_stress_Pa": s.axial_stress(axis), "peeq": s.live_peeq(), "temperature_K": s.temp,
+                  "cell_tag": s.mat + 1.0}
         if self.contact is not None:
             values.update(self.contact.nodal_gap_and_slip())
         if m.recession is not None:

@@ -68,14 +68,14 @@ def test_fields_hold_every_field_at_every_output_time(tmp_path):
     sc = scene.load(None, ["effects.fidelity=plastic", "impact.velocity=600", "mesh.size=0.004",
                            "run.end_time=2e-5", "run.output_interval=1e-5"])
     DeformableRun(sc, tmp_path, MPI.COMM_SELF).run()
-    names = ["displacement", "velocity", "von_mises_Pa", "axial_stress_Pa", "peeq", "temperature_K"]
+    names = ["displacement_m", "velocity_m_s", "von_mises_Pa", "axial_stress_Pa", "peeq", "temperature_K"]
     with h5py.File(tmp_path / "fields.h5", "r") as h5:
         for name in names:
             times = sorted(h5["Function"][name].keys(), key=float)
             assert len(times) >= 3, (name, times)  # t = 0, 1e-5, 2e-5 (and the end)
             last = h5["Function"][name][times[-1]][:]
             assert np.all(np.isfinite(last))
-        u = h5["Function"]["displacement"]
+        u = h5["Function"]["displacement_m"]
         end = sorted(u.keys(), key=float)[-1]
         assert np.abs(u[end][:]).max() > 5e-3  # 600 m/s x 20 us = 12 mm of travel
     xdmf = (tmp_path / "fields.xdmf").read_text()
