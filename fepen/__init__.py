@@ -16,6 +16,11 @@ from fepen.version import __version__
 
 __all__ = ["Scene", "Result", "run", "load", "resume", "InputError", "SimulationError", "__version__"]
 
+# numba highlights its error messages with colorama when colorama is installed (Debian's paraview brings
+# it): colorama then writes an ANSI reset to a terminal's stdout at exit, which under mpirun (whose ranks'
+# stdout is a pseudo-terminal) lands in the output of `--json` demos and of fepen's own commands.
+os.environ.setdefault("NUMBA_DISABLE_ERROR_MESSAGE_HIGHLIGHTING", "1")
+
 
 def _numba_cache_per_rank() -> None:
     """Under mpirun, give each rank its own numba cache (``~/.cache/fepen/numba/rankN``).
