@@ -61,6 +61,16 @@ class Result:
                               "structured array") from err
         return pd.DataFrame(self.history)
 
+    def plot(self, field: str = "von_mises_Pa", time: float | None = None, png=None):
+        """The projectile at an output time (the last by default) warped by its displacement, coloured by
+        ``field``, with the target face (pyvista; ``png``: write the picture offscreen instead of showing it).
+        Returns the pyvista Plotter. ParaView: ``fepen view DIR`` or ``paraview --script=DIR/view.py``."""
+        if self.fields is None:
+            raise InputError("run.fields", f"{self.out} holds no fields.xdmf (the run had run.fields = false)")
+        from fepen.post import paraview
+
+        return paraview.plot(self.out, field, time, png)
+
     def __repr__(self) -> str:
         s = self.summary
         return (f"fepen.Result({str(self.out)!r}, outcome={s.get('outcome')!r}, Hx_mm={s.get('Hx_mm'):.6g}, "

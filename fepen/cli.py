@@ -58,6 +58,11 @@ def _parser() -> argparse.ArgumentParser:
     st.add_argument("--quick", action="store_true", help="a small subset on coarse meshes (minutes)")
     st.add_argument("--fresh", action="store_true", help="run again what DIR/runs already holds")
     sub.add_parser("keys", help="list every scene key with its default, unit and allowed values")
+    vw = sub.add_parser("view", help="a run in ParaView (its view.py), or pyvista where ParaView is absent")
+    vw.add_argument("dir", help="results directory of a run with fields (finished, running or killed)")
+    vw.add_argument("--png", help="render one picture to this file, offscreen, and exit")
+    vw.add_argument("--time", type=float, help="output time (s); default the last")
+    vw.add_argument("--field", default="von_mises_Pa", help="the field to colour by (default von_mises_Pa)")
     return ap
 
 
@@ -161,6 +166,37 @@ def cmd_study(args) -> int:
     return 0
 
 
+def cmd_view(args) -> int:
+    """ParaView on the run's view.py (pvpython offscreen under xvfb-run for --png; the GUI otherwise);
+    pyvista where ParaView is not installed."""
+    import shutil
+    import subprocess
+    from pathlib import Path
+
+    from fepen.post import paraview
+
+    out = Path(args.dir)
+    if not (out / "fields.xdmf").is_file():
+        raise InputError("dir", f"{out} holds no fields.xdmf (a run with run.fields = true writes it)")
+    script = out / "view.py"
+    if not script.is_file():  # a run from before view.py was written
+        paraview.write_view_script(out)
+    extra = [*(["--time", repr(args.time)] if args.time is not None else []), "--field", args.field]
+    if args.png and shutil.which("pvpython"):
+        cmd = ["pvpython", "--force-offscreen-rendering", str(script), "--png", str(Path(args.png).resolve()), *extra]
+        if shutil.which("xvfb-run"):
+            cmd = ["xvfb-run", "-a", *cmd]
+        r = subprocess.run(cmd, capture_output=True, text=True)
+        if r.returncode != 0 or not Path(args.png).is_file():
+            raise SimulationError(f"ParaView could not render {args.png}: {r.stderr.strip()[-400:]}")
+    elif not args.png and shutil.which("paraview"):
+        subprocess.run(["paraview", f"--script={script}"], check=False)
+    else:
+        paraview.plot(out, args.field, args.time, args.png)
+    _say(f"written: {args.png}" if args.png else f"shown: {out}")
+    return 0
+
+
 def cmd_keys(args) -> int:
     """Print the scene-key table (Markdown)."""
     from fepen import scene as fscene
@@ -170,7 +206,7 @@ def cmd_keys(args) -> int:
 
 
 COMMANDS = {"run": cmd_run, "mesh": cmd_mesh, "validate": cmd_validate, "validate-depth": cmd_validate_depth,
-            "study": cmd_study, "keys": cmd_keys}
+            "study": cmd_study, "keys": cmd_keys, "view": cmd_view}
 
 
 def main(argv: list[str] | None = None) -> int:

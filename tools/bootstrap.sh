@@ -4,6 +4,7 @@
 #     libraries that PyPI's gmsh and VTK wheels load.
 #   - A virtual environment .venv on /usr/bin/python3 with --system-site-packages, so that it sees Debian's
 #     dolfinx; numpy is held at Debian's version by tools/constraints.txt (numpy 2 breaks petsc4py).
+#   - Debian's ParaView 5.11 and xvfb, for the tests that open the fields with a real ParaView.
 set -euo pipefail
 here=$(cd "$(dirname "$0")/.." && pwd)
 cd "$here"
@@ -20,6 +21,14 @@ if ! /usr/bin/python3 -c "import dolfinx, h5py, numba, matplotlib, venv" >/dev/n
   echo "[bootstrap] installing Debian packages (dolfinx 0.5.2 and friends)"
   $sudo apt-get update -qq
   DEBIAN_FRONTEND=noninteractive $sudo apt-get install -y -qq --no-install-recommends $apt_pkgs >/dev/null
+fi
+
+# ParaView (pvpython, pvbatch) and xvfb-run: tests/system/test_paraview.py opens the fields as a user does.
+# Optional: where apt cannot install them, those tests are skipped and say why.
+if ! command -v pvpython >/dev/null 2>&1 || ! command -v xvfb-run >/dev/null 2>&1; then
+  echo "[bootstrap] installing ParaView and xvfb (Debian packages) for the field-reader tests"
+  { $sudo apt-get update -qq && DEBIAN_FRONTEND=noninteractive $sudo apt-get install -y -qq paraview xvfb >/dev/null; } \
+    || echo "[bootstrap] ParaView could not be installed: its tests will be skipped"
 fi
 
 stamp=.venv/.fepen-stamp

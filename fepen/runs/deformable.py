@@ -16,7 +16,7 @@ from fepen.errors import BeyondMethod, InputError
 from fepen.geometry.frames import unit_axis
 from fepen.io import files, results
 from fepen.io.fields import FieldWriter
-from fepen.post import analyses, signals, slices
+from fepen.post import analyses, paraview, signals, slices
 from fepen.runs import checkpoint, events, model, outputs
 from fepen.solver import explicit
 
@@ -198,6 +198,8 @@ class DeformableRun:
         scalars = ["interface_gap_m", "interface_slip_m"] if self.contact is not None else []
         if self.model.recession is not None:
             scalars.append("wear_depth_m")
+        if self.comm.rank == 0:
+            paraview.write_view_script(self.out)
         return FieldWriter(self.out, self.solver, ["displacement_m", "velocity_m_s"], names, times, scalars,
                            integer=("cell_tag",))
 

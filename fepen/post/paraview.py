@@ -1,0 +1,145 @@
+"""Opening a run in ParaView or pyvista (docs/results.md): the ``view.py`` script written beside every run's
+fields, which pvpython, pvbatch or the ParaView GUI runs, and its pyvista equivalent for notebooks.
+
+``view.py`` needs nothing of fepen (ParaView's own Python runs it): it opens ``fields.xdmf`` with the Xdmf3
+reader, warps the projectile by ``displacement_m``, colours it by von Mises stress with a colour bar, draws
+the target face (the plane y = 0) and leaves the time controls on the output times; with ``--png`` it
+renders one picture offscreen instead.
+"""
+
+from __future__ import annotations
+
+from pathlib import Path
+
+__all__ = ["VIEW_SCRIPT", "write_view_script", "plot"]
+
+VIEW_SCRIPT = '''"""This run in ParaView: the projectile warped by its displacement, coloured by von Mises stress, the
+target face (y = 0) drawn, the time controls on the output times (written by fepen).
+
+    paraview --script=view.py                                  the GUI
+    pvpython view.py --png picture.png [--time T] [--field F]  one picture, offscreen (pvbatch works too)
+    fepen view DIR [--png picture.png]                         either of the two
+"""
+import argparse
+import os
+
+from paraview.simple import (GetActiveViewOrCreate, GetAnimationScene, GetColorTransferFunction, Plane,
+                             Render, SaveScreenshot, Show, WarpByVector, Xdmf3ReaderS)
+
+HERE = os.path.dirname(os.path.abspath(__file__)) if "__file__" in globals() else {here!r}
+
+
+def main(png=None, time=None, field="von_mises_Pa"):
+    reader = Xdmf3ReaderS(registrationName="fields.xdmf", FileName=[os.path.join(HERE, "fields.xdmf")])
+    reader.UpdatePipelineInformation()
+    times = list(reader.TimestepValues) or [0.0]
+    t = times[-1] if time is None else min(times, key=lambda s: abs(s - time))
+    warp = WarpByVector(registrationName="deformed", Input=reader)
+    warp.Vectors = ["POINTS", "displacement_m"]
+    view = GetActiveViewOrCreate("RenderView")
+    view.OrientationAxesVisibility = 1
+    scene = GetAnimationScene()
+    scene.UpdateAnimationUsingDataTimeSteps()
+    scene.AnimationTime = t
+    warp.UpdatePipeline(t)
+    shown = Show(warp, view)
+    shown.SetRepresentationType("Surface With Edges")
+    shown.EdgeColor = [0.25, 0.25, 0.25]
+    centre = "POINTS" if field in ("displacement_m", "velocity_m_s", "wear_depth_m") else "CELLS"
+    shown.ColorArrayName = [centre, field]
+    lut = GetColorTransferFunction(field)
+    lut.ApplyPreset("Jet", True)
+    shown.LookupTable = lut
+    shown.RescaleTransferFunctionToDataRange(False, True)
+    shown.SetScalarBarVisibility(view, True)
+    bar = lut.GetScalarBar(view) if hasattr(lut, "GetScalarBar") else None
+    if bar is not None:
+        bar.Title = field
+        bar.ComponentTitle = ""
+        bar.TitleFontSize = 14
+        bar.LabelFontSize = 12
+        bar.ScalarBarLength = 0.4
+        bar.RangeLabelFormat = "%-#.3g"
+    (x0, x1, y0, y1, z0, z1) = warp.GetDataInformation().GetBounds()
+    half = max(x1 - x0, y1 - y0, z1 - z0)
+    face = Plane(registrationName="target face (y = 0)")
+    face.Origin = [min(x0, 0.0) - half, 0.0, -half]
+    face.Point1 = [max(x1, 0.0) + half, 0.0, -half]
+    face.Point2 = [min(x0, 0.0) - half, 0.0, half]
+    drawn = Show(face, view)
+    drawn.DiffuseColor = [0.6, 0.6, 0.6]
+    drawn.Opacity = 0.35
+    view.CameraPosition = [0.5 * (x0 + x1) + 0.6 * half, 0.5 * (y0 + y1) + 0.5 * half, 4.0 * half]
+    view.CameraFocalPoint = [0.5 * (x0 + x1), 0.5 * (y0 + y1), 0.0]
+    view.CameraViewUp = [0.0, 1.0, 0.0]
+    m = 0.15 * half  # the camera on the projectile; the face shows when the projectile is near it
+    view.ResetCamera(x0 - m, x1 + m, y0 - m, y1 + m, z0 - m, z1 + m)
+    Render(view)
+    if png:
+        SaveScreenshot(png, view, ImageResolution=[1200, 800])
+    return view
+
+
+if __name__ != "view":  # run, not imported
+    parser = argparse.ArgumentParser(description="this run in ParaView")
+    parser.add_argument("--png", help="render one picture to this file and exit")
+    parser.add_argument("--time", type=float, help="output time (s); default the last")
+    parser.add_argument("--field", default="von_mises_Pa", help="the field to colour by")
+    args, _ = parser.parse_known_args()
+    main(args.png, args.time, args.field)
+'''
+
+
+def write_view_script(out: Path) -> Path:
+    """Write ``view.py`` into the results directory ``out`` (rank 0's business). Returns its path."""
+    from fepen.atomic import replacing
+
+    path = Path(out) / "view.py"
+    with replacing(path) as tmp:
+        tmp.write_text(VIEW_SCRIPT.replace("{here!r}", repr(str(Path(out).resolve()))))
+    return path
+
+
+def plot(out: Path, field: str = "von_mises_Pa", time: float | None = None, png: str | Path | None = None):
+    """The pyvista equivalent of view.py: the projectile at an output time (the last by default) warped by
+    its displacement and coloured by ``field``, with the target face.
+
+    Args:
+        out: results directory with fields.xdmf. field: a cell or point field name. time: output time (s).
+        png: write the picture there (offscreen) instead of showing it.
+
+    Returns:
+        The pyvista Plotter (closed when ``png`` is given).
+    """
+    import os
+
+    os.environ.setdefault("VTK_DEFAULT_OPENGL_WINDOW", "vtkOSOpenGLRenderWindow")
+    import numpy as np
+    import pyvista as pv
+
+    reader = pv.get_reader(str(Path(out) / "fields.xdmf"))
+    times = np.asarray(reader.time_values)
+    k = len(times) - 1 if time is None else int(np.argmin(np.abs(times - time)))
+    reader.set_active_time_point(k)
+    grid = reader.read()
+    if isinstance(grid, pv.MultiBlock):
+        grid = grid.combine()
+    warped = grid.warp_by_vector("displacement_m")
+    x0, x1, y0, y1, z0, z1 = warped.bounds
+    half = max(x1 - x0, y1 - y0, z1 - z0)
+    face = pv.Plane(center=(0.5 * (x0 + x1), 0.0, 0.0), direction=(0.0, 1.0, 0.0), i_size=x1 - x0 + 2 * half,
+                    j_size=2 * half)
+    plotter = pv.Plotter(off_screen=png is not None, window_size=(1200, 800))
+    plotter.add_mesh(warped, scalars=field, cmap="jet", show_edges=True, edge_color="#404040",
+                     scalar_bar_args={"title": field})
+    plotter.add_mesh(face, color="grey", opacity=0.35)
+    plotter.add_text(f"t = {times[k] * 1e6:.1f} us", font_size=10)
+    plotter.view_xy()
+    plotter.camera.azimuth = 20
+    plotter.camera.elevation = 15
+    if png is not None:
+        plotter.screenshot(str(png))
+        plotter.close()
+    else:
+        plotter.show()
+    return plotter
