@@ -16,7 +16,6 @@ from mpi4py import MPI
 
 from fepen.atomic import replacing
 
-
 #: what fields.xdmf says of its own frame and units (an Information element of its Domain)
 FRAME = ("fepen field output. Frame: the target's, in metres; the target face is the plane y = 0 and the target "
          "lies at y < 0 (depth = -y); the impact plane is x-y, z is normal to it; the geometry is the undeformed "
@@ -156,7 +155,7 @@ class FieldWriter:
                     dims, kind, centre = f"{nc} 1", "Scalar", "Cell"
                 else:
                     dims, kind, centre = f"{nn} 1", "Scalar", "Node"
-                number = 'NumberType="Int" Precision="8"' if name in self.integer else 'NumberType="Float" Precision="8"'
+                number = f'NumberType="{"Int" if name in self.integer else "Float"}" Precision="8"'
                 where = (f"fields.h5:/Function/{name}/{_time_name(t)}" if consolidated
                          else f"fields.d/{self._step_file(k).name}:/{name}")
                 lines += [f'        <Attribute Name={quoteattr(name)} AttributeType="{kind}" Center="{centre}">',

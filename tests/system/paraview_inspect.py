@@ -13,7 +13,7 @@ import json
 import sys
 
 from paraview import servermanager
-from paraview.simple import WarpByVector, XDMFReader, Xdmf3ReaderS
+from paraview.simple import WarpByVector, Xdmf3ReaderS, XDMFReader
 
 path, which = sys.argv[1], sys.argv[2]
 reader = Xdmf3ReaderS(FileName=[path]) if which == "xdmf3" else XDMFReader(FileNames=[path])
