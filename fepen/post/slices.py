@@ -190,6 +190,58 @@ def stress_maps(out: Path, path: Path, time: float | None = None) -> dict:
     return {"t_s": st["t"], **report}
 
 
+def trajectory_figure(out: Path, path: Path, experiment=None, outlines: int = 6) -> None:
+    """The shot in the plane of incidence (the paper's Fig. 18): the target face and the target, the
+    projectile's deformed outline (its cut by the plane z = 0) at a few output times, the nose and tail paths
+    of history.csv and, for a Table 1 shot, the test's final nose and tail.
+
+    Args:
+        experiment: fepen.experiments.Shot (Hx_mm, Hy_mm, Tx_mm, Ty_mm) or None.
+        outlines: how many output times to draw, evenly spread from the first to the last.
+    """
+    import matplotlib
+
+    matplotlib.use("Agg")
+    import matplotlib.pyplot as plt
+    from matplotlib.collections import PolyCollection
+
+    out = Path(out)
+    h = np.atleast_1d(np.genfromtxt(out / "history.csv", delimiter=",", names=True))
+    fig, ax = plt.subplots(figsize=(7, 7))
+    times = output_times(out)
+    picks = sorted(set(np.linspace(0, len(times) - 1, min(outlines, len(times))).round().astype(int)))
+    cmap = plt.get_cmap("viridis")
+    ez, basis = np.array([0.0, 0.0, 1.0]), np.array([[1.0, 0.0, 0.0], [0.0, -1.0, 0.0]])  # (x, depth)
+    for i, k in enumerate(picks):
+        st = read_state(out, float(times[k]))
+        live = st["cell_tag"] > 0 if "cell_tag" in st else np.ones(len(st["cells"]), dtype=bool)
+        x = st["X"] + st["displacement_m"]
+        polys, _ = cut(x[st["cells"][live]], ez, 0.0, basis)
+        colour = cmap(i / max(len(picks) - 1, 1))
+        ax.add_collection(PolyCollection([q * 1e3 for q in polys], facecolors=colour, edgecolors="none", alpha=0.8,
+                                         label=f"t = {st['t'] * 1e6:.0f} us"))
+    ax.plot(h["nose_x_mm"], h["nose_y_mm"], "-", color="C3", lw=1, label="nose path")
+    ax.plot(h["tail_x_mm"], h["tail_y_mm"], "--", color="C0", lw=1, label="tail path")
+    if experiment is not None:
+        ax.plot([experiment.Tx_mm, experiment.Hx_mm], [experiment.Ty_mm, experiment.Hy_mm], "k-", lw=2.5,
+                label="test: final tail to nose")
+        ax.plot([experiment.Hx_mm], [experiment.Hy_mm], "k^", ms=8)
+    ax.autoscale_view()
+    x0, x1 = ax.get_xlim()
+    y0, y1 = ax.get_ylim()
+    ax.axhspan(0.0, max(y1, 1.0), color="0.9", zorder=0)
+    ax.axhline(0.0, color="k", lw=1)
+    ax.text(x0, 0.0, " target face", va="bottom", fontsize=8)
+    ax.set(xlabel="x (mm)", ylabel="depth, -y (mm)", title=f"{out.name}: the shot in the plane of incidence")
+    ax.set_aspect("equal", adjustable="datalim")
+    ax.invert_yaxis()
+    ax.legend(fontsize=7, loc="best")
+    ax.grid(alpha=0.3)
+    fig.tight_layout()
+    fig.savefig(path, dpi=110)
+    plt.close(fig)
+
+
 def cross_sections(out: Path, path: Path, sections: dict, time: float | None = None) -> dict:
     """Axial logarithmic strain over material cross-sections (reference planes y = const), one panel each.
 

@@ -13,6 +13,7 @@ import numpy as np
 from mpi4py import MPI
 
 from fepen.errors import BeyondMethod, InputError
+from fepen.experiments import shot
 from fepen.geometry.frames import unit_axis
 from fepen.io import files, results
 from fepen.io.fields import FieldWriter
@@ -229,7 +230,15 @@ class DeformableRun:
                 report = slices.charge_report(self.out, self.sections.sections, self.peaks["charge_acc"]["t_s"])
             self.charge = self.comm.bcast(report, root=0)
         s = self.solver
-        analyses.deformed_picture(s, self.out / "deformed.png", f"t = {s.t * 1e6:.0f} us, max PEEQ {s.max_peeq():.3g}")
+        if self.fields is not None:  # the cut planes at peak load and at the end, and the shot (Figs. 18, 20-21)
+            if self.comm.rank == 0:
+                name = self.scene.get("impact.shot")
+                slices.stress_maps(self.out, self.out / "stress_maps_peak.png", self.peaks["decel"]["t_s"])
+                slices.stress_maps(self.out, self.out / "stress_maps_end.png")
+                slices.trajectory_figure(self.out, self.out / "trajectory.png", shot(name) if name else None)
+        else:
+            analyses.deformed_picture(s, self.out / "deformed.png",
+                                      f"t = {s.t * 1e6:.0f} us, max PEEQ {s.max_peeq():.3g}")
         if self.model.surface is not None:
             self.profile = analyses.nose_profile(s, self.model, self.out)
 

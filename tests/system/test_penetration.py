@@ -34,7 +34,7 @@ def test_stiff_projectile_reproduces_the_rigid_one(tmp_path):
     # at normal incidence the projectile is compressed axially, about equally on all four sides
     peak = np.abs(gauges[:, 1:5]).max(axis=0)
     assert peak.min() > 1e-5 and peak.max() / peak.min() < 3.0
-    for f in ("deformed.png", "hazard.png"):
+    for f in ("deformed.png", "hazard.png"):  # no fields (run.fields = false): the picture from the solver
         assert (tmp_path / "elastic" / f).stat().st_size > 5000
 
 
@@ -80,6 +80,8 @@ def test_fields_hold_every_field_at_every_output_time(tmp_path):
         assert np.abs(u[end][:]).max() > 5e-3  # 600 m/s x 20 us = 12 mm of travel
     xdmf = (tmp_path / "fields.xdmf").read_text()
     assert xdmf.count('Name="von_mises_Pa"') >= 3
+    for f in ("stress_maps_peak.png", "stress_maps_end.png", "trajectory.png", "view.py"):  # with fields
+        assert (tmp_path / f).stat().st_size > 2000
 
 
 def test_switched_off_physics_writes_no_field(tmp_path):
