@@ -24,6 +24,9 @@ FRAME = ("fepen field output. Frame: the target's, in metres; the target face is
          "(Pa, K, m, m/s); peeq is dimensionless; cell_tag: 1 shell, 2 charge, 0 eroded.")
 
 
+INT32, FLOAT64 = 'NumberType="Int" Precision="4"', 'NumberType="Float" Precision="8"'
+
+
 def _time_name(t: float) -> str:
     """dolfinx's dataset name for an output time."""
     return repr(float(t)).replace(".", "_") if t != 0 else "0"
@@ -39,7 +42,7 @@ class FieldWriter:
         cell: names of cell scalar fields, in writing order.
         nodal_scalar: names of nodal scalar fields, written after the cell fields.
         times: output times already written (when resuming a run; later step files are deleted).
-        integer: the names (of any kind) whose values are integers (written as int64).
+        integer: the names (of any kind) whose values are integers (written as int32).
     """
 
     def __init__(self, out: Path, solver, nodal: list[str], cell: list[str], times: list[float] = (),
@@ -108,7 +111,7 @@ class FieldWriter:
             data[name] = self._gather(values[name][: self._n_cells])
         if self.comm.rank == 0:
             data = {k: (v.reshape(-1, 1) if v.ndim == 1 else v) for k, v in data.items()}
-            data = {k: (np.rint(v).astype(np.int64) if k in self.integer else v) for k, v in data.items()}
+            data = {k: (np.rint(v).astype(np.int32) if k in self.integer else v) for k, v in data.items()}
             self._write_h5(self._step_file(len(self.times)), data)
         self.times.append(float(t))
         if self.comm.rank == 0:
@@ -155,7 +158,7 @@ class FieldWriter:
                     dims, kind, centre = f"{nc} 1", "Scalar", "Cell"
                 else:
                     dims, kind, centre = f"{nn} 1", "Scalar", "Node"
-                number = f'NumberType="{"Int" if name in self.integer else "Float"}" Precision="8"'
+                number = INT32 if name in self.integer else FLOAT64
                 where = (f"fields.h5:/Function/{name}/{_time_name(t)}" if consolidated
                          else f"fields.d/{self._step_file(k).name}:/{name}")
                 lines += [f'        <Attribute Name={quoteattr(name)} AttributeType="{kind}" Center="{centre}">',

@@ -37,13 +37,15 @@ def main(png=None, time=None, field="von_mises_Pa"):
     warp = WarpByVector(registrationName="deformed", Input=reader)
     warp.Vectors = ["POINTS", "displacement_m"]
     view = GetActiveViewOrCreate("RenderView")
+    view.ViewSize = [1200, 800]  # the screenshot's own size: fonts are not scaled up
     view.OrientationAxesVisibility = 1
     scene = GetAnimationScene()
     scene.UpdateAnimationUsingDataTimeSteps()
     scene.AnimationTime = t
     warp.UpdatePipeline(t)
     shown = Show(warp, view)
-    shown.SetRepresentationType("Surface With Edges")
+    fine = reader.GetDataInformation().GetNumberOfCells() > 5000
+    shown.SetRepresentationType("Surface" if fine else "Surface With Edges")
     shown.EdgeColor = [0.25, 0.25, 0.25]
     centre = "POINTS" if field in ("displacement_m", "velocity_m_s", "wear_depth_m") else "CELLS"
     shown.ColorArrayName = [centre, field]
@@ -69,11 +71,11 @@ def main(png=None, time=None, field="von_mises_Pa"):
     drawn = Show(face, view)
     drawn.DiffuseColor = [0.6, 0.6, 0.6]
     drawn.Opacity = 0.35
-    view.CameraPosition = [0.5 * (x0 + x1) + 0.6 * half, 0.5 * (y0 + y1) + 0.5 * half, 4.0 * half]
-    view.CameraFocalPoint = [0.5 * (x0 + x1), 0.5 * (y0 + y1), 0.0]
+    c = [0.5 * (x0 + x1), 0.5 * (y0 + y1), 0.5 * (z0 + z1)]  # the camera on the projectile, a little
+    view.CameraFocalPoint = c                                # from above and aside; the face shows when
+    view.CameraPosition = [c[0] + 0.8 * half, c[1] + 0.6 * half, c[2] + 2.3 * half]  # the projectile is near it
     view.CameraViewUp = [0.0, 1.0, 0.0]
-    m = 0.15 * half  # the camera on the projectile; the face shows when the projectile is near it
-    view.ResetCamera(x0 - m, x1 + m, y0 - m, y1 + m, z0 - m, z1 + m)
+    view.CameraViewAngle = 30.0
     Render(view)
     if png:
         SaveScreenshot(png, view, ImageResolution=[1200, 800])
