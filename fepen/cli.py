@@ -97,12 +97,17 @@ def cmd_mesh(args) -> int:
         pm.mesh.topology.create_connectivity(2, 3)
         xdmf.write_meshtags(pm.cell_tags)
         xdmf.write_meshtags(pm.facet_tags)
+    if comm.rank == 0:  # one dataset per file, as every reader wants it (fepen.io.fields.mesh_index)
+        from fepen.io.fields import mesh_index
+
+        mesh_index(out / "mesh.h5", out / "mesh.xdmf", out / "mesh_facets.xdmf")
+    comm.barrier()
     figures.mesh_picture(pm, out / "mesh.png",
                          f"{info['cells']} tets, h = {1e3 * sc.mesh.size:g} mm, {1e3 * info['mass_kg']:.2f} g")
     keys = ("cells", "nodes", "mass_kg", "volume_m3", "min_quality", "shortest_altitude_m", "stable_dt_s")
     _say(*(f"{k} = {info[k]:.6g}" if isinstance(info[k], float) else f"{k} = {info[k]}" for k in keys),
          f"altitude_over_size = {info['altitude_over_size']:.4f}",
-         f"written: {out}/mesh.json, mesh.xdmf, mesh.png")
+         f"written: {out}/mesh.json, mesh.xdmf, mesh_facets.xdmf (and .vtu), mesh.png")
     return 0
 
 

@@ -188,3 +188,45 @@ class FieldWriter:
             self._write_xdmf(consolidated=True)
             shutil.rmtree(self.dir)
         self.comm.barrier()
+
+
+def mesh_index(h5_path: Path, cells_xdmf: Path, facets_xdmf: Path) -> None:
+    """Rewrite the XDMF index of a mesh written by dolfinx's XDMFFile (mesh, cell tags, facet tags in one
+    file, three grids, which pyvista and meshio.read refuse) as two files of one grid each, on the same HDF5
+    datasets: the tetrahedra with ``cell_tag`` (every cell is tagged: the cell tags' own topology is the
+    mesh) and the tagged facets with ``facet_tag``; and each as .vtu beside it, for pyvista (rank 0)."""
+    import h5py
+
+    def item(ds, path):
+        kind = "Float" if ds.dtype.kind == "f" else "Int"
+        dims = " ".join(str(n) for n in ds.shape)
+        return (f'<DataItem Dimensions="{dims}" NumberType="{kind}" Precision="{ds.dtype.itemsize}" '
+                f'Format="HDF">{h5_path.name}:{path}</DataItem>')
+
+    with h5py.File(h5_path, "r") as h5:
+        geometry = item(h5["/Mesh/mesh/geometry"], "/Mesh/mesh/geometry")
+        for target, group, shape, name in ((cells_xdmf, "Cell tags", "Tetrahedron", "cell_tag"),
+                                           (facets_xdmf, "Facet tags", "Triangle", "facet_tag")):
+            topo, values = h5[f"/MeshTags/{group}/topology"], h5[f"/MeshTags/{group}/Values"]
+            lines = ['<?xml version="1.0"?>', '<Xdmf Version="3.0">', "  <Domain>",
+                     f"    <!-- {FRAME.split(' Units')[0].replace('--', '-')} -->",  # meshio.read wants one child
+                     '    <Grid Name="mesh" GridType="Uniform">',
+                     f'      <Topology TopologyType="{shape}" NumberOfElements="{topo.shape[0]}">',
+                     f"        {item(topo, f'/MeshTags/{group}/topology')}", "      </Topology>",
+                     '      <Geometry GeometryType="XYZ">', f"        {geometry}", "      </Geometry>",
+                     f'      <Attribute Name="{name}" AttributeType="Scalar" Center="Cell">',
+                     f"        {item(values, f'/MeshTags/{group}/Values')}", "      </Attribute>",
+                     "    </Grid>", "  </Domain>", "</Xdmf>", ""]
+            with replacing(target) as tmp:
+                tmp.write_text("\n".join(lines))
+            _write_vtu(target.with_suffix(".vtu"), h5["/Mesh/mesh/geometry"][()], topo[()], name, values[()])
+
+
+def _write_vtu(path: Path, points: np.ndarray, cells: np.ndarray, name: str, values: np.ndarray) -> None:
+    """The same grid as VTK XML (.vtu): pyvista's XDMF reader cannot open an XDMF file without time values
+    (pyvista 0.49), and a static XDMF file with them is one meshio.read cannot open."""
+    import meshio
+
+    kind = {4: "tetra", 3: "triangle"}[cells.shape[1]]
+    with replacing(path, ".vtu") as tmp:
+        meshio.write(tmp, meshio.Mesh(points, [(kind, cells)], cell_data={name: [values.ravel()]}), file_format="vtu")

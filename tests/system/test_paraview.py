@@ -224,3 +224,35 @@ def test_the_pyvista_picture_of_the_api(runs, tmp_path):
 
     img = mpimg.imread(png)[..., :3]
     assert (np.ptp(img, axis=2) > 0.4).mean() > 0.002
+
+
+def test_the_mesh_files_open_in_every_reader(tmp_path):
+    """`fepen mesh`: mesh.xdmf (the tetrahedra, cell_tag) and mesh_facets.xdmf (the tagged facets, facet_tag),
+    one dataset each, for ParaView's two readers and meshio.read; their .vtu twins for pyvista; the counts
+    those of mesh.json."""
+    r = run_fepen("mesh", "--set", "mesh.size=0.005", "--out", str(tmp_path))
+    assert r.returncode == 0, r.stderr[-1500:]
+    info = json.loads((tmp_path / "mesh.json").read_text())
+    code = ("import json, sys, meshio, pyvista as pv\n"
+            "out = {}\n"
+            "for f, name in (('mesh', 'cell_tag'), ('mesh_facets', 'facet_tag')):\n"
+            "    m = meshio.read(sys.argv[1] + '/' + f + '.xdmf')\n"
+            "    g = pv.read(sys.argv[1] + '/' + f + '.vtu')\n"
+            "    tags = sorted(set(m.cell_data[name][0].ravel().tolist()))\n"
+            "    out[f] = [len(m.points), sum(len(c.data) for c in m.cells), tags, g.n_points, g.n_cells]\n"
+            "print(json.dumps(out))")
+    found = run_reader([sys.executable, "-c", code, str(tmp_path)])
+    n, c = info["nodes"], info["cells"]
+    assert found["mesh"] == [n, c, [1], n, c]
+    assert found["mesh_facets"][0] == n and found["mesh_facets"][2] == [11, 12]
+    assert found["mesh_facets"][1] == found["mesh_facets"][4] > 0
+    if PVPYTHON is None:
+        return
+    for f, cells in (("mesh.xdmf", c), ("mesh_facets.xdmf", found["mesh_facets"][1])):
+        for reader in ("Xdmf3ReaderS(FileName=[f])", "XDMFReader(FileNames=[f])"):
+            script = ("import json, sys\nfrom paraview import servermanager\nfrom paraview.simple import *\n"
+                      f"f = sys.argv[1]\nr = {reader}\nr.UpdatePipeline()\nd = servermanager.Fetch(r)\n"
+                      "print(json.dumps([d.GetClassName(), d.GetNumberOfPoints(), d.GetNumberOfCells()]))")
+            r = subprocess.run([PVPYTHON, "-c", script, str(tmp_path / f)], capture_output=True, text=True)
+            assert r.returncode == 0, r.stderr[-1000:]
+            assert json.loads(r.stdout.strip().splitlines()[-1]) == ["vtkUnstructuredGrid", n, cells], (f, reader)
