@@ -189,9 +189,12 @@ def cmd_view(args) -> int:
     extra = [*(["--time", repr(args.time)] if args.time is not None else []), "--field", args.field]
     if args.png and shutil.which("pvpython"):
         cmd = ["pvpython", "--force-offscreen-rendering", str(script), "--png", str(Path(args.png).resolve()), *extra]
-        if shutil.which("xvfb-run"):
-            cmd = ["xvfb-run", "-a", *cmd]
-        r = subprocess.run(cmd, capture_output=True, text=True)
+        if shutil.which("xvfb-run"):  # a virtual screen of 24-bit colour on a free display number
+            cmd = ["xvfb-run", "-a", "-s", "-screen 0 1280x1024x24", *cmd]
+        for _ in range(3):  # two xvfb-run started at once may race for one display: try again
+            r = subprocess.run(cmd, capture_output=True, text=True)
+            if r.returncode == 0 and Path(args.png).is_file():
+                break
         if r.returncode != 0 or not Path(args.png).is_file():
             raise SimulationError(f"ParaView could not render {args.png}: {r.stderr.strip()[-400:]}")
     elif not args.png and shutil.which("paraview"):

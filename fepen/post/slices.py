@@ -127,7 +127,8 @@ def _strain_axial(X, x, cells) -> np.ndarray:
 
 # ---- figures -----------------------------------------------------------------------------------------
 def stress_maps(out: Path, path: Path, time: float | None = None) -> dict:
-    """Equivalent stress and PEEQ of shell and charge in the x–y and y–z planes, one figure.
+    """Equivalent stress and PEEQ of shell and charge in the x–y and y–z planes, one figure; and the same
+    cuts as data, ``path`` with the suffix .vtu (write_cut_planes), for ParaView, pyvista and meshio.
 
     Returns:
         {plane: {body: {"von_mises_max_Pa", "peeq_max", and where each is, "..._at_mm": [behind the nose tip
@@ -150,6 +151,7 @@ def stress_maps(out: Path, path: Path, time: float | None = None) -> dict:
     ncol = len(quantities) * len(bodies)
     fig, axes = plt.subplots(len(planes), ncol, figsize=(2.6 * ncol + 1, 9.5), squeeze=False)
     report = {}
+    write_cut_planes(st, x, tip, planes, Path(path).with_suffix(".vtu"))
     for r, (pname, (normal, basis)) in enumerate(planes.items()):
         polys, cells = cut(x[st["cells"]], normal, float(normal @ tip), basis)
         polys = [(q - tip @ basis.T) * 1e3 for q in polys]
@@ -189,6 +191,40 @@ def stress_maps(out: Path, path: Path, time: float | None = None) -> dict:
     fig.savefig(path, dpi=110)
     plt.close(fig)
     return {"t_s": st["t"], **report}
+
+
+def write_cut_planes(st: dict, x: np.ndarray, tip: np.ndarray, planes: dict, path: Path) -> None:
+    """The stress maps' two cuts through the deformed projectile as one unstructured grid of polygons in
+    the target's frame (m): triangles and quads with every cell field of the state, ``cell_tag`` and
+    ``plane`` (0 the x–y plane of incidence, 1 the y–z plane across it); VTK XML, which ParaView, pyvista
+    and meshio open."""
+    import meshio
+
+    from fepen.atomic import replacing
+
+    points, blocks, data = [], {3: [], 4: []}, {3: [], 4: []}
+    names = [k for k, v in st.items() if isinstance(v, np.ndarray) and v.shape == (len(st["cells"]),)]
+    n = 0
+    for k, (normal, basis) in enumerate(planes.values()):
+        off = float(normal @ tip)
+        polys, cells = cut(x[st["cells"]], normal, off, basis)
+        for q, c in zip(polys, cells):
+            if len(q) not in blocks:
+                continue
+            points.append(q @ basis + off * np.asarray(normal))
+            blocks[len(q)].append(np.arange(n, n + len(q)))
+            data[len(q)].append([float(st[m][c]) for m in names] + [float(k)])
+            n += len(q)
+    kinds = [(3, "triangle"), (4, "quad")]
+    cells_out = [(kind, np.array(blocks[m], dtype=np.int64).reshape(-1, m)) for m, kind in kinds]
+    values = {m: np.array(data[m], dtype=float).reshape(-1, len(names) + 1) for m, _ in kinds}
+    cell_data = {name: [values[m][:, i] for m, _ in kinds] for i, name in enumerate([*names, "plane"])}
+    for key in ("cell_tag", "plane"):
+        if key in cell_data:
+            cell_data[key] = [v.astype(np.int32) for v in cell_data[key]]
+    mesh = meshio.Mesh(np.concatenate(points) if points else np.zeros((0, 3)), cells_out, cell_data=cell_data)
+    with replacing(path, ".vtu") as tmp:
+        meshio.write(tmp, mesh, file_format="vtu")
 
 
 def trajectory_figure(out: Path, path: Path, experiment=None, outlines: int = 6) -> None:

@@ -169,6 +169,17 @@ def test_a_charged_run_carries_both_cell_tags_and_the_interface_fields(runs):
     r = subprocess.run([sys.executable, "-c", code, str(out / "fields.xdmf")], capture_output=True, text=True)
     assert r.returncode == 0, r.stderr[-1000:]
     assert r.stdout.strip().splitlines()[-1] == "[1, 2]"
+    # the cut planes of the stress maps open the same way: both planes, both bodies, the fields on them
+    code = ("import json, sys, meshio, numpy as np, pyvista as pv\n"
+            "g = pv.read(sys.argv[1]); m = meshio.read(sys.argv[1])\n"
+            "tags = sorted(set(np.concatenate(m.cell_data['cell_tag']).tolist()))\n"
+            "planes = sorted(set(np.asarray(g.cell_data['plane']).tolist()))\n"
+            "n = sum(len(c.data) for c in m.cells)\n"
+            "print(json.dumps({'r': [g.n_cells, n, tags, planes, sorted(g.array_names)]}))")
+    for name in ("stress_maps_peak.vtu", "stress_maps_end.vtu", "stress_maps.vtu"):
+        n_pv, n_meshio, tags, planes, arrays = run_reader([sys.executable, "-c", code, str(out / name)])["r"]
+        assert n_pv == n_meshio > 100 and tags == [1, 2] and planes == [0, 1]
+        assert {"von_mises_Pa", "peeq", "cell_tag"} <= set(arrays)
 
 
 def test_every_reader_opens_a_running_and_then_a_killed_run(tmp_path):
