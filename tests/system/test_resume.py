@@ -54,18 +54,19 @@ def kill_after_checkpoints(proc, out, n=2, timeout=300):
 
 
 def check_valid_fields(out):
-    """fields.xdmf parses and every dataset it names reads from fields.h5 with the right shape."""
+    """fields.xdmf parses and every dataset it names reads, with the right shape, from the file it names
+    (fields.h5 once the run has ended; the per-time files of fields.d while it runs or after a kill)."""
     import h5py
 
     root = ET.parse(out / "fields.xdmf").getroot()
     items = [d for d in root.iter("DataItem")]
     assert len(items) > 2
-    with h5py.File(out / "fields.h5", "r") as h5:
-        for d in items:
-            path = d.text.strip().split(":", 1)[1]
-            dims = tuple(int(v) for v in d.get("Dimensions").split())
+    for d in items:
+        name, path = d.text.strip().split(":", 1)
+        dims = tuple(int(v) for v in d.get("Dimensions").split())
+        with h5py.File(out / name, "r") as h5:
             data = h5[path][()]
-            assert data.reshape(dims).shape == dims and np.all(np.isfinite(data))
+        assert data.reshape(dims).shape == dims and np.all(np.isfinite(data))
     return sum(1 for g in root.iter("Grid") if g.get("GridType") == "Uniform")  # one grid per output time
 
 
