@@ -21,6 +21,7 @@ from typing import Any
 from fepen.errors import InputError
 from fepen.experiments import SHOTS, shot
 from fepen.steels import STEELS
+from fepen.targets import CONSTANTS, FAMILIES, TARGETS
 
 _ABSENT = object()  # marks an optional key whose absence means something (e.g. semi-infinite target)
 
@@ -38,6 +39,7 @@ class Key:
     hi_open: bool = False
     choices: tuple = ()
     doc: str = ""
+    form: str = ""  # what a list key holds
 
     def allowed(self) -> str:
         """Human-readable description of the allowed values."""
@@ -47,6 +49,8 @@ class Key:
             return "true or false"
         if self.kind is str:
             return "a string"
+        if self.kind is list:
+            return self.form or "a list"
         lo = "-inf" if self.lo is None else f"{self.lo:g}"
         hi = "inf" if self.hi is None else f"{self.hi:g}"
         brackets = ("(" if self.lo_open or self.lo is None else "[") + lo + ", " + hi + (
@@ -71,6 +75,8 @@ class Key:
         elif self.kind is str:
             if not isinstance(value, str):
                 raise InputError(name, f"got {value!r}, expected {self.allowed()}")
+        elif self.kind is list:
+            return LIST_CHECKS[name](name, value)
         if self.choices and value not in self.choices:
             raise InputError(name, f"got {value!r}, expected {self.allowed()}")
         if self.kind in (int, float):
@@ -104,7 +110,26 @@ C3 = shot("C3")
 #: has a meaning given in their doc.
 SCHEMA: dict[str, Key] = {
     # --- projectile geometry (docs/theory.md, "The projectile") ---
-    "projectile.nose": _choice("ogive", "ogive", "flat", doc="tangent ogive, or flat (a plain cylinder)"),
+    "projectile.nose": _choice("ogive", "ogive", "secant", "cone", "hemisphere", "ellipsoid", "flat", "profile",
+                               doc="tangent or secant ogive, cone, hemisphere, ellipsoid, flat (a plain cylinder), "
+                                   "or a drawn profile (projectile.profile); docs/projectiles-and-targets.md"),
+    "projectile.nose_length": _pos(_ABSENT, "m", 10.0, doc="axial length of a secant ogive, cone or ellipsoid nose "
+                                                           "(before any meplat)"),
+    "projectile.meplat_diameter": _num(0.0, "m", 0.0, 1.0, doc="flat blunt tip of an ogive, cone, hemisphere or "
+                                                                "ellipsoid nose; 0: pointed"),
+    "projectile.boattail_length": _num(0.0, "m", 0.0, 10.0, doc="tapered rear; 0: none"),
+    "projectile.boattail_diameter": _pos(_ABSENT, "m", 1.0, doc="rear-face diameter of the boat-tail"),
+    "projectile.profile": Key(str, _ABSENT, doc="CSV of the outer profile, rows z_m, r_m[, arc_radius_m] from the "
+                                                "nose (projectile.nose = 'profile'; sets diameter and length)"),
+    "projectile.inner_profile": Key(str, _ABSENT, doc="CSV of the cavity profile, rows z_m, r_m[, arc_radius_m] "
+                                                      "(a fixed cavity: the mass follows from it)"),
+    "projectile.cavity_sections": Key(list, _ABSENT, doc="cavity as [[length_m, diameter_m], ...] front to rear; "
+                                                         "the rear one's length is sized to projectile.mass",
+                                      form="a list of [length, diameter] pairs in metres, each > 0"),
+    "projectile.cad": Key(str, _ABSENT, doc="STEP or BREP file of the projectile body (axis +y, nose toward -y); "
+                                            "meshed as is, mass from the mesh (docs/projectiles-and-targets.md)"),
+    "projectile.cad_scale": _pos(1.0, "m per file unit", 1.0e3, doc="lengths of projectile.cad times this are "
+                                                                     "metres (0.001 for a file in mm)"),
     "projectile.diameter": _pos(0.0236, "m", 1.0),
     "projectile.length": _pos(0.144, "m", 10.0),
     "projectile.crh": _num(3.0, "", 0.5, 50.0, doc="ogive radius over diameter (0.5: hemisphere)"),
@@ -159,17 +184,30 @@ SCHEMA: dict[str, Key] = {
     "charge.friction": _num(0.1, "", 0.0, 2.0),
     "charge.contact": _choice("frictional", "frictional", "tied", doc="shell-charge interface"),
     # --- target (Table 3; the law: docs/paper.md §4) ---
-    "target.kind": _choice("concrete", "concrete", "rigid-wall"),
+    "target.kind": _choice("concrete", "concrete", "rigid-wall",
+                           doc="'concrete': a cavity-expansion target of target.material (or target.layers); "
+                               "'rigid-wall': a Taylor test"),
+    "target.material": _choice("concrete", *TARGETS, doc="a named target of fepen/data/targets.toml: its law's "
+                               "family and every target constant not given explicitly (docs/theory.md §16)"),
+    "target.layers": Key(list, _ABSENT, doc="[[target.layers]] tables front to back: material, thickness (m; "
+                                            "absent on the last: semi-infinite), gap (m, the air gap after it), and "
+                                            "any target constant overriding the material's (docs/theory.md §17)",
+                         form="a list of tables {material, thickness, gap, ...}"),
+    "target.yield_stress": _pos(_ABSENT, "Pa", 1.0e11, doc="Y of a metal target (strength_model 'metal')"),
+    "target.hardening_exponent": _num(_ABSENT, "", 0.0, 1.0, hi_open=True,
+                                      doc="n of a metal target's power-law hardening Y (E eps / Y)^n"),
     "target.compressive_strength": _num(40.0e6, "Pa", 1.0e5, 1.0e10),
     "target.density": _num(2400.0, "kg/m^3", 100.0, 30000.0),
     "target.youngs_modulus": _pos(_ABSENT, "Pa", 1.0e13, doc="absent: 4.7 sqrt(f_c / MPa) GPa (ACI 318)"),
     "target.tensile_strength": _pos(_ABSENT, "Pa", 1.0e10, doc="absent: compressive_strength / 10"),
     "target.pressure_hardening": _num(0.67, "", 0.0, 3.0, hi_open=True, doc="lambda of Mohr-Coulomb"),
     "target.crater_depth_factor": _num(2.37, "", 0.0, 50.0, doc="crater depth k over diameter"),
-    "target.strength_model": _choice("scaled-S", "scaled-S", "forrestal-S", "cavity-expansion",
+    "target.strength_model": _choice("scaled-S", "scaled-S", "forrestal-S", "cavity-expansion", "metal",
                                      doc="sigma_s = S fc with S = S_coefficient fc^-S_exponent / sqrt(1 + D/S_size) "
                                          "(fc in MPa): fepen's calibrated scaled-S or Forrestal's S = 82.6 "
-                                         "fc^-0.544; or the paper's elastic-cracked-plastic cavity expansion"),
+                                         "fc^-0.544; or the paper's elastic-cracked-plastic cavity expansion; or "
+                                         "'metal': Forrestal-Warren's power-law metal (yield_stress, "
+                                         "hardening_exponent)"),
     "target.S_coefficient": _pos(_ABSENT, "", 1.0e4, doc="absent: the strength model's"),
     "target.S_exponent": _num(_ABSENT, "", 0.0, 2.0, doc="absent: the strength model's"),
     "target.S_size": _pos(_ABSENT, "m", 1.0e6, doc="Bazant's D0 of the size effect; absent: the strength model's"),
@@ -229,6 +267,64 @@ SCHEMA: dict[str, Key] = {
 }
 
 SECTIONS = sorted({name.split(".")[0] for name in SCHEMA})
+
+def _check_sections(name: str, value: Any) -> list:
+    """projectile.cavity_sections: [[length, diameter], ...] of positive finite numbers (m)."""
+    form = SCHEMA[name].allowed()
+    if not isinstance(value, list) or not value:
+        raise InputError(name, f"got {value!r}, expected {form}")
+    out = []
+    for i, row in enumerate(value):
+        if (not isinstance(row, list) or len(row) != 2
+                or not all(isinstance(v, (int, float)) and not isinstance(v, bool) for v in row)
+                or not all(math.isfinite(v) and v > 0 for v in row)):
+            raise InputError(f"{name}[{i}]", f"got {row!r}, expected [length, diameter] in metres, each > 0")
+        out.append([float(row[0]), float(row[1])])
+    return out
+
+
+#: the keys of one [[target.layers]] table besides the target constants
+LAYER_KEYS = ("material", "thickness", "gap", "crater", "family")
+
+
+def _check_layers(name: str, value: Any) -> list:
+    """target.layers: tables with material, thickness, gap and target constants, types and ranges checked."""
+    if not isinstance(value, list) or not value or not all(isinstance(v, dict) for v in value):
+        raise InputError(name, f"got {value!r}, expected {SCHEMA[name].allowed()} ([[target.layers]] in TOML)")
+    out = []
+    for i, table in enumerate(value):
+        here = f"{name}[{i}]"
+        layer = {}
+        for k, v in table.items():
+            key = f"{here}.{k}"
+            if k == "material":
+                layer[k] = SCHEMA["target.material"].check(key, v)
+            elif k == "thickness":
+                layer[k] = SCHEMA["target.thickness"].check(key, v)
+            elif k == "gap":
+                layer[k] = Key(float, 0.0, "m", 0.0, 1.0e3).check(key, v)
+            elif k == "crater":
+                layer[k] = _choice("none", "none", "energy").check(key, v)
+            elif k == "family":  # as a resolved scene writes it back: must be the material's
+                layer[k] = _choice("concrete", *FAMILIES).check(key, v)
+            elif k in CONSTANTS:
+                layer[k] = SCHEMA[f"target.{k}"].check(key, v)
+            else:
+                close = difflib.get_close_matches(k, LAYER_KEYS + CONSTANTS, n=1, cutoff=0.5)
+                raise InputError(key, "unknown key" + (f" (did you mean '{close[0]}'?)" if close else
+                                                       f" (allowed: {', '.join(LAYER_KEYS + CONSTANTS)})"))
+        layer.setdefault("material", "concrete")
+        layer.setdefault("gap", 0.0)
+        if "thickness" not in layer and i < len(value) - 1:
+            raise InputError(f"{here}.thickness", "missing: every layer but the last needs a thickness (m)")
+        if "thickness" not in layer and layer["gap"] > 0.0:
+            raise InputError(f"{here}.gap", "a semi-infinite last layer has nothing after it: drop the gap")
+        out.append(layer)
+    return out
+
+
+LIST_CHECKS = {"projectile.cavity_sections": _check_sections, "target.layers": _check_layers}
+
 
 
 class Section:
@@ -399,6 +495,7 @@ def resolve(given: dict[str, Any]) -> Scene:
 
     _resolve_shot(flat, given)
     _resolve_steel(flat, given)
+    _resolve_target(flat, given)
     _check_consistency(flat, given)
 
     tree: dict[str, Any] = {}
@@ -432,6 +529,57 @@ def _resolve_steel(flat: dict, given: dict) -> None:
             flat[name] = SCHEMA[name].check(name, value)
 
 
+def _material_constants(name: str, given: dict, crater_given: str | None) -> dict:
+    """Every target constant of a named material, the given ones winning, with the derived defaults
+    (tensile strength f_c/10) and its crater (the scene's explicit effects.crater, else the material's)."""
+    out = {k: v for k, v in TARGETS[name].items() if k in CONSTANTS}
+    out.update(given)
+    if "tensile_strength" not in out and "compressive_strength" in out:
+        out["tensile_strength"] = 0.1 * out["compressive_strength"]
+    out["crater"] = crater_given or TARGETS[name].get("crater", "energy")
+    out["family"] = TARGETS[name]["family"]
+    if out["family"] == "metal":
+        for k in ("yield_stress", "hardening_exponent", "youngs_modulus"):
+            if k not in out:
+                raise InputError(f"target.{k}", f"a metal target ({name}) needs it")
+    return out
+
+
+def _resolve_target(flat: dict, given: dict) -> None:
+    """The named target material's constants for every target key the user did not give; each layer's."""
+    crater = flat["effects.crater"] if "effects.crater" in given else None
+    name = flat["target.material"]
+    if "target.layers" in flat:
+        for key in ("target.material", "target.thickness"):
+            if key in given:
+                raise InputError(key, "give it per layer in [[target.layers]] (material, thickness), not both")
+        if crater == "linear":
+            raise InputError("effects.crater", "'linear' is Forrestal's crater of one target; with target.layers "
+                                               "use 'energy' or 'none'")
+        out = []
+        for i, layer in enumerate(flat["target.layers"]):
+            family = TARGETS[layer["material"]]["family"]
+            if layer.get("family", family) != family:
+                raise InputError(f"target.layers[{i}].family", f"{layer['family']!r}: {layer['material']!r} is "
+                                                               f"a {family} (drop the key)")
+            here = {**{k: v for k, v in layer.items() if k in ("material", "thickness", "gap")},
+                    **_material_constants(layer["material"], {k: v for k, v in layer.items() if k in CONSTANTS},
+                                          crater or layer.get("crater"))}
+            if here["crater"] == "energy" and here.get("lock_density", 2650.0) <= here["density"]:
+                raise InputError(f"target.layers[{i}].lock_density", "must exceed the layer's density with the "
+                                                                     "energy crater")
+            out.append(here)
+        flat["target.layers"] = out
+        flat.pop("target.material", None)  # each layer names its own
+        return
+    mine = {k: flat[f"target.{k}"] for k in CONSTANTS if f"target.{k}" in given}
+    constants = _material_constants(name, mine, crater)
+    for k in CONSTANTS:
+        if k in constants:
+            flat[f"target.{k}"] = SCHEMA[f"target.{k}"].check(f"target.{k}", constants[k])
+    flat["effects.crater"] = constants["crater"]
+
+
 def _check_consistency(flat: dict, given: dict) -> None:
     """Checks that involve several keys. Geometry is checked in full by fepen.geometry.gmsh_model."""
     if "projectile.cavity_length" in given:
@@ -450,7 +598,7 @@ def _check_consistency(flat: dict, given: dict) -> None:
     if flat["effects.erosion"] and flat["effects.fidelity"] == "rigid":
         raise InputError("effects.erosion", "removes cells of the meshed projectile: use it with effects.fidelity "
                                             "= 'elastic' or 'plastic' (the rigid fidelity has the scalar wear)")
-    if flat["target.lock_density"] <= flat["target.density"]:
+    if flat["effects.crater"] == "energy" and flat["target.lock_density"] <= flat["target.density"]:
         raise InputError("target.lock_density", f"{flat['target.lock_density']:g} kg/m^3: must exceed "
                                                 f"target.density = {flat['target.density']:g} kg/m^3")
     if "target.tensile_strength" not in flat:
@@ -479,19 +627,30 @@ def to_toml(scene: Section) -> str:
     """The resolved scene as TOML text (every key, SI units), for results directories."""
     lines: list[str] = []
 
+    def value(v) -> str:
+        if isinstance(v, bool):
+            return "true" if v else "false"
+        if isinstance(v, str):
+            return f'"{v}"'
+        if isinstance(v, list):
+            return "[" + ", ".join(value(x) for x in v) + "]"
+        return repr(v)
+
+    def tables(v) -> bool:
+        return isinstance(v, list) and bool(v) and all(isinstance(x, dict) for x in v)
+
     def emit(prefix: str, node: dict) -> None:
-        scalars = {k: v for k, v in node.items() if not isinstance(v, dict)}
+        scalars = {k: v for k, v in node.items() if not isinstance(v, dict) and not tables(v)}
         if scalars:
             lines.append(f"[{prefix}]")
-            for k, v in scalars.items():
-                if isinstance(v, bool):
-                    text = "true" if v else "false"
-                elif isinstance(v, str):
-                    text = f'"{v}"'
-                else:
-                    text = repr(v)
-                lines.append(f"{k} = {text}")
+            lines.extend(f"{k} = {value(v)}" for k, v in scalars.items())
             lines.append("")
+        for k, v in node.items():
+            if tables(v):  # an array of tables: [[prefix.k]]
+                for table in v:
+                    lines.append(f"[[{prefix}.{k}]]")
+                    lines.extend(f"{kk} = {value(vv)}" for kk, vv in table.items() if vv is not None)
+                    lines.append("")
         for k, v in node.items():
             if isinstance(v, dict):
                 emit(f"{prefix}.{k}" if prefix else k, v)

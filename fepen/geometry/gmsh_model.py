@@ -40,28 +40,52 @@ class MeshOptions:
     optimize: str = "netgen"
 
 
-def _profile_loop(occ, pts: list[tuple[float, float]], arc: tuple[int, float, float] | None = None) -> int:
-    """A closed plane loop through pts (x = radius, y = axial); edge 0 -> 1 is a circle arc if ``arc``.
+def _profile_loop(occ, pts: list[tuple[float, float]], curves: dict | None = None) -> int:
+    """A closed plane loop through pts (x = radius, y = axial); edge i -> i+1 is a straight line unless
+    ``curves`` maps i to a conic Segment (fepen.geometry.profile) from pts[i] to pts[i+1].
 
     Returns the gmsh surface tag."""
+    curves = curves or {}
     tags = [occ.addPoint(x, y, 0.0) for x, y in pts]
     lines = []
     for i in range(len(tags)):
         j = (i + 1) % len(tags)
-        if arc is not None and i == arc[0]:
-            centre = occ.addPoint(arc[1], arc[2], 0.0)
-            lines.append(occ.addCircleArc(tags[i], centre, tags[j]))
-        else:
+        seg = curves.get(i)
+        if seg is None:
             lines.append(occ.addLine(tags[i], tags[j]))
+            continue
+        cr, cz = seg.centre
+        centre = occ.addPoint(cr, cz, 0.0)
+        if seg.is_circle:
+            lines.append(occ.addCircleArc(tags[i], centre, tags[j]))
+        else:  # OpenCASCADE wants a point on the major axis
+            major = occ.addPoint(cr + seg.ar, cz, 0.0) if seg.ar >= seg.az else occ.addPoint(cr, cz + seg.az, 0.0)
+            lines.append(occ.addEllipseArc(tags[i], centre, major, tags[j]))
     return occ.addPlaneSurface([occ.addCurveLoop(lines)])
 
 
-def _dedupe(pts: list[tuple[float, float]]) -> list[tuple[float, float]]:
-    out = []
-    for p in pts:
-        if not out or abs(out[-1][0] - p[0]) + abs(out[-1][1] - p[1]) > 1e-12:
-            out.append(p)
-    return out
+def _loop(paths: list[list]) -> tuple[list[tuple[float, float]], dict]:
+    """The vertices and conic edges of a closed loop through meridian paths in order (each a Segment list,
+    joined end to start by straight lines; the last closes back to the first's start)."""
+    pts, curves = [], {}
+    for path in paths:
+        for seg in path:
+            p0 = (seg.p0[0], seg.p0[1])
+            if not pts or abs(pts[-1][0] - p0[0]) + abs(pts[-1][1] - p0[1]) > 1e-12:
+                pts.append(p0)
+            if seg.kind == "conic":
+                curves[len(pts) - 1] = seg
+            pts.append((seg.p1[0], seg.p1[1]))
+    if len(pts) > 1 and abs(pts[-1][0] - pts[0][0]) + abs(pts[-1][1] - pts[0][1]) <= 1e-12:
+        pts.pop()
+    return pts, curves
+
+
+def _reversed(path: list) -> list:
+    """A meridian path walked backwards (conic arcs with their angles swapped)."""
+    from dataclasses import replace as _r
+
+    return [_r(s, p0=s.p1, p1=s.p0, t0=s.t1, t1=s.t0) for s in reversed(path)]
 
 
 #: the mesher retries with new random seeds until the shortest altitude reaches this fraction of the
@@ -118,26 +142,15 @@ def _revolve(shape: Shape, charge: bool) -> None:
     import gmsh
 
     occ = gmsh.model.occ
-    a, L, ln = shape.radius, shape.length, shape.nose_length
-    cav = shape.cavity_sections()
     # Outer profile from the tip, counter-clockwise in the (r, z) half plane, then back down the axis
     # through the cavity (if any).
-    outer = [(0.0, 0.0)] + ([(a, ln)] if ln > 0 else [(a, 0.0)]) + [(a, L), (0.0, L)]
-    inner = []
-    if cav:
-        inner.append((0.0, cav[-1][1]))
-        for z0, z1, r in reversed(cav):
-            inner += [(r, z1), (r, z0)]
-        inner.append((0.0, cav[0][0]))
-    arc = (0, a - shape.ogive_radius, ln) if ln > 0 else None
-    shell_face = _profile_loop(occ, _dedupe(outer + inner), arc)
+    inner = shape.inner_path if shape.has_cavity else []
+    pts, curves = _loop([shape.outer_path, _reversed(inner)])
+    shell_face = _profile_loop(occ, pts, curves)
     faces = [(2, shell_face)]
-    if cav and charge:
-        fill = [(0.0, cav[0][0])]
-        for z0, z1, r in cav:
-            fill += [(r, z0), (r, z1)]
-        fill.append((0.0, cav[-1][1]))
-        faces.append((2, _profile_loop(occ, _dedupe(fill))))
+    if inner and charge:
+        fill, fill_curves = _loop([inner])
+        faces.append((2, _profile_loop(occ, fill, fill_curves)))
     occ.synchronize()
     vols = []
     for face in faces:
@@ -156,16 +169,18 @@ def _tag(shape: Shape, charge: bool) -> list[int]:
     inside the cavity's bounding cylinder; everything else is the shell and its outer surface."""
     import gmsh
 
-    cav = shape.cavity_sections()
+    inner = shape.inner_path if shape.has_cavity else []
     tol = 1e-5 * shape.length
+    if inner:
+        zlo = min(s.z_range()[0] for s in inner)
+        zhi = max(s.z_range()[1] for s in inner)
+        rmax = max(s.r_range()[1] for s in inner)
 
     def in_cavity(dim: int, tag: int) -> bool:
-        if not cav:
+        if not inner:
             return False
         xmin, ymin, zmin, xmax, ymax, zmax = gmsh.model.getBoundingBox(dim, tag)
-        rmax = max(r for _, _, r in cav)
-        return (ymin >= cav[0][0] - tol and ymax <= cav[-1][1] + tol
-                and max(-xmin, xmax, -zmin, zmax) <= rmax + tol)
+        return ymin >= zlo - tol and ymax <= zhi + tol and max(-xmin, xmax, -zmin, zmax) <= rmax + tol
 
     all_vols = [t for d, t in gmsh.model.getEntities(3)]
     charge_v = [t for t in all_vols if charge and in_cavity(3, t)]

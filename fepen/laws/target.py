@@ -96,6 +96,43 @@ def youngs_modulus_aci(fc_pa: float) -> float:
     return 4.7e9 * math.sqrt(fc_pa / 1e6)
 
 
+def metal_cavity_stress(E: float, Y: float, n: float) -> float:
+    """Quasi-static radial stress of a spherical cavity expanded in an incompressible elastic, power-law
+    strain-hardening metal (σ = E ε, then σ = Y (E ε / Y)^n) (Luk, Forrestal & Amos 1991; the σ_s of
+    Forrestal and Warren's metal-target equations; docs/theory.md §16):
+
+        σ_s / Y = (2/3) [1 + (2E/(3Y))^n ∫_0^(1 − 3Y/(2E)) (−ln x)^n / (1 − x) dx]
+
+    computed as (2/3)[1 + (2E/(3Y))^n |ln β| ∫_0^1 (−ln(1 − β^t))^n dt] with β = 3Y/(2E) (x = 1 − β^t). For
+    n = 0 it is Hill's (2Y/3)(1 + ln(2E/(3Y))).
+
+    Args:
+        E: Young's modulus (Pa). Y: yield stress (Pa). n: hardening exponent (0 <= n < 1).
+
+    Returns:
+        σ_s (Pa).
+    """
+    from scipy import integrate
+
+    beta = 1.5 * Y / E
+    if not 0.0 < beta < 1.0:
+        raise ValueError(f"3Y/(2E) = {beta:g} must be in (0, 1)")
+    lb = -math.log(beta)
+    if n == 0.0:
+        integral = lb
+    else:
+        val, _ = integrate.quad(lambda t: (-math.log1p(-beta**t)) ** n, 0.0, 1.0, limit=200, epsabs=0.0,
+                                epsrel=1e-12)
+        integral = lb * val
+    return Y * (2.0 / 3.0) * (1.0 + (1.0 / beta) ** n * integral)
+
+
+def metal_cavity_ratio(E: float, Y: float) -> float:
+    """c/a of the incompressible elastic–plastic spherical cavity, (2E/(3Y))^(1/3): the plastic zone the
+    free-surface rule cuts (docs/theory.md §16)."""
+    return (2.0 * E / (3.0 * Y)) ** (1.0 / 3.0)
+
+
 def ogive_nose_factor(crh: float) -> float:
     """N* = (8ψ − 1)/(24ψ²) of a tangent ogive (frictionless)."""
     return (8.0 * crh - 1.0) / (24.0 * crh * crh)
@@ -119,6 +156,10 @@ class TargetLaw:
             the velocity-dependent sliding law (sliding_friction).
         lock_density: Q1 of the energy crater (kg/m^3); crush_strain: ε of the energy crater.
         c_over_a: plastic-zone ratio of the cavity expansion.
+        top, bottom: depths of this material's own faces below y = 0 when it is one layer of a block of
+            touching layers (fepen.laws.layers): it loads only points between them, while the free faces of
+            the crater, the free-surface rule and the perforation stay those of the block (0, thickness).
+            bottom None: thickness.
     """
 
     density: float
@@ -144,6 +185,14 @@ class TargetLaw:
     c_over_a: float = 1.0
     given_sigma_s: bool = False
     onset: float = 0.0
+    top: float = 0.0
+    bottom: float | None = None
+
+    @property
+    def lower(self) -> float | None:
+        """Depth of the material's rear face below the face y = 0 (m): ``bottom`` (a layer inside a block of
+        touching layers), else ``thickness``; None: semi-infinite."""
+        return self.thickness if self.bottom is None else self.bottom
 
 
 @dataclass
@@ -169,11 +218,11 @@ class SurfaceState:
 
 
 def inside(law: TargetLaw, x: np.ndarray) -> np.ndarray:
-    """Points inside the target material: −thickness < y < 0."""
+    """Points inside the target material: −lower < y < −top."""
     y = x[:, 1]
-    mask = y < 0.0
-    if law.thickness is not None:
-        mask &= y > -law.thickness
+    mask = y < -law.top
+    if law.lower is not None:
+        mask &= y > -law.lower
     return mask
 
 
@@ -183,9 +232,9 @@ def immersion(law: TargetLaw, x: np.ndarray, area: np.ndarray) -> np.ndarray:
     the force grows continuously as the projectile enters instead of jumping point by point."""
     ell = np.sqrt(area)
     y = x[:, 1]
-    w = np.clip(0.5 - y / ell, 0.0, 1.0)
-    if law.thickness is not None:
-        w *= np.clip(0.5 + (y + law.thickness) / ell, 0.0, 1.0)
+    w = np.clip(0.5 - (y + law.top) / ell, 0.0, 1.0)
+    if law.lower is not None:
+        w *= np.clip(0.5 + (y + law.lower) / ell, 0.0, 1.0)
     return w
 
 
@@ -344,8 +393,11 @@ def load_on_points(law: TargetLaw, x, v, n, area, radius, R_meridian, sin_phi0, 
     Returns:
         The PointLoad.
     """
-    kernel = _point_kernel()
-    f, sums = (kernel or point_forces)(law, x, v, n, area, radius, R_meridian, sin_phi0, axis)
+    kernel = _point_kernel() or point_forces
+    if getattr(law, "layered", False):  # a fepen.laws.layers.Layered target: layer by layer
+        f, sums = law.point_forces(kernel, x, v, n, area, radius, R_meridian, sin_phi0, axis)
+    else:
+        f, sums = kernel(law, x, v, n, area, radius, R_meridian, sin_phi0, axis)
     if reduce is not None:
         sums = reduce(sums)
     total = sums[:3]
@@ -395,7 +447,8 @@ def _law_numbers(law: TargetLaw) -> np.ndarray:
                      {"none": 0.0, "linear": 1.0, "energy": 2.0}[law.crater], law.k, law.D, float(law.separation),
                      law.phi_min, float(law.free_surface), float(law.friction), law.mu,
                      law.mu if law.mu_dynamic is None else law.mu_dynamic, law.mu_decay, law.lock_density,
-                     law.crush_strain, law.c_over_a, float(law.given_sigma_s), law.onset])
+                     law.crush_strain, law.c_over_a, float(law.given_sigma_s), law.onset, law.top,
+                     -1.0 if law.lower is None else law.lower])
 
 
 def _bind(lib):
@@ -433,17 +486,20 @@ class ForrestalCrater:
 
     Args:
         law: the target law. mass: projectile mass (kg). v0: striking speed (m/s). crh: nose CRH.
+        nose_factor: N* of the nose (fepen.geometry.shape.Shape.nose_factor); None: the tangent ogive's.
     """
 
     law: TargetLaw
     mass: float
     v0: float
     crh: float
+    nose_factor: float | None = None
 
     def __post_init__(self):
         a = 0.5 * self.law.D
         kd = self.law.k * self.law.D
-        N = ogive_nose_factor(self.crh) if self.crh > 0 else 1.0
+        N = self.N = self.nose_factor if self.nose_factor is not None else (
+            ogive_nose_factor(self.crh) if self.crh > 0 else 1.0)
         area = math.pi * a * a
         self.v1_sq = max((self.mass * self.v0**2 - area * kd * self.law.sigma_s)
                          / (self.mass + N * self.law.density * area * kd), 0.0)
@@ -459,6 +515,6 @@ class ForrestalCrater:
     def depth(self) -> float:
         """Forrestal's two-stage final depth (m): k D + M/(2π a² ρ0 N*) ln(1 + N* ρ0 V1²/σ_s)."""
         a = 0.5 * self.law.D
-        N = ogive_nose_factor(self.crh)
+        N = self.N
         return self.kd + self.mass / (2 * math.pi * a * a * self.law.density * N) * math.log(
             1 + N * self.law.density * self.v1_sq / self.law.sigma_s)

@@ -8,7 +8,8 @@
 /* p[]: the TargetLaw as numbers, in this order */
 enum { P_DENSITY, P_Y, P_E, P_T, P_LAM, P_SIGMA_S, P_B, P_THICKNESS /* < 0: none */, P_CRATER /* 2: energy */,
        P_K, P_D, P_SEPARATION, P_PHI_MIN, P_FREE_SURFACE, P_FRICTION, P_MU, P_MU_DYNAMIC, P_MU_DECAY,
-       P_LOCK_DENSITY, P_CRUSH_STRAIN, P_C_OVER_A, P_GIVEN_SIGMA_S, P_ONSET, P_COUNT };
+       P_LOCK_DENSITY, P_CRUSH_STRAIN, P_C_OVER_A, P_GIVEN_SIGMA_S, P_ONSET,
+       P_TOP /* the material's own faces in a block of layers */, P_LOWER /* < 0: none */, P_COUNT };
 
 #define SIN_TOL 1e-9
 
@@ -35,8 +36,8 @@ int32_t point_forces(int32_t k, const double *x, const double *v, const double *
         fi[0] = fi[1] = fi[2] = 0.0;
         sig[i] = 0.0;
         double ell = sqrt(area[i]), y = xi[1];
-        double frac = clip01(0.5 - y / ell);
-        if (thk >= 0.0) frac *= clip01(0.5 + (y + thk) / ell);
+        double frac = clip01(0.5 - (y + p[P_TOP]) / ell);
+        if (p[P_LOWER] >= 0.0) frac *= clip01(0.5 + (y + p[P_LOWER]) / ell);
         if (!(frac > 0.0)) continue;
         double vn = vi[0] * ni[0] + vi[1] * ni[1] + vi[2] * ni[2];
         double speed = sqrt(vi[0] * vi[0] + vi[1] * vi[1] + vi[2] * vi[2]);

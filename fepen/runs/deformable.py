@@ -17,8 +17,9 @@ from fepen.experiments import shot
 from fepen.geometry.frames import unit_axis
 from fepen.io import files, results
 from fepen.io.fields import FieldWriter
+from fepen.laws import layers as fl
 from fepen.post import analyses, paraview, signals, slices
-from fepen.runs import checkpoint, events, model, outputs
+from fepen.runs import checkpoint, events, model, outputs, rigid
 from fepen.solver import explicit
 
 #: steps between two checks of the stop rules in the target (each costs a few reductions)
@@ -54,6 +55,7 @@ class DeformableRun:
         self.rows: list[list[float]] = []
         self.end = scene.get("run.end_time")
         self.rules = events.StopRules(m.law.thickness if m.law is not None else None, self.end is None)
+        self.crossings = fl.Crossings(m.law.faces()) if getattr(m.law, "layered", False) else None
         self.peaks: dict | None = None
         self.charge: dict | None = None
         self.profile: dict | None = None
@@ -75,7 +77,11 @@ class DeformableRun:
 
     @property
     def hard_end(self) -> float:
-        return self.end if self.end is not None else MAX_TIME
+        if self.end is not None:
+            return self.end
+        if self.crossings is not None:  # long enough to reach the last layer
+            return max(MAX_TIME, rigid.LAYERED_TIME * self.model.law.faces()[-1][0] / self.model.v0)
+        return MAX_TIME
 
     # ------------------------------------------------------------------------------------------------
     def run(self) -> dict:
@@ -126,6 +132,9 @@ class DeformableRun:
         pts = m.surface.kinematics(x, s.Vel)[0]
         y_min = self.comm.allreduce(float(pts[:, 1].min()) if len(pts) else np.inf, op=MPI.MIN)
         y_max = self.comm.allreduce(float(pts[:, 1].max()) if len(pts) else -np.inf, op=MPI.MAX)
+        if self.crossings is not None:
+            self.crossings.update(s.t, -float(s.node_value(m.tip, x)[1]), -y_max,
+                                  float(np.linalg.norm(s.momentum_velocity())))
         if not (self.rules.entered or y_min < 0.0):
             return None  # not in the target yet
         axis = unit_axis(s.node_value(m.tip, x), s.node_value(m.tail, x))
@@ -278,6 +287,8 @@ class DeformableRun:
         extra.update(self.removal_summary())
         extra["nose_profile"] = self.profile
         summary = results.summary(self.scene, self.rows, outcome, extra)
+        if self.crossings is not None:
+            summary.update(self.crossings.summary(self.model.law, 1e-3 * summary["depth_mm"]))
         files.write_json(self.out / "summary.json", summary, self.comm)
         return summary
 
@@ -291,7 +302,8 @@ class DeformableRun:
         heat = self.comm.allreduce(m.recession.heat_total, op=MPI.SUM) if m.recession is not None else 0.0
         return {"mass_loss_kg": lost, "mass_loss_percent": 100.0 * lost / s.initial_mass,
                 "remaining_mass_kg": s.total_mass, "length_change_mm": length - self.pm.shape.length * 1e3,
-                "eroded_cells": m.erosion.count if m.erosion is not None else 0, "wear_heat_J": heat,
+                "eroded_cells": m.erosion.count if m.erosion is not None else 0,
+                "crossings": self.crossings.state() if self.crossings is not None else None, "wear_heat_J": heat,
                 "removed_kinetic_J": e.removed_kinetic, "removed_elastic_J": e.removed_internal}
 
     # ------------------------------------------------------------------------------------------------
@@ -318,6 +330,7 @@ class DeformableRun:
                 "next_out": self.fields_out.clock.next if self.fields_out is not None else 0.0,
                 "next_ckpt": self.checkpoints.clock.next, **self.rules.state(),
                 "eroded_cells": m.erosion.count if m.erosion is not None else 0,
+                "crossings": self.crossings.state() if self.crossings is not None else None,
                 "tip": self._tip_reference()}
         meta = {"wall_s": self.wall_before + time.perf_counter() - self.wall_t0, "loop": loop,
                 "field_times_s": list(self.fields.times) if self.fields is not None else []}
@@ -352,6 +365,8 @@ class DeformableRun:
             self.fields_out.clock.next = loop["next_out"]
         self.checkpoints.clock.next = loop["next_ckpt"]
         self.rules.restore(loop)
+        if self.crossings is not None and loop.get("crossings"):
+            self.crossings.restore(loop["crossings"])
         if m.erosion is not None:
             m.erosion.count = int(loop.get("eroded_cells", 0))
         if "tip" in loop:

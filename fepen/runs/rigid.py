@@ -16,6 +16,7 @@ from mpi4py import MPI
 from fepen.geometry import mesh as fmesh
 from fepen.geometry import revolution, tags
 from fepen.io import files, results
+from fepen.laws import layers as fl
 from fepen.laws import target as tg
 from fepen.laws import wear
 from fepen.laws.rigid_body import (
@@ -34,6 +35,9 @@ STEP_FRACTION = 0.2
 STOP_STEPS = 150
 #: load points per ring of the default (mesh-free) rigid body
 RING_SECTORS = 12
+#: a layered target's run without run.end_time lasts at least this many times the time to reach its last
+#: face at the striking speed
+LAYERED_TIME = 20.0
 
 
 def mesh_points(scene, comm) -> tuple[dict, tuple, int]:
@@ -122,6 +126,7 @@ class RigidRun:
         self.loaded = 0
         self.area = 0.0
         self.wear = Wear(scene) if scene.effects.wear else None
+        self.crossings = fl.Crossings(self.law.faces()) if getattr(self.law, "layered", False) else None
 
     # ------------------------------------------------------------------------------------------------
     def force_fn(self, s: RigidState, x, v, n):
@@ -164,6 +169,11 @@ class RigidRun:
         self.rules = events.StopRules(self.law.thickness, end is None)
         outcome = None
         t_loop = time.perf_counter()
+        if self.crossings is not None:
+            hard_end = end if end is not None else max(hard_end, LAYERED_TIME * self.law.faces()[-1][0] / self.v0)
+            y0 = body.points(s)[0][:, 1]
+            self.crossings.update(0.0, -body.to_world(s, self.tip_ref[None])[0][1], -float(y0.max()),
+                                  float(np.linalg.norm(s.V)))
         _, F, M = body.derivative(s, self.force_fn)
         self.record(s, F)
         while self.t < hard_end:
@@ -175,6 +185,9 @@ class RigidRun:
             self.t += self.dt
             self.steps += 1
             y = body.points(s)[0][:, 1]
+            if self.crossings is not None:
+                tip_y = body.to_world(s, self.tip_ref[None])[0][1]
+                self.crossings.update(self.t, -tip_y, -float(y.max()), float(np.linalg.norm(s.V)))
             outcome = self.rules.penetration(float(y.min()), float(y.max()), s.V, self.axis(s), self.mass, self.ke0)
             if outcome == "embedded" and float(s.V @ self.axis(s)) <= 0.0:
                 # stopped advancing: interpolate to where the speed along the axis vanishes
@@ -200,6 +213,8 @@ class RigidRun:
         if self.wear is not None:
             extra.update(self.wear.summary(self.mass, body.mass))
         summary = results.summary(self.scene, self.rows, outcome or "ended", extra)
+        if self.crossings is not None:
+            summary.update(self.crossings.summary(self.law, 1e-3 * summary["depth_mm"]))
         if self.out is not None:
             results.write_history(self.rows, self.out, self.comm, results.HISTORY_COLUMNS
                                   + (results.WEAR_COLUMNS if self.wear is not None else []))

@@ -15,7 +15,10 @@ from fepen.errors import InputError
 from fepen.geometry import gmsh_model, tags, tetra
 from fepen.geometry import mesh as fmesh
 from fepen.geometry.shape import Built, Shape, reach_mass
+from fepen.laws import layers as fl
 from fepen.laws import target as tg
+from fepen.scene import SCHEMA
+from fepen.targets import CONSTANTS, TARGETS
 
 
 # ---------------------------------------------------------------------------------------------------------
@@ -42,33 +45,63 @@ def charge_material(scene):
     return M.bilinear(c.youngs_modulus, c.poisson_ratio, c.density, c.yield_stress, c.tangent_modulus)
 
 
-def target_law(scene) -> tg.TargetLaw:
-    """The concrete target law (docs/theory.md §8)."""
+def target_law(scene):
+    """The target's law (docs/theory.md §8, §16, §17): a TargetLaw of target.material, or a Layered target of
+    target.layers."""
+    layers = scene.get("target.layers")
+    if layers:
+        return fl.build(layers, lambda c: material_law(scene, c, c.get("thickness")))
+    c = {k: scene.get(f"target.{k}") for k in CONSTANTS}
+    c["crater"] = scene.effects.crater
+    c["family"] = TARGETS[scene.target.material]["family"]
+    return material_law(scene, c, scene.get("target.thickness"))
+
+
+def material_law(scene, c: dict, thickness: float | None) -> tg.TargetLaw:
+    """The TargetLaw of one target material's constants ``c`` (target.* names without the prefix, absent ones
+    None or missing, plus "crater" and "family"), with the scene's effects, friction and separation.
+
+    Families (fepen/data/targets.toml): concrete, rock and soil by the Mohr–Coulomb cavity expansion (σ_s by
+    target.strength_model), metal by Forrestal–Warren's power-law cavity expansion (fepen.laws.target.
+    metal_cavity_stress)."""
     t, e = scene.target, scene.effects
-    Y, T, lam = t.compressive_strength, t.tensile_strength, t.pressure_hardening
-    E = scene.get("target.youngs_modulus") or tg.youngs_modulus_aci(Y)
-    given = scene.get("target.quasi_static_stress")
-    if given is not None:
-        sigma_s = given
-    elif t.strength_model in tg.S_MODELS:
-        a, b, size = tg.S_MODELS[t.strength_model]
-        if t.strength_model == "scaled-S" and e.friction:  # refitted with friction on (theory.md §8.1)
-            a, b, size = tg.SCALED_S_FRICTION
-        a = scene.get("target.S_coefficient") or a
-        b = scene.get("target.S_exponent") if scene.get("target.S_exponent") is not None else b
-        size = scene.get("target.S_size") or size
-        sigma_s = tg.strength_S(Y, scene.projectile.diameter, a, b, size) * Y
+    get = c.get
+    B = get("inertial_factor") if get("inertial_factor") is not None else SCHEMA["target.inertial_factor"].default
+    lock = get("lock_density") or SCHEMA["target.lock_density"].default
+    k = get("crater_depth_factor") if get("crater_depth_factor") is not None else SCHEMA[
+        "target.crater_depth_factor"].default
+    given = get("quasi_static_stress")
+    model = get("strength_model")
+    if c.get("family") == "metal":
+        Y, E, n = get("yield_stress"), get("youngs_modulus"), get("hardening_exponent")
+        sigma_s = given if given is not None else tg.metal_cavity_stress(E, Y, n)
+        T, lam, ca, crush, density = Y, 0.0, tg.metal_cavity_ratio(E, Y), 0.0, get("density")
+        given_flag = True
     else:
-        sigma_s = float(tg.quasi_static_stress(Y, E, T, lam))
+        Y, T, lam = get("compressive_strength"), get("tensile_strength"), get("pressure_hardening")
+        E = get("youngs_modulus") or tg.youngs_modulus_aci(Y)
+        density = get("density")
+        if given is not None:
+            sigma_s = given
+        elif model in tg.S_MODELS:
+            a, b, size = tg.S_MODELS[model]
+            if model == "scaled-S" and e.friction:  # refitted with friction on (theory.md §8.1)
+                a, b, size = tg.SCALED_S_FRICTION
+            a = get("S_coefficient") or a
+            b = get("S_exponent") if get("S_exponent") is not None else b
+            size = get("S_size") or size
+            sigma_s = tg.strength_S(Y, scene.projectile.diameter, a, b, size) * Y
+        else:
+            sigma_s = float(tg.quasi_static_stress(Y, E, T, lam))
+        ca, crush = tg.cavity_ratio(Y, E, T), 1.0 - density / lock
+        given_flag = given is not None or model != "cavity-expansion"
     return tg.TargetLaw(
-        density=t.density, Y=Y, E=E, T=T, lam=lam, sigma_s=sigma_s, B=t.inertial_factor,
-        thickness=scene.get("target.thickness"), crater=e.crater, k=t.crater_depth_factor,
+        density=density, Y=Y, E=E, T=T, lam=lam, sigma_s=sigma_s, B=B,
+        thickness=thickness, crater=get("crater"), k=k,
         D=scene.projectile.diameter, separation=e.separation, phi_min=math.radians(t.separation_angle_deg),
         free_surface=e.free_surface, friction=e.friction, mu=t.friction,
         mu_dynamic=scene.get("target.friction_dynamic"), mu_decay=t.friction_decay,
-        lock_density=t.lock_density, crush_strain=1.0 - t.density / t.lock_density,
-        c_over_a=tg.cavity_ratio(Y, E, T),
-        given_sigma_s=given is not None or t.strength_model != "cavity-expansion",
+        lock_density=lock, crush_strain=crush, c_over_a=ca, given_sigma_s=given_flag,
         onset=math.radians(t.onset_angle_deg))
 
 
@@ -156,7 +189,11 @@ def check_supported(scene) -> None:
 
 def crater(scene, law: tg.TargetLaw, mass: float, v0: float) -> tg.ForrestalCrater | None:
     """Forrestal's linear crater when effects.crater = "linear", else None (the energy crater is in the law)."""
-    return tg.ForrestalCrater(law, mass, v0, scene.projectile.crh) if law.crater == "linear" else None
+    if law.crater != "linear":
+        return None
+    shape = projectile(scene).shape
+    return tg.ForrestalCrater(law, mass, v0, scene.projectile.crh,
+                              None if shape.nose == "ogive" and not shape.meplat_diameter else shape.nose_factor())
 
 
 # ---------------------------------------------------------------------------------------------------------

@@ -59,7 +59,8 @@ def area_vectors(x: np.ndarray, tri: np.ndarray) -> np.ndarray:
 
 
 def _patch_areas(shape, p: np.ndarray, patch: np.ndarray, m: int = SUBDIVISION) -> np.ndarray:
-    """Areas of the exact-surface patches spanned by flat triangles p (f, 3, 3)."""
+    """Areas of the exact-surface patches spanned by flat triangles p (f, 3, 3) on their meridian segments
+    ``patch`` (f,)."""
     pts, tris = [], []
     index = {}
     for i in range(m + 1):
@@ -216,12 +217,9 @@ def outer_surface(V, facet_tags, shape, tag: int = tags.OUTER) -> Surface:
     flat = np.linalg.norm(av, axis=1)
     nflat = av / np.maximum(flat, 1e-300)[:, None]
     centroid = X[tri].mean(axis=1)
-    tol = 1e-6 * shape.length
-    patch = np.zeros(len(tri), dtype=np.int64)
-    patch[(nflat[:, 1] > 0.99) & (np.abs(centroid[:, 1] - shape.length) < tol)] = 1
-    patch[(nflat[:, 1] < -0.99) & (np.abs(centroid[:, 1]) < tol) & (shape.nose_length == 0.0)] = 2
+    patch = shape.classify(X[tri], nflat) if len(tri) else np.zeros(0, dtype=np.int64)  # meridian segments
     P = shape.project(centroid, patch)
-    N, radius, Rm, sphi = shape.surface_info(P)
+    N, radius, Rm, sphi = shape.surface_info(P, patch)
     bad = np.isnan(N[:, 0])  # should not happen for centroids; fall back to the flat normal
     N[bad] = nflat[bad]
     area = _patch_areas(shape, X[tri], patch) if len(tri) else np.zeros(0)
