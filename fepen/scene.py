@@ -580,8 +580,53 @@ def _resolve_target(flat: dict, given: dict) -> None:
     flat["effects.crater"] = constants["crater"]
 
 
+def _check_geometry_keys(flat: dict, given: dict) -> None:
+    """Which projectile keys go together (nose families, drawn profiles, cavity forms)."""
+    nose = flat["projectile.nose"]
+    if "projectile.profile" in flat:
+        if "projectile.nose" in given and nose != "profile":
+            raise InputError("projectile.profile", f"draws the whole outside: drop projectile.nose = {nose!r} (or "
+                                                   "set it to 'profile')")
+        flat["projectile.nose"] = nose = "profile"
+        for key in ("projectile.diameter", "projectile.length", "projectile.crh", "projectile.nose_length",
+                    "projectile.meplat_diameter", "projectile.boattail_length", "projectile.boattail_diameter"):
+            if key in given:
+                raise InputError(key, "is set by projectile.profile: drop it")
+        if "projectile.mass" not in given and not any(k in given for k in (
+                "projectile.cavity_diameter", "projectile.cavity_sections", "projectile.inner_profile")):
+            flat["projectile.cavity_diameter"] = 0.0  # the paper's cavity belongs to the paper's body
+    elif nose == "profile":
+        raise InputError("projectile.nose", "'profile' needs projectile.profile, the CSV of the outside")
+    if nose in ("secant", "cone", "ellipsoid") and "projectile.nose_length" not in flat:
+        raise InputError("projectile.nose_length", f"a {nose} nose needs its axial length (m)")
+    if "projectile.nose_length" in given and nose not in ("secant", "cone", "ellipsoid"):
+        raise InputError("projectile.nose_length", f"is for a secant, cone or ellipsoid nose, not {nose!r} (a "
+                                                   "tangent ogive's length follows from projectile.crh)")
+    if flat["projectile.meplat_diameter"] > 0.0 and nose in ("flat", "profile"):
+        raise InputError("projectile.meplat_diameter", f"a {nose!r} nose has no tip to blunt: drop it")
+    if flat["projectile.boattail_length"] > 0.0 and "projectile.boattail_diameter" not in flat:
+        raise InputError("projectile.boattail_diameter", "a boat-tail (projectile.boattail_length > 0) needs its "
+                                                         "rear diameter (m)")
+    if "projectile.boattail_diameter" in given and flat["projectile.boattail_length"] == 0.0:
+        raise InputError("projectile.boattail_length", "must be > 0 with projectile.boattail_diameter")
+    if "projectile.cavity_sections" in flat:
+        for key in ("projectile.cavity_diameter", "projectile.cavity_length", "projectile.cavity_step_diameter",
+                    "projectile.cavity_step_length", "projectile.inner_profile"):
+            if key in given:
+                raise InputError(key, "give the cavity as projectile.cavity_sections or with this key, not both")
+    if "projectile.inner_profile" in flat:
+        for key in ("projectile.mass", "projectile.cavity_diameter", "projectile.cavity_length",
+                    "projectile.cavity_step_diameter", "projectile.cavity_step_length"):
+            if key in given:
+                raise InputError(key, "a drawn cavity (projectile.inner_profile) fixes the mass and the cavity: "
+                                      "drop it")
+        flat.pop("projectile.mass", None)
+        flat.pop("projectile.cavity_length", None)
+
+
 def _check_consistency(flat: dict, given: dict) -> None:
     """Checks that involve several keys. Geometry is checked in full by fepen.geometry.gmsh_model."""
+    _check_geometry_keys(flat, given)
     if "projectile.cavity_length" in given:
         if "projectile.mass" in given:
             raise InputError("projectile.mass", "give projectile.mass or projectile.cavity_length, not both")

@@ -134,7 +134,9 @@ def build(shape: Shape, opts: MeshOptions, charge: bool, seed: int = 1) -> None:
     # Make sure the tracked points are mesh nodes.
     _embed_axis_point(0.0, outer_s)
     _embed_axis_point(shape.length, outer_s)
-    _size_and_mesh(opts, shape.nose_length, seed)
+    # Frontal-Delaunay (6) overlaps facets at the apex of a cone; Delaunay (5) meshes it
+    apex = any(g.kind == "line" and g.p0[1] != g.p1[1] and 0.0 in (g.p0[0], g.p1[0]) for g in shape.outer_path)
+    _size_and_mesh(opts, shape.nose_length, seed, 5 if apex else 6)
 
 
 def _revolve(shape: Shape, charge: bool) -> None:
@@ -198,7 +200,7 @@ def _tag(shape: Shape, charge: bool) -> list[int]:
     return outer_s
 
 
-def _size_and_mesh(opts: MeshOptions, nose_length: float, seed: int) -> None:
+def _size_and_mesh(opts: MeshOptions, nose_length: float, seed: int, algorithm: int = 6) -> None:
     """Element sizes (graded from the nose tip when opts.nose_size is smaller), mesh, optimise."""
     import gmsh
 
@@ -207,7 +209,7 @@ def _size_and_mesh(opts: MeshOptions, nose_length: float, seed: int) -> None:
     gmsh.option.setNumber("Mesh.MeshSizeMin", 0.2 * min(h, opts.nose_size or h))
     gmsh.option.setNumber("Mesh.MeshSizeExtendFromBoundary", 1)
     gmsh.option.setNumber("Mesh.MeshSizeFromPoints", 0)
-    gmsh.option.setNumber("Mesh.Algorithm", 6)
+    gmsh.option.setNumber("Mesh.Algorithm", algorithm)
     gmsh.option.setNumber("Mesh.Algorithm3D", 1)
     gmsh.option.setNumber("Mesh.RandomSeed", seed)
     gmsh.option.setNumber("Mesh.OptimizeThreshold", 0.5)

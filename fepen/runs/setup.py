@@ -12,7 +12,7 @@ import numpy as np
 from mpi4py import MPI
 
 from fepen.errors import InputError
-from fepen.geometry import gmsh_model, tags, tetra
+from fepen.geometry import gmsh_model, profile, tags, tetra
 from fepen.geometry import mesh as fmesh
 from fepen.geometry.shape import Built, Shape, reach_mass
 from fepen.laws import layers as fl
@@ -107,10 +107,20 @@ def material_law(scene, c: dict, thickness: float | None) -> tg.TargetLaw:
 
 #: cavity keys that, when the user gives any of them, fix the cavity (its length is still sized to the mass)
 CAVITY_KEYS = ("projectile.cavity_diameter", "projectile.cavity_length", "projectile.cavity_step_diameter",
-               "projectile.cavity_step_length")
+               "projectile.cavity_step_length", "projectile.cavity_sections")
 
 
 def projectile(scene) -> Built:
+    """See _projectile; a cavity given as projectile.cavity_sections is named so in errors."""
+    try:
+        return _projectile(scene)
+    except InputError as err:
+        if scene.get("projectile.cavity_sections") and err.key in CAVITY_KEYS:
+            raise InputError("projectile.cavity_sections", err.message) from None
+        raise
+
+
+def _projectile(scene) -> Built:
     """The checked exact projectile built to projectile.mass by the mass-reaching rule
     (fepen.geometry.shape.reach_mass): the given cavity sized, else reduced or dropped, with one line in
     Built.note saying what was chosen. A cavity the user gave explicitly is only sized (InputError if the
@@ -119,19 +129,40 @@ def projectile(scene) -> Built:
     solid = p.cavity_diameter == 0.0
     explicit = any(k in scene.explicit for k in CAVITY_KEYS)
     mass = scene.get("projectile.mass")
+    sections = scene.get("projectile.cavity_sections")
+    inner = scene.get("projectile.inner_profile")
+    outer = scene.get("projectile.profile")
+    table, cav_d, step_d, step_l = (), p.cavity_diameter, p.cavity_step_diameter, p.cavity_step_length
+    cav_l = scene.get("projectile.cavity_length") or 0.0
+    if sections:  # front ones fixed, the rear one sized (or the sum when no mass is asked for)
+        table = tuple((l, d) for l, d in sections[:-1])
+        cav_d, step_d, step_l, solid, explicit = sections[-1][1], 0.0, 0.0, False, True
+        cav_l = sum(l for l, _ in sections) if mass is None else 0.0
+    geometry = dict(nose=p.nose, crh=p.crh, base_thickness=p.base_thickness,
+                    nose_length_given=scene.get("projectile.nose_length") or 0.0,
+                    meplat_diameter=p.meplat_diameter, boattail_length=p.boattail_length,
+                    boattail_diameter=scene.get("projectile.boattail_diameter") or 0.0)
+    D, L = p.diameter, p.length
+    if outer:
+        pts = tuple(profile.read_points(outer, "projectile.profile"))
+        geometry["outer_points"] = pts
+        D, L = 2.0 * max(r for _, r, _ in pts), max(z for z, _, _ in pts) - min(z for z, _, _ in pts)
+    if inner:
+        geometry["inner_points"] = tuple(profile.read_points(inner, "projectile.inner_profile"))
+        solid, cav_d = False, 0.0
     shape = Shape(
-        diameter=p.diameter, length=p.length, nose=p.nose, crh=p.crh,
-        cavity_diameter=p.cavity_diameter,
-        cavity_length=0.0 if solid else (scene.get("projectile.cavity_length") or 0.0),
-        step_diameter=0.0 if solid else p.cavity_step_diameter,
-        step_length=0.0 if solid else p.cavity_step_length,
-        base_thickness=p.base_thickness,
+        diameter=D, length=L,
+        cavity_diameter=0.0 if solid else cav_d,
+        cavity_length=0.0 if solid else cav_l,
+        step_diameter=0.0 if solid else step_d,
+        step_length=0.0 if solid else step_l,
+        cavity_table=() if solid else table, **geometry,
     )
-    if mass is None or explicit:
+    if mass is None or explicit or inner:
         shape.check()
     else:  # the outside only: a default cavity that does not fit is left to the mass rule
-        replace(shape, cavity_diameter=0.0).check()
-    if mass is None or (solid and explicit):
+        replace(shape, cavity_diameter=0.0, cavity_table=()).check()
+    if mass is None or (solid and explicit) or inner:
         return Built(shape, p.material.density)
     rho_c = scene.charge.material.density if scene.effects.charge else None
     return reach_mass(shape, mass, p.material.density, rho_c, adapt=not explicit and not scene.effects.charge)

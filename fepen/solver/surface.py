@@ -81,6 +81,31 @@ def _patch_areas(shape, p: np.ndarray, patch: np.ndarray, m: int = SUBDIVISION) 
     return 0.5 * np.linalg.norm(np.cross(qp[:, t[:, 1]] - a, qp[:, t[:, 2]] - a), axis=2).sum(axis=1)
 
 
+def _rim_segments(shape, p: np.ndarray, patch: np.ndarray) -> np.ndarray:
+    """The circular segments between a flat face's rim and the chords of its facets that span it (f,): the
+    part of the exact disk (or annulus) the polygon leaves out, added at an outer rim and taken away at an
+    inner one (a flat face's patches are otherwise only its flat triangles)."""
+    out = np.zeros(len(p))
+    r = np.hypot(p[..., 0], p[..., 2])
+    tol = 1e-6 * shape.length
+    for i, seg in enumerate(shape.outer_path):
+        if not (seg.kind == "line" and seg.p0[1] == seg.p1[1]):
+            continue
+        on = np.flatnonzero(patch == i)
+        lo, hi = sorted((seg.p0[0], seg.p1[0]))
+        for R, sign in ((hi, 1.0), (lo, -1.0)):
+            if R <= tol:
+                continue
+            for a, b in ((0, 1), (1, 2), (2, 0)):
+                rim = (np.abs(r[on, a] - R) < tol) & (np.abs(r[on, b] - R) < tol)
+                if not np.any(rim):
+                    continue
+                c = np.linalg.norm(p[on[rim], a] - p[on[rim], b], axis=1)
+                theta = 2.0 * np.arcsin(np.minimum(c / (2.0 * R), 1.0))
+                out[on[rim]] += sign * 0.5 * R * R * (theta - np.sin(theta))
+    return out
+
+
 @dataclass
 class Surface:
     """Facet load points of the outer surface owned by this rank.
@@ -223,6 +248,8 @@ def outer_surface(V, facet_tags, shape, tag: int = tags.OUTER) -> Surface:
     bad = np.isnan(N[:, 0])  # should not happen for centroids; fall back to the flat normal
     N[bad] = nflat[bad]
     area = _patch_areas(shape, X[tri], patch) if len(tri) else np.zeros(0)
+    if len(tri):
+        area += _rim_segments(shape, X[tri], patch)
     return Surface(tri, P, area, flat, N, nflat, radius, Rm, sphi, cells)
 
 
