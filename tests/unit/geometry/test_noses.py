@@ -40,7 +40,8 @@ def families():
                      lambda z: cr + math.sqrt(s * s - (z - cz) ** 2) if z < ls else a, ls)
     lc = 0.03
     out["cone"] = (Shape(D, L, "cone", nose_length_given=lc), lambda z: a * z / lc if z < lc else a, lc)
-    out["hemisphere"] = (Shape(D, L, "hemisphere"), lambda z: math.sqrt(max(a * a - (a - z) ** 2, 0)) if z < a else a, a)
+    out["hemisphere"] = (Shape(D, L, "hemisphere"),
+                         lambda z: math.sqrt(max(a * a - (a - z) ** 2, 0)) if z < a else a, a)
     le = 0.03
     out["ellipsoid"] = (Shape(D, L, "ellipsoid", nose_length_given=le),
                         lambda z: a * math.sqrt(max(1 - ((le - z) / le) ** 2, 0)) if z < le else a, le)
