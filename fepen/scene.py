@@ -580,8 +580,24 @@ def _resolve_target(flat: dict, given: dict) -> None:
     flat["effects.crater"] = constants["crater"]
 
 
+CAD_EXCLUDES = ("projectile.nose", "projectile.diameter", "projectile.length", "projectile.crh", "projectile.mass",
+                "projectile.nose_length", "projectile.meplat_diameter", "projectile.boattail_length",
+                "projectile.boattail_diameter", "projectile.profile", "projectile.inner_profile",
+                "projectile.cavity_sections", "projectile.cavity_diameter", "projectile.cavity_length",
+                "projectile.cavity_step_diameter", "projectile.cavity_step_length", "projectile.base_thickness")
+
+
 def _check_geometry_keys(flat: dict, given: dict) -> None:
-    """Which projectile keys go together (nose families, drawn profiles, cavity forms)."""
+    """Which projectile keys go together (nose families, drawn profiles, cavity forms, CAD)."""
+    if "projectile.cad" in flat:
+        for key in CAD_EXCLUDES:
+            if key in given:
+                raise InputError(key, "the body is read from projectile.cad (its shape, and its mass from its mesh "
+                                      "and projectile.material.density): drop this key")
+        if flat["effects.charge"]:
+            raise InputError("effects.charge", "a CAD body has no charge: it is meshed as one steel solid")
+        flat["projectile.cavity_diameter"] = 0.0
+        return
     nose = flat["projectile.nose"]
     if "projectile.profile" in flat:
         if "projectile.nose" in given and nose != "profile":

@@ -128,6 +128,12 @@ def build(shape: Shape, opts: MeshOptions, charge: bool, seed: int = 1) -> None:
     """
     import gmsh
 
+    if shape.is_cad:
+        from fepen.geometry import cad
+
+        cad.build(shape.cad_file, shape.cad_scale)
+        _size_and_mesh(opts, 0.0, seed)
+        return
     gmsh.model.add("projectile")
     _revolve(shape, charge)
     outer_s = _tag(shape, charge)

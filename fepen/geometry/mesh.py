@@ -117,6 +117,11 @@ def _mesh_on_root(shape: Shape, opts, charge: bool, mass, rho_s, rho_c, use_cach
         step = error / ((rho_s - (rho_c or 0.0)) * math.pi * r * r)
         current = replace(current, cavity_length=current.cavity_length + step)
         current.check()
+    if current.is_cad:  # the tracked ends: mesh nodes
+        from fepen.geometry import cad
+
+        tip, tail = cad.end_nodes()
+        current = replace(current, tip_point=tip, tail_point=tail)
     seconds = time.perf_counter() - t0
     if use_cache:
         folder.mkdir(parents=True, exist_ok=True)
@@ -368,6 +373,8 @@ def metrics(pm: ProjectileMesh, density: dict, speed: dict, safety: float, nomin
     charge_v = total(vol[tag == tags.CHARGE])
     exact_shell = pm.shape.shell_volume()
     exact_total = pm.shape.outer_volume() if pm.charge else exact_shell
+    if not math.isfinite(exact_total):  # a CAD body: no exact volume
+        exact_total = None
     volume = shell_v + charge_v
     h = nominal_size
     shortest = smallest(alt)
@@ -379,7 +386,7 @@ def metrics(pm: ProjectileMesh, density: dict, speed: dict, safety: float, nomin
         "shell_volume_m3": shell_v,
         "charge_volume_m3": charge_v,
         "exact_volume_m3": exact_total,
-        "volume_error": volume / exact_total - 1.0,
+        "volume_error": None if exact_total is None else volume / exact_total - 1.0,
         "min_quality": smallest(q),
         "shortest_altitude_m": shortest,
         "nominal_size_m": h,

@@ -61,10 +61,32 @@ class Shape:
     cavity_table: tuple = ()
     outer_points: tuple = ()
     inner_points: tuple = ()
+    cad_file: str = ""
+    cad_scale: float = 1.0
+    cad_digest: str = ""
+    tip_point: tuple = ()
+    tail_point: tuple = ()
 
     def __post_init__(self):
         for name in ("cavity_table", "outer_points", "inner_points"):  # lists from JSON back to tuples
             object.__setattr__(self, name, tuple(tuple(float(v) for v in row) for row in getattr(self, name)))
+        for name in ("tip_point", "tail_point"):
+            object.__setattr__(self, name, tuple(float(v) for v in getattr(self, name)))
+
+    @property
+    def is_cad(self) -> bool:
+        """A body read from a CAD file (fepen.geometry.cad): no exact surface, mass from the mesh."""
+        return self.nose == "cad"
+
+    @property
+    def tip(self) -> tuple:
+        """The tracked nose-tip point of the reference body (a mesh node)."""
+        return self.tip_point or (0.0, 0.0, 0.0)
+
+    @property
+    def tail(self) -> tuple:
+        """The tracked tail-centre point of the reference body (a mesh node)."""
+        return self.tail_point or (0.0, self.length, 0.0)
 
     @property
     def radius(self) -> float:
@@ -112,6 +134,8 @@ class Shape:
     def outer_path(self) -> list:
         """The outer meridian (fepen.geometry.profile.Segment list) from the nose on the axis to the centre
         of the rear face."""
+        if self.is_cad:
+            return []
         if self.nose == "profile":
             pts = list(self.outer_points)
             z0 = pts[0][0]
@@ -138,6 +162,8 @@ class Shape:
     def nose_length(self) -> float:
         """Axial length of the nose: from the tip (or meplat) to where the outer radius first reaches the
         calibre (0 for a flat nose)."""
+        if self.is_cad:
+            return 0.0
         if self.nose == "profile":
             for seg in self.outer_path:
                 for r, z in (seg.p0, seg.p1):
@@ -153,6 +179,8 @@ class Shape:
     def outer_radius(self, z):
         """Outer radius at axial distance z from the tip (array-aware)."""
         z = np.asarray(z, dtype=float)
+        if self.is_cad:  # no exact surface: the calibre
+            return np.full(z.shape, self.radius)
         return P.radius_at(self.outer_path, np.clip(z, 0.0, self.length))
 
     @functools.cached_property
@@ -210,7 +238,10 @@ class Shape:
         return out
 
     def outer_volume(self) -> float:
-        """Exact volume inside the outer surface (m^3) (Green's theorem along the meridian)."""
+        """Exact volume inside the outer surface (m^3) (Green's theorem along the meridian); nan for a CAD
+        body."""
+        if self.is_cad:
+            return math.nan
         return float(P.path_integrals(self.outer_path)[0])
 
     def outer_area(self) -> float:
@@ -424,6 +455,8 @@ class Shape:
         """Raise InputError (naming the scene key) if this shape cannot be built."""
         D, a = self.diameter, self.radius
         rm = 0.5 * self.meplat_diameter
+        if self.is_cad:
+            return
         if self.nose != "profile":
             if rm >= a and self.nose != "flat":
                 raise InputError("projectile.meplat_diameter",

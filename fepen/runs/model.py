@@ -76,8 +76,8 @@ def build(scene, comm: MPI.Comm = MPI.COMM_WORLD) -> Model:
     if pm.split:
         contact = shell_charge.ShellChargeContact(s, pm.facet_tags, scene.charge.friction)
         s.interface = contact
-    tip = s.node_at((0.0, 0.0, 0.0))
-    tail = s.node_at((0.0, pm.shape.length, 0.0))
+    tip = s.node_at(pm.shape.tip)
+    tail = s.node_at(pm.shape.tail)
     R, v = setup.placement(scene)
     v0 = float(np.linalg.norm(v))
     surf = law = None

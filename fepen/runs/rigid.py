@@ -95,9 +95,9 @@ class RigidRun:
         self.scene, self.comm = scene, comm
         self.t0 = time.perf_counter()
         self.cells = 0  # no volume mesh unless asked for
-        if points == "mesh":
-            points, mass_properties, self.cells = mesh_points(scene, comm)
         built = setup.projectile(scene)
+        if points == "mesh" or (points is None and built.shape.is_cad):  # a CAD body has only its mesh
+            points, mass_properties, self.cells = mesh_points(scene, comm)
         if points is None:
             points = ring_points(scene, built.shape)
         if mass_properties is None:

@@ -120,7 +120,25 @@ def projectile(scene) -> Built:
         raise
 
 
+def _cad_projectile(scene) -> Built:
+    """A body read from projectile.cad: calibre and length from the file, mass from its mesh."""
+    import os
+
+    from fepen.geometry import cad
+
+    path = os.path.abspath(scene.projectile.cad)
+    scale = scene.projectile.cad_scale
+    D, L = cad.probe(path, scale)
+    if not (0.0 < D <= 1.0 and 0.0 < L <= 10.0):
+        raise InputError("projectile.cad_scale", f"the body is {D:g} m wide and {L:g} m long after scaling by "
+                                                 f"{scale:g}: give the scale that makes its lengths metres")
+    shape = Shape(D, L, "cad", cad_file=path, cad_scale=scale, cad_digest=cad.digest(path))
+    return Built(shape, scene.projectile.material.density)
+
+
 def _projectile(scene) -> Built:
+    if scene.get("projectile.cad"):
+        return _cad_projectile(scene)
     """The checked exact projectile built to projectile.mass by the mass-reaching rule
     (fepen.geometry.shape.reach_mass): the given cavity sized, else reduced or dropped, with one line in
     Built.note saying what was chosen. A cavity the user gave explicitly is only sized (InputError if the

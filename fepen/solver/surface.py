@@ -190,6 +190,51 @@ class Surface:
         _to_nodes(self.tri, f, out)
 
 
+#: facets whose normals differ by more than this meet at a feature edge (not smoothed across)
+FEATURE_ANGLE_DEG = 30.0
+
+
+def smoothed_normals(P: np.ndarray, n: np.ndarray, area: np.ndarray, comm) -> np.ndarray:
+    """Normals of a faceted surface without an exact one (a CAD body): at each corner of a facet the
+    area-weighted mean of the unit normals of the facets around that node that lie within FEATURE_ANGLE_DEG
+    of it, then the mean of its three corners, normalised. On a smooth surface this is the surface normal
+    at the centroid to O(h²) where the flat normal is off by O(h); edges sharper than the feature angle
+    stay sharp. Every rank sees every facet (allgather), so the result does not depend on the partition.
+
+    Args:
+        P: corners of this rank's facets (f, 3, 3). n: their flat unit normals (f, 3). area: their areas (f,).
+        comm: the mesh's communicator.
+
+    Returns:
+        (f, 3) unit normals.
+    """
+    parts = comm.allgather((P, n, area))
+    Pg = np.concatenate([p for p, _, _ in parts])
+    ng = np.concatenate([q for _, q, _ in parts])
+    ag = np.concatenate([a for _, _, a in parts])
+    if not len(P):
+        return np.zeros((0, 3))
+    grid = 1e-9  # nodes are the same point to far better than a nanometre
+    keys = np.round(np.concatenate([Pg.reshape(-1, 3), P.reshape(-1, 3)]) / grid).astype(np.int64)
+    _, vid = np.unique(keys, axis=0, return_inverse=True)
+    vid = vid.ravel()
+    vg, vl = vid[: 3 * len(Pg)], vid[3 * len(Pg):].reshape(-1, 3)
+    order = np.argsort(vg, kind="stable")
+    starts = np.searchsorted(vg[order], np.arange(vid.max() + 2))
+    facet_of = order // 3
+    cos_min = math.cos(math.radians(FEATURE_ANGLE_DEG))
+    out = np.zeros_like(n)
+    for i in range(len(P)):
+        total = np.zeros(3)
+        for v in vl[i]:
+            g = facet_of[starts[v]:starts[v + 1]]
+            g = g[ng[g] @ n[i] > cos_min]
+            m = (ag[g][:, None] * ng[g]).sum(axis=0)
+            total += m / np.linalg.norm(m)
+        out[i] = total / np.linalg.norm(total)
+    return out
+
+
 def oriented_facets(V, facet_tags, tag: int, with_cells: bool = False):
     """The owned facets carrying ``tag``, as node triples (block indices of V) ordered so that their area
     vectors point out of the cell they bound.
@@ -238,6 +283,14 @@ def outer_surface(V, facet_tags, shape, tag: int = tags.OUTER) -> Surface:
     imap = V.dofmap.index_map
     X = V.tabulate_dof_coordinates()[: imap.size_local + imap.num_ghosts]
     tri, cells = oriented_facets(V, facet_tags, tag, with_cells=True)
+    if shape.is_cad:  # no exact surface: the facets' areas, their normals smoothed across smooth edges
+        empty = np.zeros(0, dtype=np.int64)
+        surf = Surface(np.zeros((0, 3), dtype=np.int64), np.zeros((0, 3)), np.zeros(0), np.zeros(0),
+                       np.zeros((0, 3)), np.zeros((0, 3)), np.zeros(0), np.zeros(0), np.zeros(0), empty)
+        surf.append_flat(X, tri, cells)
+        surf.N0 = smoothed_normals(X[tri], surf.n_flat0, surf.flat0, V.mesh.comm)
+        surf.sin_phi0 = np.abs(surf.N0[:, 1])
+        return surf
     av = area_vectors(X, tri)
     flat = np.linalg.norm(av, axis=1)
     nflat = av / np.maximum(flat, 1e-300)[:, None]

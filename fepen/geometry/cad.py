@@ -1,0 +1,92 @@
+"""Projectile bodies from CAD files (STEP or BREP), read and meshed with gmsh's OpenCASCADE kernel
+(docs/projectiles-and-targets.md). The body is taken as drawn: axis along +y, nose toward −y; fepen moves it
+so that its foremost point is at y = 0 and scales it to metres. No exact surface: the target loads the
+mesh's own facets; mass properties come from the mesh.
+"""
+
+from __future__ import annotations
+
+import hashlib
+from pathlib import Path
+
+import numpy as np
+
+from fepen.errors import InputError
+
+
+def digest(path: str) -> str:
+    """A short hash of the file's bytes (mesh-cache key): a changed file is meshed again."""
+    return hashlib.sha256(Path(path).read_bytes()).hexdigest()[:16]
+
+
+def _import(path: str, scale: float) -> list:
+    """Import the file into a new gmsh model, scaled to metres; its volumes (dim, tag)."""
+    import gmsh
+
+    if not gmsh.isInitialized():
+        gmsh.initialize(interruptible=False)
+    gmsh.option.setNumber("General.Terminal", 0)
+    gmsh.option.setNumber("Geometry.OCCBoundsUseStl", 1)
+    gmsh.model.add("cad")
+    try:
+        ents = gmsh.model.occ.importShapes(str(path))
+    except Exception as err:  # gmsh raises a bare Exception with OpenCASCADE's message
+        raise InputError("projectile.cad", f"gmsh cannot read {path!r} as STEP or BREP: {err}") from None
+    vols = [(d, t) for d, t in ents if d == 3]
+    if not vols:
+        raise InputError("projectile.cad", f"{path!r} holds no solid (volume): fepen needs a closed body")
+    if scale != 1.0:
+        gmsh.model.occ.dilate(gmsh.model.occ.getEntities(), 0.0, 0.0, 0.0, scale, scale, scale)
+    gmsh.model.occ.synchronize()
+    return vols
+
+
+def probe(path: str, scale: float) -> tuple[float, float]:
+    """The body's calibre (twice its largest distance from the y axis) and length along y (m).
+
+    Raises:
+        InputError (projectile.cad): no such file, unreadable, or no solid in it.
+    """
+    import gmsh
+
+    if not Path(path).is_file():
+        raise InputError("projectile.cad", f"no such file: {path}")
+    _import(path, scale)
+    xmin, ymin, zmin, xmax, ymax, zmax = gmsh.model.getBoundingBox(-1, -1)
+    gmsh.model.remove()
+    return 2.0 * max(-xmin, xmax, -zmin, zmax), ymax - ymin
+
+
+def build(path: str, scale: float) -> None:
+    """The CAD body in the current gmsh model, foremost point at y = 0, tagged: every volume SHELL, its
+    boundary OUTER (fepen.geometry.tags); not yet meshed."""
+    import gmsh
+
+    from fepen.geometry import tags
+
+    vols = _import(path, scale)
+    _, ymin, _, _, _, _ = gmsh.model.getBoundingBox(-1, -1)
+    gmsh.model.occ.translate(gmsh.model.occ.getEntities(), 0.0, -ymin, 0.0)
+    if len(vols) > 1:
+        gmsh.model.occ.fragment(vols[:1], vols[1:])
+    gmsh.model.occ.removeAllDuplicates()
+    gmsh.model.occ.synchronize()
+    vols = [t for _, t in gmsh.model.getEntities(3)]
+    gmsh.model.addPhysicalGroup(3, vols, tags.SHELL)
+    bnd = gmsh.model.getBoundary([(3, t) for t in vols], combined=True, oriented=False)
+    gmsh.model.addPhysicalGroup(2, sorted({abs(t) for _, t in bnd}), tags.OUTER)
+
+
+def end_nodes() -> tuple[tuple, tuple]:
+    """The mesh nodes fepen tracks as nose tip and tail centre: of the nodes within 1e-9 m of the foremost
+    (rearmost) y, the one nearest the axis."""
+    import gmsh
+
+    _, coords, _ = gmsh.model.mesh.getNodes()
+    x = coords.reshape(-1, 3)
+    out = []
+    for y in (x[:, 1].min(), x[:, 1].max()):
+        near = np.flatnonzero(np.abs(x[:, 1] - y) < 1e-9)
+        k = near[np.argmin(np.hypot(x[near, 0], x[near, 2]))]
+        out.append(tuple(float(v) for v in x[k]))
+    return out[0], out[1]
