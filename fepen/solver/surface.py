@@ -82,15 +82,16 @@ def _patch_areas(shape, p: np.ndarray, patch: np.ndarray, m: int = SUBDIVISION) 
 
 
 def _rim_segments(shape, p: np.ndarray, patch: np.ndarray) -> np.ndarray:
-    """The circular segments between a flat face's rim and the chords of its facets that span it (f,): the
-    part of the exact disk (or annulus) the polygon leaves out, added at an outer rim and taken away at an
-    inner one (a flat face's patches are otherwise only its flat triangles)."""
+    """The circular segments between a forward-facing flat face's rim and the chords of its facets that span
+    it (f,): the part of the exact disk (or annulus) the polygon leaves out, added at an outer rim and taken
+    away at an inner one (a flat face's patches are otherwise only its flat triangles). Rear faces keep their
+    polygon areas: they are loaded only when the body moves backward."""
     out = np.zeros(len(p))
     r = np.hypot(p[..., 0], p[..., 2])
     tol = 1e-6 * shape.length
     for i, seg in enumerate(shape.outer_path):
-        if not (seg.kind == "line" and seg.p0[1] == seg.p1[1]):
-            continue
+        if not (seg.kind == "line" and seg.p0[1] == seg.p1[1] and seg.p1[0] > seg.p0[0]):
+            continue  # only faces that face forward (a flat nose, a meplat): a rear face is never loaded ahead
         on = np.flatnonzero(patch == i)
         lo, hi = sorted((seg.p0[0], seg.p1[0]))
         for R, sign in ((hi, 1.0), (lo, -1.0)):
