@@ -79,8 +79,9 @@ for v in (float(x) for x in args.speeds.split(",")):
     rows.append((v, depth, 1e3 * closed_form(scene)))
 
 if comm.rank == 0:
-    print(f"sigma_s = {setup.target_law(scene).sigma_s / 1e6:.1f} MPa (A = "
-          f"{setup.target_law(scene).sigma_s / 276e6:.3f}), B = 1.5, mass {fepen.load(out / 'rigid-500').summary['mass_kg'] * 1e3:.2f} g")
+    law = setup.target_law(scene)
+    mass_g = 1e3 * revolution.mass_properties(setup.projectile_shape(scene), scene.projectile.material.density)[0]
+    print(f"sigma_s = {law.sigma_s / 1e6:.1f} MPa (A = {law.sigma_s / law.Y:.3f}), B = {law.B:g}, mass {mass_g:.2f} g")
     print(f"{'v0_m_s':>7s} {'fepen_mm':>9s} {'closed_mm':>9s} {'error':>8s}")
     for v, d, c in rows:
         print(f"{v:7.0f} {d:9.2f} {c:9.2f} {100 * (d / c - 1):+7.3f}%")
