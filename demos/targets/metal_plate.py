@@ -21,16 +21,15 @@
 
 # +
 import argparse
-import math
 import tempfile
 from pathlib import Path
 
 from mpi4py import MPI
-from scipy import integrate
 
 import fepen
 from fepen.geometry import revolution
 from fepen.runs import setup
+from fepen.studies import closed_forms
 
 parser = argparse.ArgumentParser(description=__doc__)
 parser.add_argument("--out", default=None)
@@ -54,21 +53,9 @@ ROD = ["target.material='6061-T6511'", "projectile.diameter=0.0071", "projectile
 def closed_form(scene):
     shape, law = setup.projectile_shape(scene), setup.target_law(scene)
     m = revolution.mass_properties(shape, scene.projectile.material.density)[0]
-    a, ln, N = shape.radius, shape.nose_length, shape.nose_factor()
-    rho, B, ss, s = law.density, law.B, law.sigma_s, shape.crh * shape.diameter
-
-    def r(z):
-        return math.sqrt(max(s * s - (ln - z) ** 2, 0.0)) - (s - a)
-
-    def slope(z):
-        return (ln - z) / math.sqrt(max(s * s - (ln - z) ** 2, 1e-300))
-
-    def K(z):
-        return integrate.quad(lambda t: 2 * math.pi * r(t) * slope(t) ** 3 / (1 + slope(t) ** 2), 0.0, z)[0]
-
-    sol = integrate.solve_ivp(lambda z, w: [-(2 / m) * (ss * math.pi * r(z) ** 2 + B * rho * K(z) * w[0])],
-                              (0.0, ln), [scene.impact.velocity**2], rtol=1e-10, atol=1e-6)
-    return ln + m / (2 * math.pi * a * a * rho * N * B) * math.log(1 + N * B * rho * sol.y[0, -1] / ss)
+    r, slope, ln = closed_forms.tangent_ogive(shape.radius, shape.crh)
+    return closed_forms.depth_with_nose_entry(r, slope, ln, m, law.density, law.B, law.sigma_s, shape.nose_factor(),
+                                              scene.impact.velocity)
 
 
 rows = []

@@ -9,7 +9,6 @@ import tempfile
 import numpy as np
 import pytest
 from mpi4py import MPI
-from scipy import integrate
 
 from fepen import scene
 from fepen.geometry import revolution
@@ -17,6 +16,7 @@ from fepen.laws import target as tg
 from fepen.runs import rigid, setup
 from fepen.runs.deformable import DeformableRun
 from fepen.runs.rigid import RigidRun
+from fepen.studies import closed_forms
 
 NORMAL = ["effects.fidelity=rigid", "impact.obliquity_deg=0", "impact.attack_deg=0"]
 FAMILIES = {"ogive": [], "secant": ["projectile.nose_length=0.025", "projectile.crh=4.0"],
@@ -48,27 +48,12 @@ METAL = ["target.material='6061-T6511'", "projectile.diameter=0.0071", "projecti
 
 
 def forrestal_warren_depth(sc) -> float:
-    """The rigid nose-tip depth into a semi-infinite metal target (m): the nose entering (0 < z < ℓ), where the
-    force is σ_s π r(z)² + B ρ V² K(z) with K(z) = ∫_0^z 2π r r'³/(1 + r'²) dζ, integrated as an ODE in V²,
-    then Forrestal and Warren's tunnel depth ℓ + m/(2π a² ρ N* B) ln(1 + N* B ρ V1²/σ_s)."""
+    """The closed form (fepen.studies.closed_forms.depth_with_nose_entry) of the scene's tangent ogive (m)."""
     shape, law = setup.projectile_shape(sc), setup.target_law(sc)
     m = revolution.mass_properties(shape, sc.projectile.material.density)[0]
-    a, ln, N, rho, B, ss = shape.radius, shape.nose_length, shape.nose_factor(), law.density, law.B, law.sigma_s
-    s = shape.crh * shape.diameter  # the tangent ogive r(z) written out
-
-    def r(z):
-        return math.sqrt(max(s * s - (ln - z) ** 2, 0.0)) - (s - a)
-
-    def slope(z):
-        return (ln - z) / math.sqrt(max(s * s - (ln - z) ** 2, 1e-300))
-
-    def K(z):
-        return integrate.quad(lambda t: 2 * math.pi * r(t) * slope(t) ** 3 / (1 + slope(t) ** 2), 0.0, z)[0]
-
-    sol = integrate.solve_ivp(lambda z, w: [-(2 / m) * (ss * math.pi * r(z) ** 2 + B * rho * K(z) * w[0])],
-                              (0.0, ln), [sc.impact.velocity**2], rtol=1e-10, atol=1e-6)
-    v1_sq = sol.y[0, -1]
-    return ln + m / (2 * math.pi * a * a * rho * N * B) * math.log(1 + N * B * rho * v1_sq / ss)
+    r, slope, ln = closed_forms.tangent_ogive(shape.radius, shape.crh)
+    return closed_forms.depth_with_nose_entry(r, slope, ln, m, law.density, law.B, law.sigma_s, shape.nose_factor(),
+                                              sc.impact.velocity)
 
 
 @pytest.mark.parametrize("v0", [500.0, 800.0, 1100.0])
@@ -111,10 +96,10 @@ def test_a_thin_slabs_residual_speed_against_its_closed_form(h):
     sc = scene.Scene(f"[target]\nthickness = {h}\n", NORMAL + sets)
     s = RigidRun(sc, None, MPI.COMM_SELF).run()
     law, shape = setup.target_law(sc), setup.projectile_shape(sc)
-    k = math.pi * shape.radius**2 * shape.nose_factor() * law.density / s["mass_kg"]
-    c = law.sigma_s / (shape.nose_factor() * law.density)
+    exact = closed_forms.slab_residual_speed(800.0, h, shape.radius, s["mass_kg"], law.density, law.sigma_s,
+                                             shape.nose_factor())
     assert s["outcome"] == "perforated"
-    assert s["residual_speed_m_s"] == pytest.approx(math.sqrt((800.0**2 + c) * math.exp(-2 * k * h) - c), rel=2e-2)
+    assert s["residual_speed_m_s"] == pytest.approx(exact, rel=2e-2)
 
 
 LAYERED_METAL = """
