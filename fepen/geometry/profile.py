@@ -58,13 +58,6 @@ class Segment:
         return Segment("conic", (float(p0[0]), float(p0[1])), (float(p1[0]), float(p1[1])),
                        (float(cr), float(cz)), R, R, t0, t1)
 
-    @staticmethod
-    def ellipse(centre, ar, az, t0, t1) -> Segment:
-        cr, cz = centre
-        p0 = (cr + ar * math.cos(t0), cz + az * math.sin(t0))
-        p1 = (cr + ar * math.cos(t1), cz + az * math.sin(t1))
-        return Segment("conic", p0, p1, (float(cr), float(cz)), float(ar), float(az), float(t0), float(t1))
-
     @property
     def is_circle(self) -> bool:
         return self.kind == "conic" and self.ar == self.az
@@ -286,8 +279,8 @@ def read_points(path: str, key: str) -> list[tuple[float, float, float]]:
         try:
             nums = [float(c) if c else 0.0 for c in cells]
         except ValueError:
-            if not rows and n == min(n, 3):
-                continue  # a header
+            if not rows:
+                continue  # a header line before the first point
             raise InputError(key, f"{path}:{n}: expected numbers z_m, r_m[, arc_radius_m], got {line!r}") from None
         if len(nums) not in (2, 3) or not all(math.isfinite(v) for v in nums):
             raise InputError(key, f"{path}:{n}: expected 2 or 3 finite numbers (z_m, r_m[, arc_radius_m]), "
