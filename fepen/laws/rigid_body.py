@@ -4,9 +4,34 @@ rigid-body motion under the sum of the load points' forces (docs/theory.md §9).
 
 from __future__ import annotations
 
+import os
 from dataclasses import dataclass
+from pathlib import Path
 
 import numpy as np
+
+_KERNEL: dict = {}
+
+
+def _kernel():
+    """rigid_points and force_moment in C (fepen/laws/rigid_kernel.c), or None when they do not build or
+    FEPEN_KERNEL=numpy (the numpy expressions below, the reference) is set."""
+    if "lib" not in _KERNEL:
+        _KERNEL["lib"] = None
+        if os.environ.get("FEPEN_KERNEL", "").lower() not in ("numpy", "numba"):
+            import ctypes
+
+            from fepen import native
+
+            lib, _KERNEL["why_not"] = native.load(Path(__file__).with_name("rigid_kernel.c"))
+            if lib is not None:
+                vp = ctypes.c_void_p
+                lib.rigid_points.argtypes = [ctypes.c_int32, *[vp] * 10]
+                lib.rigid_points.restype = None
+                lib.force_moment.argtypes = [ctypes.c_int32, vp, vp, vp]
+                lib.force_moment.restype = None
+                _KERNEL["lib"] = lib
+    return _KERNEL["lib"]
 
 
 def tet_mass_properties(p: np.ndarray, rho: np.ndarray):
@@ -102,21 +127,48 @@ class RigidBody:
         self.centre0 = np.asarray(centre0, float)
         self.I_body = np.asarray(inertia, float)
         self.I_body_inv = np.linalg.inv(self.I_body)
-        self.r0 = np.asarray(points, float) - self.centre0  # body-frame arms
-        self.N0 = np.asarray(normals, float)
+        self.r0 = np.ascontiguousarray(np.asarray(points, float) - self.centre0)  # body-frame arms
+        self.N0 = np.ascontiguousarray(normals, dtype=float)
+        self.lib = _kernel()
+        self._r0_at, self._N0_at = self.r0.ctypes.data, self.N0.ctypes.data  # the arrays live as long as self
+        #: (R, ω) of the state last passed to derivative (force functions may use them)
+        self.frame: tuple[np.ndarray, np.ndarray] | None = None
 
     def omega(self, s: RigidState, R: np.ndarray | None = None) -> np.ndarray:
         """World angular velocity ω = R I_b^{-1} R^T L."""
         R = quat_to_matrix(s.q) if R is None else R
         return R @ (self.I_body_inv @ (R.T @ s.L))
 
-    def points(self, s: RigidState):
-        """World positions, velocities and normals of the load points."""
-        R = quat_to_matrix(s.q)
+    def points(self, s: RigidState, R: np.ndarray | None = None, w: np.ndarray | None = None):
+        """World positions, velocities and normals of the load points, and their arms about the centre
+        (R, w: the state's rotation and angular velocity when already known)."""
+        R = quat_to_matrix(s.q) if R is None else R
+        w = self.omega(s, R) if w is None else w
+        if self.lib is not None:
+            k = len(self.r0)
+            out = np.empty((4, k, 3))
+            a = out.ctypes.data
+            step = 24 * k
+            small = np.concatenate([R.ravel(), s.c, s.V, w])
+            b = small.ctypes.data
+            self.lib.rigid_points(k, self._r0_at, self._N0_at, b, b + 72, b + 96, b + 120, a, a + step,
+                                  a + 2 * step, a + 3 * step)
+            return out[0], out[1], out[2], out[3]
         arm = self.r0 @ R.T
-        w = self.omega(s, R)
         skew = np.array([[0.0, -w[2], w[1]], [w[2], 0.0, -w[0]], [-w[1], w[0], 0.0]])  # w × r = skew r
         return s.c + arm, s.V + arm @ skew.T, self.N0 @ R.T, arm
+
+    def force_moment(self, arm: np.ndarray, f: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+        """Σ f and Σ arm × f over the load points."""
+        if self.lib is not None:
+            FM = np.empty(6)
+            f = np.ascontiguousarray(f, dtype=float)
+            self.lib.force_moment(len(f), arm.ctypes.data, f.ctypes.data, FM.ctypes.data)
+            return FM[:3], FM[3:]
+        # Σ arm × f as three dot products (np.cross on (k, 3) arrays costs more than the sum)
+        return f.sum(axis=0), np.array([arm[:, 1] @ f[:, 2] - arm[:, 2] @ f[:, 1],
+                                        arm[:, 2] @ f[:, 0] - arm[:, 0] @ f[:, 2],
+                                        arm[:, 0] @ f[:, 1] - arm[:, 1] @ f[:, 0]])
 
     def to_world(self, s: RigidState, X: np.ndarray) -> np.ndarray:
         """World position of reference points X (k, 3)."""
@@ -124,20 +176,19 @@ class RigidBody:
 
     def derivative(self, s: RigidState, force_fn):
         """Time derivative of the state, and the force and moment; force_fn(s, x, v, n) -> forces (k, 3) on
-        the load points at world positions x, velocities v, normals n."""
-        x, v, n, arm = self.points(s)
-        f = force_fn(s, x, v, n)
-        F = f.sum(axis=0)
-        # Σ arm × f as three dot products (np.cross on (k, 3) arrays costs more than the sum)
-        M = np.array([arm[:, 1] @ f[:, 2] - arm[:, 2] @ f[:, 1], arm[:, 2] @ f[:, 0] - arm[:, 0] @ f[:, 2],
-                      arm[:, 0] @ f[:, 1] - arm[:, 1] @ f[:, 0]])
-        w = self.omega(s)
+        the load points at world positions x, velocities v, normals n (self.frame holds the state's rotation
+        and angular velocity meanwhile)."""
+        R = quat_to_matrix(s.q)
+        w = self.omega(s, R)
+        self.frame = (R, w)
+        x, v, n, arm = self.points(s, R, w)
+        F, M = self.force_moment(arm, force_fn(s, x, v, n))
         dq = 0.5 * quat_mul(np.array([0.0, *w]), s.q)
         return np.concatenate([s.V, dq, F / self.mass, M]), F, M
 
-    def power(self, s: RigidState, F: np.ndarray, M: np.ndarray) -> float:
-        """Power F·V + M·ω of the external force and moment (W)."""
-        return float(F @ s.V + M @ self.omega(s))
+    def power(self, s: RigidState, F: np.ndarray, M: np.ndarray, w: np.ndarray | None = None) -> float:
+        """Power F·V + M·ω of the external force and moment (W); w: the state's ω when already known."""
+        return float(F @ s.V + M @ (self.omega(s) if w is None else w))
 
     def rk4_step(self, s: RigidState, dt: float, force_fn):
         """One classical Runge–Kutta step.
@@ -156,7 +207,7 @@ class RigidBody:
             ki, F, M = self.derivative(state, force_fn)
             if i == 0:
                 F0, M0 = F, M
-            work += w * self.power(state, F, M)
+            work += w * self.power(state, F, M, self.frame[1])
             k.append(ki)
         y = y0 + dt / 6.0 * (k[0] + 2 * k[1] + 2 * k[2] + k[3])
         new = RigidState.from_array(y)

@@ -459,18 +459,42 @@ def _bind(lib):
     lib.point_forces.restype = i32
     xg, wg = _gauss_legendre(8)
     gauss = np.ascontiguousarray(np.concatenate([xg, wg]))
+    bound: dict = {}  # the addresses of the arrays a run passes every call unchanged (its points' constants)
+
+    def constant(a, keep):
+        """The address of a per-point array, taken once for a C-contiguous float64 array (whose address does
+        not change; the cache holds the array, so its id is not reused while it is cached); any other array is
+        converted (kept alive in ``keep`` for the call)."""
+        hit = bound.get(id(a))
+        if hit is not None and hit[0] is a:
+            return hit[1]
+        if isinstance(a, np.ndarray) and a.dtype == np.float64 and a.flags.c_contiguous:
+            if len(bound) > 64:
+                bound.clear()
+            bound[id(a)] = (a, a.ctypes.data)
+            return a.ctypes.data
+        c = np.ascontiguousarray(a, dtype=float)
+        keep.append(c)
+        return c.ctypes.data
+
+    gauss_at = gauss.ctypes.data  # c_point_forces.gauss below keeps the array alive
+
     def c_point_forces(law, x, v, n, area, radius, R_meridian, sin_phi0, axis):
         p = _law_numbers(law)
-        arrays = [np.ascontiguousarray(a, dtype=float) for a in (x, v, n, area, radius, R_meridian, sin_phi0)]
+        moving = [np.ascontiguousarray(a, dtype=float) for a in (x, v, n)]
         ax = None if axis is None else np.ascontiguousarray(axis, dtype=float)
-        k = len(arrays[0])
-        f, sig, sums = np.empty((k, 3)), np.empty(k), np.empty(5)
-        count = lib.point_forces(k, *[a.ctypes.data for a in arrays], None if ax is None else ax.ctypes.data,
-                                 p.ctypes.data, gauss.ctypes.data, len(xg), f.ctypes.data, sig.ctypes.data,
-                                 sums.ctypes.data)
+        k = len(moving[0])
+        out = np.empty(4 * k + 5)
+        at = out.ctypes.data
+        keep: list = []
+        count = lib.point_forces(k, *[a.ctypes.data for a in moving],
+                                 *[constant(a, keep) for a in (area, radius, R_meridian, sin_phi0)],
+                                 None if ax is None else ax.ctypes.data, p.ctypes.data, gauss_at, len(xg), at,
+                                 at + 24 * k, at + 32 * k)
         assert count == len(p), "target_kernel.c and _law_numbers disagree on the parameters"
-        return f, sums
+        return out[: 3 * k].reshape(k, 3), out[4 * k:]
 
+    c_point_forces.gauss = gauss
     return c_point_forces
 
 

@@ -77,6 +77,33 @@ def ring_points(scene, shape) -> dict:
     return revolution.load_points(shape, panel, RING_SECTORS)
 
 
+#: the default bodies built so far in this process, by their scene keys (a sweep's shots share a projectile)
+_BODIES: dict = {}
+
+
+def _body_key(scene) -> tuple:
+    from fepen.scene import SCHEMA
+
+    return tuple((k, repr(scene.get(k))) for k in SCHEMA
+                 if k.startswith(("projectile.", "charge.")) or k in ("effects.charge", "mesh.rigid_panel"))
+
+
+def default_body(scene):
+    """(the built projectile, its ring load points, its exact mass properties), built once per projectile in
+    a process (the arrays are shared: read them, never write)."""
+    key = _body_key(scene)
+    hit = _BODIES.get(key)
+    if hit is None:
+        built = setup.projectile(scene)
+        rho_c = scene.charge.material.density if scene.effects.charge else None
+        hit = (built, ring_points(scene, built.shape),
+               revolution.mass_properties(built.shape, built.shell_density, rho_c))
+        if len(_BODIES) >= 16:
+            _BODIES.clear()
+        _BODIES[key] = hit
+    return hit
+
+
 class RigidRun:
     """One rigid-projectile penetration.
 
@@ -95,7 +122,10 @@ class RigidRun:
         self.scene, self.comm = scene, comm
         self.t0 = time.perf_counter()
         self.cells = 0  # no volume mesh unless asked for
-        built = setup.projectile(scene)
+        if points is None and mass_properties is None and not scene.get("projectile.cad"):
+            built, points, mass_properties = default_body(scene)
+        else:
+            built = setup.projectile(scene)
         if points == "mesh" or (points is None and built.shape.is_cad):  # a CAD body has only its mesh
             points, mass_properties, self.cells = mesh_points(scene, comm)
         if points is None:
@@ -132,9 +162,10 @@ class RigidRun:
     def force_fn(self, s: RigidState, x, v, n):
         """Target forces on the load points (zero outside the target)."""
         g = self.pts
-        tip = self.body.to_world(s, self.tip_ref[None])[0]
+        R = self.body.frame[0]  # s's rotation (RigidBody.derivative)
+        tip = s.c + R @ (self.tip_ref - self.body.centre0)
         load = tg.load_on_points(self.law, x, v, n, g["area0"], g["radius"], g["R_meridian"], g["sin_phi0"],
-                                 self.axis(s), self.crater, -tip[1])
+                                 -R[:, 1], self.crater, -tip[1])
         self.loaded, self.area = load.loaded, load.area
         if self.wear is not None:
             self.wear.stage(load.force, n, v)
