@@ -15,7 +15,8 @@ def random_body(seed, k=500):
     A = rng.normal(size=(3, 3))
     inertia = A @ A.T + 3 * np.eye(3)
     n = rng.normal(size=(k, 3))
-    body = rb.RigidBody(0.4, rng.normal(size=3), inertia, rng.normal(size=(k, 3)), n / np.linalg.norm(n, axis=1)[:, None])
+    n /= np.linalg.norm(n, axis=1)[:, None]
+    body = rb.RigidBody(0.4, rng.normal(size=3), inertia, rng.normal(size=(k, 3)), n)
     q = rng.normal(size=4)
     s = rb.RigidState(rng.normal(size=3), q / np.linalg.norm(q), rng.normal(size=3) * 600, rng.normal(size=3))
     return body, s, rng.normal(size=(k, 3)) * 1e4
