@@ -5,6 +5,7 @@
     fepen mesh SCENE.toml [--out DIR] [--set KEY=VALUE ...]
     fepen validate [SCENE.toml] [--out DIR] [--set KEY=VALUE ...]
     fepen study accuracy-cost [--out DIR] [--ranks N] [--quick] [--fresh]
+    fepen sweep SWEEP.toml [--out DIR] [--ranks-per-shot K] [--workers W] [--set KEY=VALUE ...] [--fresh]
     fepen keys
 
 Bad input prints one line naming the key and what is allowed and exits with code 2, before anything is
@@ -57,6 +58,17 @@ def _parser() -> argparse.ArgumentParser:
     st.add_argument("--ranks", type=int, default=2, help="MPI ranks of each run (default 2)")
     st.add_argument("--quick", action="store_true", help="a small subset on coarse meshes (minutes)")
     st.add_argument("--fresh", action="store_true", help="run again what DIR/runs already holds")
+    sw = sub.add_parser("sweep", help="many shots of a base scene (grid, Monte Carlo or a table): sweep.csv, "
+                                      "sweep.md, figures; resumable; MPI groups (docs/studies.md)")
+    sw.add_argument("sweep", help="the sweep file (TOML)")
+    sw.add_argument("--out", default="results/sweep", help="results directory (default results/sweep)")
+    sw.add_argument("--ranks-per-shot", type=int, default=1, metavar="K",
+                    help="ranks of each shot's MPI group (default 1; must divide the number of ranks)")
+    sw.add_argument("--workers", type=int, default=None, metavar="W",
+                    help="without mpirun: run under mpirun -n W (default: one per core; 1: in this process)")
+    sw.add_argument("--set", dest="sets", action="append", default=[], metavar="KEY=VALUE",
+                    help="override a key of the base scene")
+    sw.add_argument("--fresh", action="store_true", help="discard the shots OUT holds and run them all again")
     sub.add_parser("keys", help="list every scene key with its default, unit and allowed values")
     vw = sub.add_parser("view", help="a run in ParaView (its view.py), or pyvista where ParaView is absent")
     vw.add_argument("dir", help="results directory of a run with fields (finished, running or killed)")
@@ -205,6 +217,37 @@ def cmd_view(args) -> int:
     return 0
 
 
+def cmd_sweep(args) -> int:
+    """A sweep, on the MPI ranks it was started on, or relaunched under mpirun -n --workers."""
+    import os
+    import shutil
+    import subprocess
+
+    from mpi4py import MPI
+
+    from fepen.studies import processes, sweep
+
+    world = MPI.COMM_WORLD
+    if args.workers is not None and args.workers < 1:
+        raise InputError("--workers", f"must be at least 1, got {args.workers}")
+    if args.ranks_per_shot < 1:
+        raise InputError("--ranks-per-shot", f"must be at least 1, got {args.ranks_per_shot}")
+    workers = args.workers if args.workers is not None else (os.cpu_count() or 1)
+    if world.size == 1 and workers > 1 and shutil.which("mpirun"):
+        if workers % args.ranks_per_shot:
+            raise InputError("--workers", f"must be a multiple of --ranks-per-shot {args.ranks_per_shot}, "
+                                          f"got {workers}")
+        sweep.read(args.sweep, args.sets)  # bad input here, in one line, before mpirun starts
+        argv = ["sweep", args.sweep, "--out", args.out, "--ranks-per-shot", str(args.ranks_per_shot),
+                "--workers", "1", *(["--fresh"] if args.fresh else []), *[f"--set={s}" for s in args.sets]]
+        return subprocess.run(processes.command(argv, workers), env=processes.mpi_env()).returncode
+    res = sweep.run(args.sweep, args.out, world, args.ranks_per_shot, args.sets, args.fresh, say=_say)
+    _say(f"shots: {res['shots']} ({res['ran']} run now, {res['skipped']} recorded before); "
+         + ", ".join(f"{k} {v}" for k, v in sorted(res["statuses"].items())) + f"; wall {res['wall_s']:.1f} s",
+         f"written: {args.out}/sweep.csv, sweep.md, shots.jsonl, sweep.png")
+    return 0
+
+
 def cmd_keys(args) -> int:
     """Print the scene-key table (Markdown)."""
     from fepen import scene as fscene
@@ -214,7 +257,7 @@ def cmd_keys(args) -> int:
 
 
 COMMANDS = {"run": cmd_run, "mesh": cmd_mesh, "validate": cmd_validate, "validate-depth": cmd_validate_depth,
-            "study": cmd_study, "keys": cmd_keys, "view": cmd_view}
+            "study": cmd_study, "sweep": cmd_sweep, "keys": cmd_keys, "view": cmd_view}
 
 
 def main(argv: list[str] | None = None) -> int:

@@ -1,0 +1,253 @@
+"""Many shots on any number of ranks: the engine of ``fepen sweep``, the ballistic-limit and ricochet studies
+and ``fepen validate`` (docs/studies.md).
+
+COMM_WORLD (or the communicator given) is split into groups of ``ranks_per_shot`` ranks. The leader of each
+group asks rank 0 for a shot, the group runs it on its own communicator, and the leader sends the record back
+with its next request: a dynamic queue, since shots differ in cost. On rank 0 a thread serves the queue
+(MPI_THREAD_MULTIPLE, which mpi4py asks for) while rank 0's own group runs shots like any other. Rank 0 appends
+each record to OUT/shots.jsonl as it arrives (one JSON line, flushed and synced), so a killed study starts
+again where it stopped and never runs a finished shot twice. Records do not depend on which group ran a
+shot: a rigid shot is the same ODE on any group; a deformable one is the same to round-off.
+"""
+
+from __future__ import annotations
+
+import json
+import logging
+import os
+import shutil
+import sys
+import threading
+import time
+from pathlib import Path
+
+from mpi4py import MPI
+
+from fepen.errors import InputError, SimulationError
+
+__all__ = ["execute", "run_shot", "read_records", "check_directory", "RECORDS"]
+
+RECORDS = "shots.jsonl"
+_REQUEST, _REPLY = 7101, 7102
+#: the dispatcher's poll period (s) between requests
+POLL = 5e-4
+
+
+def check_directory(out: Path, digest: str, fresh: bool) -> tuple | None:
+    """On rank 0: None when OUT is new, holds this study (resumable) or is cleared by ``fresh``; else the
+    (key, message) of the InputError to raise on every rank."""
+    out = Path(out)
+    if out.exists() and not out.is_dir():
+        return ("--out", f"{out} is a file, not a results directory")
+    meta = out / "sweep.json"
+    if fresh:
+        for name in (RECORDS, "sweep.json"):
+            if (out / name).exists():
+                (out / name).unlink()
+        if (out / "shots").is_dir():
+            shutil.rmtree(out / "shots")
+        return None
+    if meta.is_file():
+        try:
+            old = json.loads(meta.read_text()).get("digest")
+        except (OSError, ValueError):
+            old = None
+        if old != digest:
+            return ("--out", f"{out} holds the results of another sweep: give a new --out, or --fresh to "
+                             "replace them")
+    return None
+
+
+def read_records(out: Path) -> dict:
+    """{shot: record} of OUT/shots.jsonl; a line cut short by a kill is ignored (its shot runs again)."""
+    records = {}
+    path = Path(out) / RECORDS
+    if not path.is_file():
+        return records
+    for line in path.read_text().splitlines():
+        try:
+            r = json.loads(line)
+        except ValueError:
+            continue
+        if isinstance(r, dict) and isinstance(r.get("shot"), int):
+            records[r["shot"]] = r
+    return records
+
+
+class _Log:
+    """Appends records to OUT/shots.jsonl, each flushed and synced before the next shot is handed out."""
+
+    def __init__(self, out: Path, records: dict, bar):
+        self.path, self.records, self.bar = Path(out) / RECORDS, records, bar
+        self.f = open(self.path, "a")
+        if self.f.tell() > 0:  # a kill may have cut the last line: start on a new one
+            with open(self.path, "rb") as g:
+                g.seek(-1, os.SEEK_END)
+                if g.read(1) != b"\n":
+                    self.f.write("\n")
+
+    def add(self, record: dict) -> None:
+        self.f.write(json.dumps(record, default=float) + "\n")
+        self.f.flush()
+        os.fsync(self.f.fileno())
+        self.records[record["shot"]] = record
+        if self.bar is not None:
+            self.bar.update(1)
+
+    def close(self):
+        self.f.close()
+        if self.bar is not None:
+            self.bar.close()
+
+
+def run_shot(i: int, scene, out, comm) -> dict:
+    """Run shot i on comm; its record: shot, status ("ok", "stopped": the simulation could not go on,
+    "bad-input"), message, summary (without the scene and versions), wall_s, ranks.
+
+    Args:
+        i: the shot's index. scene: its resolved Scene. out: its results directory, or None (a rigid shot
+            then writes nothing). comm: the group's communicator.
+    """
+    from fepen import api
+    from fepen.runs.rigid import RigidRun
+
+    t0 = time.perf_counter()
+    summary, status, message = None, "ok", ""
+    try:
+        if out is None and scene.effects.fidelity == "rigid":
+            summary = RigidRun(scene, None, comm).run()
+        else:
+            summary = api.run(scene, out=out, comm=comm).summary
+    except SimulationError as err:
+        status, message = "stopped", str(err)
+    except InputError as err:
+        status, message = "bad-input", f"{err.key}: {err.message}"
+    if summary is not None:
+        summary = {k: v for k, v in summary.items() if k not in ("scene", "versions")}
+    return {"shot": i, "status": status, "message": message, "summary": summary,
+            "wall_s": time.perf_counter() - t0, "ranks": comm.size}
+
+
+def execute(n: int, scene_of, out, comm=None, ranks_per_shot: int = 1, keep=None, say=None,
+            desc: str = "shots") -> tuple[dict, int]:
+    """Run the shots 0 … n−1 not yet recorded in OUT/shots.jsonl.
+
+    Args:
+        n: number of shots. scene_of: shot index -> resolved Scene. out: the results directory (exists).
+        comm: the communicator (None: COMM_WORLD). ranks_per_shot: ranks per group; divides comm.size.
+        keep: Scene -> whether the shot writes its results directory OUT/shots/NNNNN (None: never for rigid
+            shots). say: prints a line (rank 0). desc: the progress bar's label.
+
+    Returns:
+        ({shot: record} of every finished shot on rank 0, {} elsewhere; the number of shots run now).
+    """
+    comm = MPI.COMM_WORLD if comm is None else comm
+    k = ranks_per_shot
+    if k < 1 or comm.size % k:
+        raise InputError("--ranks-per-shot", f"must divide the number of ranks ({comm.size}), got {k}")
+    keep = keep or (lambda sc: sc.effects.fidelity != "rigid")
+    out = Path(out)
+    records = read_records(out) if comm.rank == 0 else {}
+    pending = comm.bcast([i for i in range(n) if i not in records] if comm.rank == 0 else None, root=0)
+    groups = comm.size // k
+    if comm.rank == 0 and say is not None:
+        done = n - len(pending)
+        say(f"{desc}: {n}" + (f", {done} done before (OUT/{RECORDS})" if done else "")
+            + f"; {groups} group{'s' if groups > 1 else ''} of {k} rank{'s' if k > 1 else ''}")
+    log = None
+    if comm.rank == 0:
+        from tqdm import tqdm
+
+        bar = tqdm(total=len(pending), unit="shot", desc=desc, leave=False, disable=None) if pending else None
+        log = _Log(out, records, bar)
+    quiet = logging.getLogger("fepen")
+    level = quiet.level
+    quiet.setLevel(logging.ERROR)  # the shots' notes were said once when the study was read
+    interval = sys.getswitchinterval()
+    try:
+        if comm.size == 1:
+            for i in pending:
+                sc = scene_of(i)
+                log.add(run_shot(i, sc, _shot_dir(out, i) if keep(sc) else None, comm))
+        elif MPI.Query_thread() < MPI.THREAD_MULTIPLE:  # no dispatcher thread: a fixed round robin
+            if comm.rank == 0 and say is not None:
+                say(f"{desc}: this MPI has no MPI_THREAD_MULTIPLE: shots go round robin, not by a queue")
+            _round_robin(pending, scene_of, out, comm, k, keep, log)
+        else:
+            sys.setswitchinterval(1e-3)  # rank 0's dispatcher answers within a millisecond or so
+            _parallel(pending, scene_of, out, comm, k, keep, log)
+    finally:
+        quiet.setLevel(level)
+        sys.setswitchinterval(interval)
+        if log is not None:
+            log.close()
+    return records, len(pending)
+
+
+def _shot_dir(out: Path, i: int) -> Path:
+    return out / "shots" / f"{i:05d}"
+
+
+def _parallel(pending, scene_of, out, comm, k, keep, log) -> None:
+    group = comm.Split(comm.rank // k, comm.rank)
+    queue = comm.Dup()
+    groups = comm.size // k
+    dispatcher = None
+    if comm.rank == 0:
+        dispatcher = threading.Thread(target=_dispatch, args=(queue, list(pending), groups, log), daemon=True)
+        dispatcher.start()
+    try:
+        record = None
+        while True:
+            i = None
+            if group.rank == 0:
+                queue.send(record, dest=0, tag=_REQUEST)
+                i = queue.recv(source=0, tag=_REPLY)
+            i = group.bcast(i, root=0)
+            if i < 0:
+                break
+            sc = scene_of(i)
+            r = run_shot(i, sc, _shot_dir(out, i) if keep(sc) else None, group)
+            record = r if group.rank == 0 else None
+    finally:
+        if dispatcher is not None:
+            dispatcher.join()
+        group.Free()
+        queue.Free()
+
+
+def _round_robin(pending, scene_of, out, comm, k, keep, log) -> None:
+    group = comm.Split(comm.rank // k, comm.rank)
+    mine = []
+    for i in pending[comm.rank // k:: comm.size // k]:
+        sc = scene_of(i)
+        r = run_shot(i, sc, _shot_dir(out, i) if keep(sc) else None, group)
+        if comm.rank == 0:
+            log.add(r)
+        elif group.rank == 0:
+            mine.append(r)
+    for part in comm.gather(mine, root=0) or []:
+        for r in part:
+            log.add(r)
+    group.Free()
+
+
+def _dispatch(queue, pending: list, groups: int, log) -> None:
+    """Rank 0's thread: hand out the pending shots in order to whichever leader asks, record what they send
+    back, tell each leader to stop when none is left."""
+    status = MPI.Status()
+    nxt, stopped = 0, 0
+    while stopped < groups:
+        if not queue.Iprobe(source=MPI.ANY_SOURCE, tag=_REQUEST, status=status):
+            time.sleep(POLL)
+            continue
+        src = status.Get_source()
+        record = queue.recv(source=src, tag=_REQUEST)
+        if record is not None:
+            log.add(record)
+        if nxt < len(pending):
+            queue.send(pending[nxt], dest=src, tag=_REPLY)
+            nxt += 1
+        else:
+            queue.send(-1, dest=src, tag=_REPLY)
+            stopped += 1
