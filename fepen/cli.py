@@ -52,12 +52,23 @@ def _parser() -> argparse.ArgumentParser:
                     help="override a scene key in every rigid run (e.g. target.strength_model=forrestal-S)")
     vd.add_argument("--out", default="results/validate-depth", help="results directory")
     vd.add_argument("--workers", type=int, default=1, help="processes at once (default 1)")
-    st = sub.add_parser("study", help="accuracy-cost: what accuracy costs in time (study.md, pareto.png)")
-    st.add_argument("which", choices=["accuracy-cost"])
-    st.add_argument("--out", default="results/study", help="results directory (default results/study)")
-    st.add_argument("--ranks", type=int, default=2, help="MPI ranks of each run (default 2)")
-    st.add_argument("--quick", action="store_true", help="a small subset on coarse meshes (minutes)")
-    st.add_argument("--fresh", action="store_true", help="run again what DIR/runs already holds")
+    st = sub.add_parser("study", help="accuracy-cost: what accuracy costs in time (study.md, pareto.png); "
+                                      "ballistic-limit; ricochet (docs/studies.md)")
+    st.add_argument("which", choices=["accuracy-cost", "ballistic-limit", "ricochet"])
+    st.add_argument("scene", nargs="?", help="ballistic-limit, ricochet: the base scene (absent: the default)")
+    st.add_argument("--out", default=None, help="results directory (default results/study, "
+                                                "results/ballistic-limit or results/ricochet)")
+    st.add_argument("--ranks", type=int, default=2, help="accuracy-cost: MPI ranks of each run (default 2)")
+    st.add_argument("--quick", action="store_true", help="accuracy-cost: a small subset on coarse meshes")
+    st.add_argument("--fresh", action="store_true", help="run again what DIR already holds")
+    st.add_argument("--set", dest="sets", action="append", default=[], metavar="KEY=VALUE",
+                    help="ballistic-limit, ricochet: override a key of the base scene")
+    st.add_argument("--ranks-per-shot", type=int, default=1, metavar="K", help="ranks of each shot (default 1)")
+    st.add_argument("--speeds", default=None, help="ballistic-limit: the bracket 'LOW,HIGH' (default 100,1500 "
+                                                   "m/s); ricochet: the speeds (default 300,400,...,900 m/s)")
+    st.add_argument("--tol", type=float, default=None,
+                    help="the bisection's final width: m/s (ballistic-limit, default 2) or deg (ricochet, 0.5)")
+    st.add_argument("--obliquity-max", type=float, default=85.0, help="ricochet: top of the bracket (deg)")
     sw = sub.add_parser("sweep", help="many shots of a base scene (grid, Monte Carlo or a table): sweep.csv, "
                                       "sweep.md, figures; resumable; MPI groups (docs/studies.md)")
     sw.add_argument("sweep", help="the sweep file (TOML)")
@@ -174,6 +185,9 @@ def cmd_study(args) -> int:
 
     from fepen.studies import accuracy_cost
 
+    if args.which != "accuracy-cost":
+        return _limit_study(args)
+    args.out = args.out or "results/study"
     if MPI.COMM_WORLD.size > 1:
         raise InputError("fepen study", "run it without mpirun: it starts its own MPI jobs (--ranks)")
     if args.ranks < 1:
@@ -181,6 +195,54 @@ def cmd_study(args) -> int:
     accuracy_cost.study(args.out, ranks=args.ranks, quick=args.quick, fresh=args.fresh, say=_say)
     _say(f"written: {args.out}/study.csv, study.md, study.json, pareto.png")
     return 0
+
+
+def _numbers(option: str, text: str) -> list[float]:
+    import math
+
+    try:
+        values = [float(x) for x in text.split(",")]
+    except ValueError:
+        values = []
+    if not values or not all(math.isfinite(v) and v > 0 for v in values):
+        raise InputError(option, f"comma-separated positive numbers, got {text!r}")
+    return values
+
+
+def _limit_study(args) -> int:
+    """fepen study ballistic-limit | ricochet, on the ranks it was started on."""
+    from mpi4py import MPI
+
+    from fepen.studies import limits
+
+    fresh_dir(args)
+    comm = MPI.COMM_WORLD
+    if args.ranks_per_shot < 1 or comm.size % args.ranks_per_shot:
+        raise InputError("--ranks-per-shot", f"must divide the number of ranks ({comm.size})")
+    if args.which == "ballistic-limit":
+        lo, hi = _numbers("--speeds", args.speeds) if args.speeds else (100.0, 1500.0)
+        limits.ballistic_limit(args.scene, args.sets, args.out, comm, args.ranks_per_shot, lo, hi,
+                               args.tol or 2.0, say=_say)
+        _say(f"written: {args.out}/ballistic_limit.json, ballistic_limit.png")
+    else:
+        speeds = _numbers("--speeds", args.speeds) if args.speeds else [300.0 + 100 * j for j in range(7)]
+        limits.ricochet(args.scene, args.sets, args.out, comm, args.ranks_per_shot, speeds, args.obliquity_max,
+                        args.tol or 0.5, say=_say)
+        _say(f"written: {args.out}/ricochet.json, ricochet.png")
+    return 0
+
+
+def fresh_dir(args) -> None:
+    """The default results directory of a limit study; --fresh clears its rounds (rank 0)."""
+    import shutil
+    from pathlib import Path
+
+    from mpi4py import MPI
+
+    args.out = args.out or f"results/{args.which}"
+    if args.fresh and MPI.COMM_WORLD.rank == 0 and (Path(args.out) / "rounds").is_dir():
+        shutil.rmtree(Path(args.out) / "rounds")
+    MPI.COMM_WORLD.barrier()
 
 
 def cmd_view(args) -> int:
