@@ -5,7 +5,7 @@ COMM_WORLD (or the communicator given) is split into groups of ``ranks_per_shot`
 group asks rank 0 for a shot, the group runs it on its own communicator, and the leader sends the record back
 with its next request: a dynamic queue, since shots differ in cost. On rank 0 a thread serves the queue
 (MPI_THREAD_MULTIPLE, which mpi4py asks for) while rank 0's own group runs shots like any other. Rank 0 appends
-each record to OUT/shots.jsonl as it arrives (one JSON line, flushed and synced), so a killed study starts
+each record to OUT/shots.jsonl as it arrives (one JSON line, flushed; synced every second), so a killed study starts
 again where it stopped and never runs a finished shot twice. Records do not depend on which group ran a
 shot: a rigid shot is the same ODE on any group; a deformable one is the same to round-off.
 """
@@ -31,6 +31,8 @@ RECORDS = "shots.jsonl"
 _REQUEST, _REPLY = 7101, 7102
 #: the dispatcher's poll period (s) between requests
 POLL = 5e-4
+#: the records are synced to the disk at most this often (s)
+SYNC = 1.0
 
 
 def check_directory(out: Path, digest: str, fresh: bool) -> tuple | None:
@@ -75,11 +77,14 @@ def read_records(out: Path) -> dict:
 
 
 class _Log:
-    """Appends records to OUT/shots.jsonl, each flushed and synced before the next shot is handed out."""
+    """Appends records to OUT/shots.jsonl, each flushed before the next shot is handed out (a killed process
+    loses nothing it flushed) and synced to the disk at most every SYNC seconds (a machine that loses power
+    loses at most that much)."""
 
     def __init__(self, out: Path, records: dict, bar):
         self.path, self.records, self.bar = Path(out) / RECORDS, records, bar
         self.f = open(self.path, "a")
+        self.synced = time.monotonic()
         if self.f.tell() > 0:  # a kill may have cut the last line: start on a new one
             with open(self.path, "rb") as g:
                 g.seek(-1, os.SEEK_END)
@@ -89,12 +94,16 @@ class _Log:
     def add(self, record: dict) -> None:
         self.f.write(json.dumps(record, default=float) + "\n")
         self.f.flush()
-        os.fsync(self.f.fileno())
+        if time.monotonic() - self.synced > SYNC:
+            os.fsync(self.f.fileno())
+            self.synced = time.monotonic()
         self.records[record["shot"]] = record
         if self.bar is not None:
             self.bar.update(1)
 
     def close(self):
+        self.f.flush()
+        os.fsync(self.f.fileno())
         self.f.close()
         if self.bar is not None:
             self.bar.close()

@@ -12,11 +12,15 @@ __all__ = ["write", "report", "quantiles", "OUTCOME_COLOURS"]
 
 OUTCOME_COLOURS = {"embedded": "tab:blue", "perforated": "tab:green", "ricochet": "tab:red", "ended": "tab:grey"}
 #: the figures summarised by quantiles and histograms when present
-FIGURES = ("depth_mm", "Hx_mm", "Hy_mm", "residual_speed_m_s", "charge_peak_acceleration_m_s2",
+FIGURES = ("depth_mm", "Hx_mm", "residual_speed_m_s", "charge_peak_acceleration_m_s2",
            "peak_acceleration_m_s2", "max_peeq", "mass_loss_percent")
 
 
 def _column(rows, name) -> np.ndarray:
+    """A numeric column (NaN where absent); the residual speed only of the perforated shots (an embedded
+    shot's is the sideways drift left when it stops advancing)."""
+    if name == "residual_speed_m_s":
+        rows = [r for r in rows if r.get("outcome") == "perforated"]
     return np.array([r[name] if isinstance(r.get(name), (int, float)) and not isinstance(r.get(name), bool)
                      else np.nan for r in rows], float)
 
@@ -47,7 +51,7 @@ def write(sweep, cols, rows, out: Path) -> list[Path]:
     keys = [k for k in sweep.keys if np.isfinite(_column(rows, k)).all()]
     depth = _column(rows, "depth_mm")
     outcome = [r.get("outcome", r["status"]) for r in rows]
-    if keys and np.isfinite(depth).any():
+    if keys and np.isfinite(depth).any() and len(depth) == len(rows):
         n = len(keys)
         ncol = min(n, 3)
         fig, axes = plt.subplots(math.ceil(n / ncol), ncol, figsize=(4.2 * ncol, 3.4 * math.ceil(n / ncol)),
@@ -81,7 +85,7 @@ def write(sweep, cols, rows, out: Path) -> list[Path]:
                 ax.hist(v, bins=min(60, max(10, int(np.sqrt(len(v))))), color="tab:blue", alpha=0.75)
                 for p, style in (("P5", ":"), ("P50", "-"), ("P95", ":")):
                     ax.axvline(q[p], color="k", ls=style, lw=1)
-                ax.set_xlabel(name)
+                ax.set_xlabel(name + (" (perforated)" if name == "residual_speed_m_s" else ""))
                 ax.set_ylabel("shots")
                 ax.set_title(f"P5 {q['P5']:.4g}, P50 {q['P50']:.4g}, P95 {q['P95']:.4g}", fontsize=9)
             fig.suptitle(f"Monte Carlo, {len(rows)} shots")
@@ -113,7 +117,8 @@ def report(sweep, rows, wall_s: float, ran: int, ranks: int, ranks_per_shot: int
         for name in names:
             q = quantiles(_column(rows, name))
             if q["count"]:
-                lines.append(f"| `{name}` | {q['count']} | " + " | ".join(
+                label = f"`{name}`" + (" (perforated)" if name == "residual_speed_m_s" else "")
+                lines.append(f"| {label} | {q['count']} | " + " | ".join(
                     f"{q[p]:.5g}" for p in ("mean", "std", "min", "P5", "P50", "P95", "max")) + " |")
     lines += ["", "Files: sweep.csv (one row per shot), costs.csv (wall time per shot), shots.jsonl (the records, "
               "full precision), sweep.json, sweep.png" + (", histograms.png" if sweep.kind == "monte-carlo" else "")
