@@ -33,8 +33,9 @@ lint: setup
 
 bench: setup
 	$(PY) benchmarks/mesh_cost.py
-	$(PY) benchmarks/step_cost.py
-	mpirun -n $(NP) $(PY) benchmarks/step_cost.py 2.5
+	$(PY) benchmarks/wall_step_cost.py
+	mpirun -n $(NP) $(PY) benchmarks/wall_step_cost.py 2.5
+	$(PY) benchmarks/step_cost.py --ranks $(NP) --label "make bench"
 	$(PY) benchmarks/rigid_shot.py
 	$(PY) benchmarks/shot_cost.py 1 2
 

@@ -56,8 +56,9 @@ class StepTimes:
     kinematics: float = 0.0
     material: float = 0.0
     assembly: float = 0.0
-    boundary: float = 0.0
+    boundary: float = 0.0  #: the external load (the target's collectives included) and the interface
     update: float = 0.0
+    target_comm: float = 0.0  #: of boundary: the target load's broadcasts, reductions and ghost sum
 
 
 #: steps between two evaluations of the stable step

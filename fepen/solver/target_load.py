@@ -8,6 +8,8 @@ the owned nodes' external force.
 
 from __future__ import annotations
 
+from time import perf_counter
+
 import numpy as np
 from dolfinx import la
 from mpi4py import MPI
@@ -37,19 +39,32 @@ class TargetLoad:
         self.wear = None  # a fepen.solver.recession.Recession fed each step's point loads, or None
 
     def __call__(self, solver) -> None:
+        t0 = perf_counter()
         x_all = solver.positions()
         tip = solver.node_value(self.tip, x_all)
         axis = unit_axis(tip, solver.node_value(self.tail, x_all))
+        comm_s = perf_counter() - t0  # the two broadcasts (and the positions)
+
+        def reduce(a):
+            nonlocal comm_s
+            t1 = perf_counter()
+            a = solver.comm.allreduce(a, op=MPI.SUM)
+            comm_s += perf_counter() - t1
+            return a
+
         x, v, area, n = self.surf.kinematics(x_all, solver.Vel)
         s = self.surf
         load = tg.load_on_points(self.law, x, v, n, area, s.radius, s.R_meridian, s.sin_phi0, axis, self.crater,
-                                 -tip[1], lambda a: solver.comm.allreduce(a, op=MPI.SUM))
+                                 -tip[1], reduce)
         arr = self.buf.array.reshape(-1, 3)
         arr[:] = 0.0
         self.surf.to_nodes(load.force, arr)
         if self.wear is not None:
             self.wear.add(load.force, n, v, solver.dt)
+        t1 = perf_counter()
         self.buf.scatter_reverse(la.ScatterMode.add)
+        comm_s += perf_counter() - t1
         n_own = solver.n_owned
         solver.fext[:n_own] += arr[:n_own]
         self.force, self.contact_nodes, self.area = load.total, load.loaded, load.area
+        solver.times.target_comm += comm_s
