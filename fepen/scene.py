@@ -254,9 +254,9 @@ SCHEMA: dict[str, Key] = {
     "run.output_interval": _pos(5.0e-5, "s", 1.0),
     "run.safety_factor": _num(0.8, "", 0.0, 1.0, lo_open=True,
                               doc="stable step = factor * (the estimate of run.stable_step)"),
-    "run.stable_step": _choice("altitude", "altitude", "eigenvalue",
-                               doc="altitude: min h/c (conservative); eigenvalue: 2/omega_max of the "
-                                   "discrete body (power iteration), tracked by h/c as it deforms"),
+    "run.stable_step": _choice("eigenvalue", "altitude", "eigenvalue",
+                               doc="eigenvalue: 2/omega_max of the discrete body (power iteration), tracked "
+                                   "by h/c as it deforms; altitude: min h/c (conservative)"),
     "run.fields": _flag(True, doc="write fields.xdmf"),
     "run.acceleration_filter_hz": _num(1.0e4, "Hz", 0.0, 1.0e7,
                                        doc="low-pass cut-off of the filtered accelerations (accelerations.csv); "
