@@ -388,6 +388,23 @@ def plastic_pass(x, dt, dofs, grad0, vol0, mat, params, s, eps_p, temp, sy0, P_o
             _piola(P_out, e, True, s0 * f, s1 * f, s2 * f, s3 * f, s4 * f, s5 * f, C)
 
 
+@numba.njit(cache=True, error_model="numpy")
+def internal_force(P, dofs, grad0, vol0, f):
+    """The internal nodal forces f_a = Σ_e V0_e P_e grad0_{e,a} (the form ∫ P : ∇_X w dX of one-point P1
+    cells), added into f (n_nodes, 3) over the cells of dofs (rows of P beyond them are not read)."""
+    for e in range(dofs.shape[0]):
+        v = vol0[e]
+        P00, P01, P02 = v * P[e, 0], v * P[e, 1], v * P[e, 2]
+        P10, P11, P12 = v * P[e, 3], v * P[e, 4], v * P[e, 5]
+        P20, P21, P22 = v * P[e, 6], v * P[e, 7], v * P[e, 8]
+        for a in range(4):
+            nd = dofs[e, a]
+            g0, g1, g2 = grad0[e, a, 0], grad0[e, a, 1], grad0[e, a, 2]
+            f[nd, 0] += P00 * g0 + P01 * g1 + P02 * g2
+            f[nd, 1] += P10 * g0 + P11 * g1 + P12 * g2
+            f[nd, 2] += P20 * g0 + P21 * g1 + P22 * g2
+
+
 @numba.njit(cache=True, fastmath=_FAST, error_model="numpy")
 def static_flow_stress(mat, params, eps_p, temp, out):
     """σ_y(ε_p, ε̇ = 0, T) of every cell into out (inf for elastic materials and eroded cells)."""

@@ -39,16 +39,18 @@ class TargetLoad:
         self.wear = None  # a fepen.solver.recession.Recession fed each step's point loads, or None
 
     def __call__(self, solver) -> None:
+        x_all = solver.x  # the positions of this step's forces (ExplicitSolver._forces)
         t0 = perf_counter()
-        x_all = solver.positions()
-        tip = solver.node_value(self.tip, x_all)
-        axis = unit_axis(tip, solver.node_value(self.tail, x_all))
-        comm_s = perf_counter() - t0  # the two broadcasts (and the positions)
+        tip, tail = solver.node_values((self.tip, self.tail), x_all)  # one reduction for both
+        comm_s = perf_counter() - t0
+        axis = unit_axis(tip, tail)
 
         def reduce(a):
             nonlocal comm_s
             t1 = perf_counter()
-            a = solver.comm.allreduce(a, op=MPI.SUM)
+            a = np.array(a, dtype=float)
+            if solver.comm.size > 1:
+                solver.comm.Allreduce(MPI.IN_PLACE, a, op=MPI.SUM)
             comm_s += perf_counter() - t1
             return a
 

@@ -239,3 +239,17 @@ def test_calibrated_critical_step_is_the_stability_limit():
     s = explicit.ExplicitSolver(pm.mesh, [M.elastic(210e9, 0.3, 7850.0)], cells, 0.8)
     dt, gain = s.calibrate_step()
     assert 1.5 < gain < 3.0 and s.dt == pytest.approx(0.8 * dt, rel=1e-12)
+
+
+def test_internal_force_is_the_compiled_forms_vector():
+    """The solver's own pass over the cells (kernels.internal_force) gives dolfinx's assembly of the
+    internal-force form, to round-off, for any P."""
+    pm = setup.mesh(scene.load(None, ["mesh.size=0.006"]), MPI.COMM_SELF)
+    cells = np.zeros(pm.mesh.topology.index_map(3).size_local, dtype=np.int64)
+    s = explicit.ExplicitSolver(pm.mesh, [M.elastic(210e9, 0.3, 7850.0)], cells, 0.8)
+    s.P_packed[: s.n_cells] = np.random.default_rng(5).standard_normal((s.n_cells, 9)) * 1e8
+    ref = np.zeros_like(s.fint_fn.x.array)
+    s.assemble_form(ref)
+    s.assemble_internal_force()
+    scale = np.abs(ref).max()
+    assert np.abs(s.fint_fn.x.array - ref).max() < 1e-12 * scale
