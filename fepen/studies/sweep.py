@@ -245,9 +245,37 @@ def read(path, sets=()) -> Sweep:
     Raises:
         InputError: naming the sweep key (or the shot and the scene key) and what is allowed.
     """
+    path = Path(path)
+    spec = _load(path)
+    kinds = [k for k in ("grid", "monte_carlo", "table") if k in spec]
+    if len(kinds) != 1:
+        raise InputError("SWEEP", "give exactly one of [grid], [monte_carlo] and [table]")
+    base = _base_keys(path, spec, sets)
+    resolved = fscene.Scene(base)  # the base alone must be a valid scene
+    kind = kinds[0]
+    if kind == "grid":
+        keys, shots = _grid(spec["grid"])
+    elif kind == "monte_carlo":
+        keys, shots = _monte_carlo(spec["monte_carlo"], resolved)
+    else:
+        tab = spec["table"]
+        if not isinstance(tab, dict) or not isinstance(tab.get("file"), str):
+            raise InputError("table.file", "the CSV file of shots (a string)")
+        keys, shots = _read_table((path.parent / tab["file"]).resolve())
+    if any(k in IMPACT for k in keys) and "impact.shot" in base:
+        # the shot's three impact values become plain keys, so that the varied ones may replace them
+        del base["impact.shot"]
+        for k in IMPACT:
+            base.setdefault(k, resolved.get(k))
+    keep, digits = _output(spec.get("output", {}))
+    sweep = Sweep(kind.replace("_", "-"), base, keys, shots, keep, digits, spec)
+    _check_shots(sweep)
+    return sweep
+
+
+def _load(path: Path) -> dict:
     import tomllib
 
-    path = Path(path)
     try:
         spec = tomllib.loads(path.read_text())
     except OSError as err:
@@ -258,9 +286,11 @@ def read(path, sets=()) -> Sweep:
     for k in spec:
         if k not in known:
             raise InputError(k, f"not a sweep section; allowed: {', '.join(sorted(known))}")
-    kinds = [k for k in ("grid", "monte_carlo", "table") if k in spec]
-    if len(kinds) != 1:
-        raise InputError("SWEEP", "give exactly one of [grid], [monte_carlo] and [table]")
+    return spec
+
+
+def _base_keys(path: Path, spec: dict, sets) -> dict:
+    """The base scene's given keys: the scene file, then [base], then --set."""
     base = {}
     if "scene" in spec:
         if not isinstance(spec["scene"], str):
@@ -279,54 +309,45 @@ def read(path, sets=()) -> Sweep:
     for k in base:
         if k not in fscene.SCHEMA:
             raise fscene._unknown(k)
-    resolved = fscene.Scene(base)  # the base alone must be a valid scene
-    kind = kinds[0]
-    if kind == "grid":
-        grid = spec["grid"]
-        if not isinstance(grid, dict) or not grid:
-            raise InputError("grid", "a table of scene keys, each with a list or a range")
-        values = _flat_leaves(grid, lambda d: "start" in d)
-        for k in values:
-            _check_key("grid", k)
-        values = {k: _grid_values(k, v) for k, v in values.items()}
-        keys = list(values)
-        shots = [dict(zip(keys, combo)) for combo in _product([values[k] for k in keys])]
-    elif kind == "monte_carlo":
-        mc = spec["monte_carlo"]
-        allowed = {"samples", "seed", "latin_hypercube", "vary"}
-        for k in mc:
-            if k not in allowed:
-                raise InputError(f"monte_carlo.{k}",
-                                 f"not a key of [monte_carlo]; allowed: {', '.join(sorted(allowed))}")
-        n = mc.get("samples")
-        if isinstance(n, bool) or not isinstance(n, int) or not 1 <= n <= 10_000_000:
-            raise InputError("monte_carlo.samples", f"an integer in [1, 10000000], got {n!r}")
-        seed = mc.get("seed", 0)
-        if isinstance(seed, bool) or not isinstance(seed, int) or seed < 0:
-            raise InputError("monte_carlo.seed", f"a non-negative integer, got {seed!r}")
-        lhs = mc.get("latin_hypercube", False)
-        if not isinstance(lhs, bool):
-            raise InputError("monte_carlo.latin_hypercube", f"true or false, got {lhs!r}")
-        vary = mc.get("vary")
-        if not isinstance(vary, dict) or not vary:
-            raise InputError("monte_carlo.vary", "a table of scene keys, each with its distribution")
-        specs = _flat_leaves(vary, lambda d: "distribution" in d)
-        for k in specs:
-            _check_key("monte_carlo.vary", k)
-        dists = {k: _distribution(k, v, resolved.get(k)) for k, v in specs.items()}
-        keys = list(dists)
-        shots = monte_carlo(dists, n, seed, lhs)
-    else:
-        tab = spec["table"]
-        if not isinstance(tab, dict) or not isinstance(tab.get("file"), str):
-            raise InputError("table.file", "the CSV file of shots (a string)")
-        keys, shots = _read_table((path.parent / tab["file"]).resolve())
-    if any(k in IMPACT for k in keys) and "impact.shot" in base:
-        # the shot's three impact values become plain keys, so that the varied ones may replace them
-        del base["impact.shot"]
-        for k in IMPACT:
-            base.setdefault(k, resolved.get(k))
-    output = spec.get("output", {})
+    return base
+
+
+def _grid(grid) -> tuple[list, list]:
+    if not isinstance(grid, dict) or not grid:
+        raise InputError("grid", "a table of scene keys, each with a list or a range")
+    values = _flat_leaves(grid, lambda d: "start" in d)
+    for k in values:
+        _check_key("grid", k)
+    values = {k: _grid_values(k, v) for k, v in values.items()}
+    keys = list(values)
+    return keys, [dict(zip(keys, combo)) for combo in _product([values[k] for k in keys])]
+
+
+def _monte_carlo(mc, resolved) -> tuple[list, list]:
+    allowed = {"samples", "seed", "latin_hypercube", "vary"}
+    for k in mc:
+        if k not in allowed:
+            raise InputError(f"monte_carlo.{k}", f"not a key of [monte_carlo]; allowed: {', '.join(sorted(allowed))}")
+    n = mc.get("samples")
+    if isinstance(n, bool) or not isinstance(n, int) or not 1 <= n <= 10_000_000:
+        raise InputError("monte_carlo.samples", f"an integer in [1, 10000000], got {n!r}")
+    seed = mc.get("seed", 0)
+    if isinstance(seed, bool) or not isinstance(seed, int) or seed < 0:
+        raise InputError("monte_carlo.seed", f"a non-negative integer, got {seed!r}")
+    lhs = mc.get("latin_hypercube", False)
+    if not isinstance(lhs, bool):
+        raise InputError("monte_carlo.latin_hypercube", f"true or false, got {lhs!r}")
+    vary = mc.get("vary")
+    if not isinstance(vary, dict) or not vary:
+        raise InputError("monte_carlo.vary", "a table of scene keys, each with its distribution")
+    specs = _flat_leaves(vary, lambda d: "distribution" in d)
+    for k in specs:
+        _check_key("monte_carlo.vary", k)
+    dists = {k: _distribution(k, v, resolved.get(k)) for k, v in specs.items()}
+    return list(dists), monte_carlo(dists, n, seed, lhs)
+
+
+def _output(output) -> tuple[bool, int]:
     if not isinstance(output, dict) or set(output) - {"keep_results", "digits"}:
         raise InputError("output", "a table of keep_results (true or false) and digits (3 to 17)")
     keep = output.get("keep_results", False)
@@ -335,9 +356,7 @@ def read(path, sets=()) -> Sweep:
     digits = output.get("digits", 6)
     if isinstance(digits, bool) or not isinstance(digits, int) or not 3 <= digits <= 17:
         raise InputError("output.digits", f"an integer in [3, 17], got {digits!r}")
-    sweep = Sweep(kind.replace("_", "-"), base, keys, shots, keep, digits, spec)
-    _check_shots(sweep)
-    return sweep
+    return keep, digits
 
 
 def _product(lists):
