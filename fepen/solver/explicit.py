@@ -3,6 +3,7 @@ internal-force form, energies, failure checks (docs/theory.md §3, §6, §11).""
 
 from __future__ import annotations
 
+import math
 from dataclasses import dataclass
 from time import perf_counter
 from typing import Protocol
@@ -63,6 +64,8 @@ class StepTimes:
 
 #: steps between two evaluations of the stable step
 STEP_EVERY = 4
+#: the eigenvalue step's gain over the altitude estimate is rounded down to a multiple of this (calibrate_step)
+GAIN_QUANTUM = 0.005
 
 
 class Load(Protocol):
@@ -289,7 +292,7 @@ class ExplicitSolver:
 
         K d is the internal force of a tiny displacement ε d from the reference state (the solver's own
         element, nodal pressure included), so ω_max is that of the discrete system actually integrated.
-        Sets ``step_gain`` = (2/ω_max) / min(h/c), by which the altitude estimate is multiplied from then
+        Sets ``step_gain`` = (2/ω_max) / min(h/c) (rounded down to a multiple of GAIN_QUANTUM), by which the altitude estimate is multiplied from then
         on (it keeps tracking the deformed mesh). Call before set_initial: the state is zeroed after.
         The start vector is a smooth-free oscillating field of the reference positions, the same on any
         partition. The Rayleigh quotient approaches ω_max² from below, so the safety factor keeps a margin.
@@ -330,7 +333,10 @@ class ExplicitSolver:
                                                    self.speed, np.empty_like(self.nodal_vol))
         h_c = self.comm.allreduce(h_c, op=MPI.MIN)
         dt_crit = 2.0 / np.sqrt(lam)
-        self.step_gain = dt_crit / h_c
+        # rounded down to a multiple of GAIN_QUANTUM: the Rayleigh quotient of a 1e-9 L displacement carries
+        # round-off of ~1e-6 that depends on the partition; rounded, the step is the same on any number of
+        # ranks (unless the gain falls within ~1e-6 of a multiple), and at most GAIN_QUANTUM / 2 smaller
+        self.step_gain = max(math.floor(dt_crit / h_c / GAIN_QUANTUM) * GAIN_QUANTUM, GAIN_QUANTUM)
         self.dt = self.dt0 = self.dt_min = self.stable_step()
         return dt_crit, self.step_gain
 
