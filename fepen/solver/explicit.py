@@ -292,7 +292,8 @@ class ExplicitSolver:
 
         K d is the internal force of a tiny displacement ε d from the reference state (the solver's own
         element, nodal pressure included), so ω_max is that of the discrete system actually integrated.
-        Sets ``step_gain`` = (2/ω_max) / min(h/c) (rounded down to a multiple of GAIN_QUANTUM), by which the altitude estimate is multiplied from then
+        Sets ``step_gain`` = (2/ω_max) / min(h/c) (rounded down to a multiple of GAIN_QUANTUM), by which the
+        altitude estimate is multiplied from then
         on (it keeps tracking the deformed mesh). Call before set_initial: the state is zeroed after.
         The start vector is a smooth-free oscillating field of the reference positions, the same on any
         partition. The Rayleigh quotient approaches ω_max² from below, so the safety factor keeps a margin.
