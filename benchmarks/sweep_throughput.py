@@ -3,7 +3,7 @@
 the projectile's load points and the compiled kernels kept, as a sweep keeps them), and a Monte Carlo sweep
 of SHOTS rigid shots (v0 ± 20 m/s, obliquity ± 1°, yaw ± 0.5°, f_c ± 10 %) serially and on 2 workers (two
 MPI ranks taking shots from the queue). Prints ms per shot per core and the projection for 10,000 shots on 2
-cores; writes benchmarks/results/sweep_throughput.md.
+cores; writes benchmarks/sweep_throughput_results.md.
 
     .venv/bin/python benchmarks/sweep_throughput.py [SHOTS [DIR]]   (default 2000; serially, it starts mpirun;
                                                                       DIR: keep the two sweeps in DIR/w1, DIR/w2)
@@ -76,8 +76,7 @@ def main():
         same = (tmp / "w1" / "sweep.csv").read_text() == (tmp / "w2" / "sweep.csv").read_text()
         say(f"tables of 1 and 2 workers identical: {same}")
         say(f"projected 10,000 rigid shots on 2 cores: {walls[2] / n * 10000 / 60:.1f} min")
-    out = Path(__file__).with_name("results") / "sweep_throughput.md"
-    out.parent.mkdir(exist_ok=True)
+    out = Path(__file__).with_name("sweep_throughput_results.md")
     out.write_text("# Rigid shots in a sweep\n\n`benchmarks/sweep_throughput.py " + str(n) + "`, 2 cores.\n\n"
                    + "\n".join(f"- {ln}" for ln in lines) + "\n")
 
