@@ -39,7 +39,7 @@ class TargetLoad:
         self.wear = None  # a fepen.solver.recession.Recession fed each step's point loads, or None
 
     def __call__(self, solver) -> None:
-        x_all = solver.x  # the positions of this step's forces (ExplicitSolver._forces)
+        x_all = solver.positions()  # not solver.x: a load may be evaluated on a state set by hand (wear playback)
         t0 = perf_counter()
         tip, tail = solver.node_values((self.tip, self.tail), x_all)  # one reduction for both
         comm_s = perf_counter() - t0

@@ -31,8 +31,8 @@ def configurations(quick: bool = False) -> list[dict]:
     if quick:
         runs.append({"name": "rigid", "group": "fidelity", "h": 0.006,
                      "sets": ["mesh.size=0.006", "effects.fidelity=rigid"]})
-        runs.append({"name": "eigenvalue-step-6mm", "group": "cheaper", "h": 0.006,
-                     "sets": ["mesh.size=0.006", "run.stable_step=eigenvalue"]})
+        runs.append({"name": "altitude-step-6mm", "group": "costlier", "h": 0.006,
+                     "sets": ["mesh.size=0.006", "run.stable_step=altitude"]})
         return runs
     h = 0.0025
     ladder = [
@@ -48,8 +48,8 @@ def configurations(quick: bool = False) -> list[dict]:
     for name, sets in ladder:
         runs.append({"name": name, "group": "fidelity", "h": h, "sets": [f"mesh.size={h}", *sets]})
     for hh in (0.0025, FINEST):
-        runs.append({"name": f"eigenvalue-step-{hh * 1e3:g}mm", "group": "cheaper", "h": hh,
-                     "sets": [f"mesh.size={hh}", "run.stable_step=eigenvalue"]})
+        runs.append({"name": f"altitude-step-{hh * 1e3:g}mm", "group": "costlier", "h": hh,
+                     "sets": [f"mesh.size={hh}", "run.stable_step=altitude"]})
     runs.append({"name": "graded-4mm-nose1.6mm", "group": "cheaper", "h": 0.004,
                  "sets": ["mesh.size=0.004", "mesh.nose_size=0.0016"]})
     runs.append({"name": "default-2.5mm-1rank", "group": "ranks", "h": 0.0025, "sets": ["mesh.size=0.0025"],
@@ -225,7 +225,7 @@ def pareto(rows, path: Path) -> None:
     import matplotlib.pyplot as plt
 
     fig, axes = plt.subplots(1, 2, figsize=(12, 5))
-    marks = {"mesh": "o", "fidelity": "s", "cheaper": "^", "ranks": "D"}
+    marks = {"mesh": "o", "fidelity": "s", "cheaper": "^", "costlier": "v", "ranks": "D"}
     colours = {"C3": "tab:blue", "C7": "tab:red"}
     for ax, key, label in ((axes[0], "nose_error", "nose error against Table 1"),
                            (axes[1], "H_vs_finest", "nose position against the finest run")):
