@@ -18,20 +18,9 @@ from mpi4py import MPI
 
 from fepen import scene
 from fepen.runs.rigid import RigidRun
-from fepen.studies import processes
+from fepen.studies import processes, sweep
 
-MC = """scene = "{root}/scenes/default.toml"
-[base]
-effects.fidelity = "rigid"
-[monte_carlo]
-samples = {n}
-seed = 2026
-[monte_carlo.vary]
-"impact.velocity" = {{ distribution = "normal", std = 20.0 }}
-"impact.obliquity_deg" = {{ distribution = "truncated-normal", std = 1.0, low = 0.0 }}
-"impact.attack_deg" = {{ distribution = "normal", std = 0.5 }}
-"target.compressive_strength" = {{ distribution = "normal", std_percent = 10.0 }}
-"""
+DEMO = processes.ROOT / "demos" / "studies" / "c3_scatter.toml"  # seed 2026, resized to SHOTS
 
 
 def main():
@@ -62,7 +51,7 @@ def main():
         warm.sort()
         say(f"rigid C3, one `fepen run` process: {process_s:.2f} s; in-process, first: {1e3 * first_s:.0f} ms; "
             f"warm: median {1e3 * warm[10]:.1f} ms, best {1e3 * warm[0]:.1f} ms")
-        (tmp / "mc.toml").write_text(MC.format(root=processes.ROOT, n=n))
+        (tmp / "mc.toml").write_text(sweep.resized(DEMO, n))
         walls = {}
         for workers in (1, 2):
             t0 = time.perf_counter()

@@ -47,7 +47,7 @@ import numpy as np
 from fepen import scene as fscene
 from fepen.errors import InputError
 
-__all__ = ["Sweep", "read", "run", "table_rows", "DISTRIBUTIONS"]
+__all__ = ["Sweep", "read", "run", "table_rows", "resized", "DISTRIBUTIONS"]
 
 #: distribution name: its parameters (mean absent: the base scene's value)
 DISTRIBUTIONS = {"normal": ("mean", "std"), "uniform": ("low", "high"),
@@ -91,6 +91,20 @@ class Sweep:
             return fscene.Scene({**self.base, **self.shots[i]})
         except InputError as err:
             raise InputError(f"shot {i}: {err.key}", err.message) from None
+
+
+def resized(path, samples: int, seed: int | None = None) -> str:
+    """The text of a Monte Carlo sweep file with another sample size (and seed), its base scene made absolute:
+    for tests and benchmarks of a shipped sweep file."""
+    import re
+
+    path = Path(path).resolve()
+    text = path.read_text()
+    text = re.sub(r"(?m)^scene = \"(.*)\"", lambda m: f'scene = "{(path.parent / m.group(1)).resolve()}"', text)
+    text = re.sub(r"(?m)^samples = \d+", f"samples = {samples}", text)
+    if seed is not None:
+        text = re.sub(r"(?m)^seed = \d+", f"seed = {seed}", text)
+    return text
 
 
 def _flat_leaves(tree: dict, is_leaf, prefix: str = "") -> dict:

@@ -10,20 +10,9 @@ import time
 import pytest
 from conftest import run_fepen
 
-from fepen.studies import processes
+from fepen.studies import processes, sweep
 
-MC = """scene = "{root}/scenes/default.toml"
-[base]
-effects.fidelity = "rigid"
-[monte_carlo]
-samples = {n}
-seed = 11
-[monte_carlo.vary]
-"impact.velocity" = {{ distribution = "normal", std = 20.0 }}
-"impact.obliquity_deg" = {{ distribution = "truncated-normal", std = 1.0, low = 0.0 }}
-"impact.attack_deg" = {{ distribution = "normal", std = 0.5 }}
-"target.compressive_strength" = {{ distribution = "normal", std_percent = 10.0 }}
-"""
+DEMO = processes.ROOT / "demos" / "studies" / "c3_scatter.toml"  # the shipped C3 scatter, resized
 N = 120
 
 
@@ -31,7 +20,7 @@ N = 120
 def mc(tmp_path_factory):
     """The sweep file and its uninterrupted serial run."""
     d = tmp_path_factory.mktemp("mc")
-    (d / "mc.toml").write_text(MC.format(root=processes.ROOT, n=N))
+    (d / "mc.toml").write_text(sweep.resized(DEMO, N, seed=11))
     r = run_fepen("sweep", d / "mc.toml", "--out", d / "serial", "--workers", "1")
     assert r.returncode == 0, r.stderr
     return d
@@ -86,7 +75,7 @@ def test_killed_sweep_runs_only_the_missing_shots(mc):
 
 def test_another_sweep_into_the_same_directory_is_refused(mc, tmp_path):
     other = tmp_path / "other.toml"
-    other.write_text(MC.format(root=processes.ROOT, n=N + 1))
+    other.write_text(sweep.resized(DEMO, N + 1, seed=11))
     r = run_fepen("sweep", other, "--out", mc / "serial", "--workers", "1")
     assert r.returncode == 2
     assert "--out" in r.stderr and "another sweep" in r.stderr and "Traceback" not in r.stderr
