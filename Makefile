@@ -18,8 +18,8 @@ setup:
 	@bash tools/bootstrap.sh
 
 run: setup
-	mpirun -n $(NP) $(PY) -m fepen run scenes/default.toml --out results/C3
-	$(PY) -m fepen run scenes/default.toml --set effects.fidelity=rigid --out results/C3-rigid
+	mpirun -n $(NP) $(PY) -m fepen run scenes/default.toml --out results/C3 --force
+	$(PY) -m fepen run scenes/default.toml --set effects.fidelity=rigid --out results/C3-rigid --force
 	$(PY) -m fepen mesh scenes/default.toml --out results/C3-mesh
 
 test: setup

@@ -21,7 +21,7 @@ ROOT = Path(__file__).resolve().parents[1]
 def run(ranks: int) -> dict:
     out = Path(tempfile.mkdtemp(prefix="fepen-shot-"))
     t0 = time.perf_counter()
-    processes.run(["run", ROOT / "scenes/default.toml", "--out", out], ranks, check=True)
+    processes.run(["run", ROOT / "scenes/default.toml", "--out", out, "--force"], ranks, check=True)
     whole = time.perf_counter() - t0
     s = json.loads((out / "summary.json").read_text())
     return dict(ranks=ranks, whole=whole, **s["time_split_s"], steps=s["steps"], Hy=s["Hy_mm"])

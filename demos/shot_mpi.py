@@ -27,7 +27,7 @@ def main():
     ap.add_argument("--set", dest="sets", action="append", default=[])
     args = ap.parse_args()
     out = Path(args.out)
-    cmd = ["run", "scenes/default.toml", "--out", out.resolve(), "--set", f'impact.shot="{args.shot}"']
+    cmd = ["run", "scenes/default.toml", "--out", out.resolve(), "--force", "--set", f'impact.shot="{args.shot}"']
     for s in args.sets:
         cmd += ["--set", s]
     r = processes.run(cmd, args.ranks)

@@ -73,6 +73,9 @@ class Result:
 
     def __repr__(self) -> str:
         s = self.summary
+        if "Hx_mm" not in s:  # a run that stopped before its end
+            return (f"fepen.Result({str(self.out)!r}, outcome={s.get('outcome')!r}, "
+                    f"stop_reason={s.get('stop_reason')!r})")
         return (f"fepen.Result({str(self.out)!r}, outcome={s.get('outcome')!r}, Hx_mm={s.get('Hx_mm'):.6g}, "
                 f"Hy_mm={s.get('Hy_mm'):.6g})")
 
@@ -99,7 +102,7 @@ def _comm(comm):
     return MPI.COMM_WORLD if comm is None else comm
 
 
-def run(scene, out=None, comm=None, progress: bool = False) -> Result:
+def run(scene, out=None, comm=None, progress: bool = False, force: bool = False) -> Result:
     """Run one scene, as ``fepen run`` does, and return its Result.
 
     Args:
@@ -107,17 +110,19 @@ def run(scene, out=None, comm=None, progress: bool = False) -> Result:
         out: the results directory; None: a new temporary directory (Result.out names it).
         comm: the MPI communicator of the run; None: COMM_WORLD.
         progress: a progress bar on rank 0.
+        force: when ``out`` holds another run's results, remove them first (else InputError).
 
     Returns:
         The Result.
 
     Raises:
-        InputError: bad input, before anything is meshed or written.
+        InputError: bad input, before anything is meshed or written; ``out`` holding another run's results
+            (without force) or in use by a running one.
         SimulationError: the simulation could not go on (what, where, when); what it wrote is kept.
+        MachineFault: disk full, permission, a signal (fepen.errors); what it wrote is kept and resumable.
     """
     from fepen import scene as fscene
-    from fepen.io import files
-    from fepen.post import figures
+    from fepen.io import files, rundir
     from fepen.runs import run_scene, setup
 
     comm = _comm(comm)
@@ -126,32 +131,44 @@ def run(scene, out=None, comm=None, progress: bool = False) -> Result:
     setup.announce(sc, comm)
     if out is None:
         out = comm.bcast(tempfile.mkdtemp(prefix="fepen-") if comm.rank == 0 else None, root=0)
-    out = files.prepare(out, comm)
-    files.write_text(out / "scene.toml", fscene.to_toml(sc), comm)
-    try:
-        run_scene(sc, out, comm, progress=progress)
-    finally:
-        if (out / "history.csv").exists():
-            figures.history_figure(out, sc, comm)
-    comm.barrier()
+    out = Path(out)
+    with rundir.RunDirectory(out, comm, "force" if force else "new"):
+        files.agree(comm, "scene.toml", lambda: files.write_text(out / "scene.toml", fscene.to_toml(sc), comm))
+        try:
+            run_scene(sc, out, comm, progress=progress)
+        finally:
+            _figure(out, sc, comm)
     return load(out)
 
 
-def resume(results_dir, comm=None, progress: bool = False) -> Result:
-    """Continue a killed deformable run from its last checkpoint (same number of ranks); its Result."""
+def _figure(out: Path, sc, comm) -> None:
+    """history.png of whatever history.csv holds (a full disk leaves the last one)."""
     from fepen.post import figures
+
+    if (out / "history.csv").exists():
+        try:
+            figures.history_figure(out, sc, comm)
+        except OSError:
+            pass
+    comm.barrier()
+
+
+def resume(results_dir, comm=None, progress: bool = False) -> Result:
+    """Continue a killed or interrupted deformable run from its last checkpoint (same number of ranks), or run
+    a stopped rigid run again; its Result."""
+    from fepen.io import rundir
     from fepen.runs import checkpoint, run_scene
 
     comm = _comm(comm)
     out = Path(results_dir)
     if not (out / "scene.toml").exists():
         raise InputError("--resume", f"{out} is not a results directory (no scene.toml)")
-    state = checkpoint.read_state(out, comm)
     sc = Scene(out / "scene.toml")
-    try:
-        run_scene(sc, out, comm, progress=progress, resume=state)
-    finally:
-        if (out / "history.csv").exists():
-            figures.history_figure(out, sc, comm)
-    comm.barrier()
+    rigid = sc.effects.fidelity == "rigid"  # seconds to run: a stopped rigid run runs again from the start
+    state = None if rigid else checkpoint.read_state(out, comm)
+    with rundir.RunDirectory(out, comm, "resume"):
+        try:
+            run_scene(sc, out, comm, progress=progress, resume=state)
+        finally:
+            _figure(out, sc, comm)
     return load(out)

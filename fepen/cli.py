@@ -7,9 +7,13 @@
     fepen study accuracy-cost [--out DIR] [--ranks N] [--quick] [--fresh]
     fepen sweep SWEEP.toml [--out DIR] [--ranks-per-shot K] [--workers W] [--set KEY=VALUE ...] [--fresh]
     fepen keys
+    fepen --version
+    fepen --debug COMMAND ...    (a traceback with every error, for developers)
 
-Bad input prints one line naming the key and what is allowed and exits with code 2, before anything is
-written; an unstable simulation exits with code 3.
+Exit codes (fepen.errors, docs/results.md): 0 success; 2 bad input (one line naming the key or argument and
+what is allowed, before anything is written); 3 the simulation cannot go on (what, where, when); 4 a fault of
+the machine (disk full, permission, a signal that stopped the run after a checkpoint); 1 a bug in fepen. Every
+error is one line on stderr; --debug adds the traceback.
 """
 
 from __future__ import annotations
@@ -17,7 +21,7 @@ from __future__ import annotations
 import argparse
 import sys
 
-from fepen.errors import InputError, SimulationError
+from fepen.errors import InputError, Interrupted, MachineFault, SimulationError, describe_os_error
 
 
 class _Parser(argparse.ArgumentParser):
@@ -26,8 +30,12 @@ class _Parser(argparse.ArgumentParser):
 
 
 def _parser() -> argparse.ArgumentParser:
-    ap = _Parser(prog="fepen", description="Projectile penetrating concrete, projectile-target separation.")
-    sub = ap.add_subparsers(dest="command", required=True, parser_class=_Parser)
+    ap = _Parser(prog="fepen", description="Projectile penetrating concrete, projectile-target separation.",
+                 epilog="Exit codes: 0 success, 2 bad input, 3 the simulation cannot go on, 4 a fault of the "
+                        "machine (disk full, permission, SIGTERM/SIGINT after a checkpoint), 1 a bug. "
+                        "--debug (anywhere): tracebacks.")
+    ap.add_argument("--version", action="store_true", help="print fepen's version and code revision and exit")
+    sub = ap.add_subparsers(dest="command", parser_class=_Parser)
 
     def scene_args(p, out_default):
         p.add_argument("scene", nargs="?", help="scene file (TOML); absent: the default scene")
@@ -38,7 +46,10 @@ def _parser() -> argparse.ArgumentParser:
     run = sub.add_parser("run", help="one simulation: summary.json, history.csv, fields.xdmf, figures")
     scene_args(run, "results/run")
     run.add_argument("--resume", metavar="DIR",
-                     help="continue the killed run in DIR from its last checkpoint (same scene, same ranks)")
+                     help="continue the killed or interrupted run in DIR from its last checkpoint (same scene, "
+                          "same ranks)")
+    run.add_argument("--force", action="store_true",
+                     help="when --out holds another run's results, remove them first (only what fepen writes)")
     scene_args(sub.add_parser("validate", help="the Table 1 sweep: validation.csv, validation.md, figures"),
                "results/validation")
     scene_args(sub.add_parser("mesh", help="build the projectile mesh only: mesh.json, mesh.xdmf, mesh.png"),
@@ -92,8 +103,12 @@ def _parser() -> argparse.ArgumentParser:
 def _say(*lines: str) -> None:
     from mpi4py import MPI
 
+    from fepen.io import rundir
+
     if MPI.COMM_WORLD.rank == 0:
         print(*lines, sep="\n", flush=True)
+        for line in lines:
+            rundir.log_line(line)
 
 
 def cmd_mesh(args) -> int:
@@ -139,12 +154,12 @@ def cmd_run(args) -> int:
     from fepen import api
 
     if args.resume is not None:
-        if args.scene is not None or args.sets:
+        if args.scene is not None or args.sets or args.force:
             raise InputError("--resume", "takes the scene of the run it continues (DIR/scene.toml): give no "
-                                         "scene file and no --set")
+                                         "scene file, no --set and no --force")
         result = api.resume(args.resume, progress=True)
     else:
-        result = api.run(api.Scene(args.scene, sets=args.sets), out=args.out, progress=True)
+        result = api.run(api.Scene(args.scene, sets=args.sets), out=args.out, progress=True, force=args.force)
     summary, out = result.summary, result.out
     keys = ("outcome", "Hx_mm", "Hy_mm", "Tx_mm", "Ty_mm", "length_mm", "residual_speed_m_s", "max_peeq",
             "energy_error", "steps", "dt_s", "wall_s")
@@ -322,18 +337,61 @@ COMMANDS = {"run": cmd_run, "mesh": cmd_mesh, "validate": cmd_validate, "validat
             "study": cmd_study, "sweep": cmd_sweep, "keys": cmd_keys, "view": cmd_view}
 
 
+def version_line() -> str:
+    """``fepen 0.1.0 (revision abc123…)``: the version and the code revision of this source tree."""
+    from fepen.io.rundir import revision
+    from fepen.version import __version__
+
+    rev = revision()
+    return f"fepen {__version__}" + (f" (revision {rev})" if rev else "")
+
+
 def main(argv: list[str] | None = None) -> int:
-    """Entry point of the ``fepen`` console script. Returns the exit code."""
+    """Entry point of the ``fepen`` console script. Returns the exit code (fepen.errors): every error is one
+    line on stderr, with its traceback only under --debug."""
+    argv = list(sys.argv[1:] if argv is None else argv)
+    debug = "--debug" in argv
+    argv = [a for a in argv if a != "--debug"]
     try:
         args = _parser().parse_args(argv)
+        if args.version:
+            _say(version_line())
+            return 0
+        if args.command is None:
+            raise InputError("command line", "name a command: " + ", ".join(COMMANDS) + " (fepen --help)")
         _quiet()
         return COMMANDS[args.command](args)
-    except InputError as err:
-        _error(f"fepen: bad input: {err}")
-        return InputError.exit_code
-    except SimulationError as err:
-        _error(f"fepen: simulation stopped: {err}")
-        return SimulationError.exit_code
+    except BaseException as err:  # noqa: B036 - every way out is one line and a documented code
+        if isinstance(err, SystemExit):
+            return err.code if isinstance(err.code, int) else 0  # --help
+        code, line = _verdict(err)
+        if debug:
+            import traceback
+
+            traceback.print_exc()
+        _error(line)
+        return code
+
+
+def _verdict(err: BaseException) -> tuple[int, str]:
+    """The exit code and the one line of an error."""
+    if isinstance(err, InputError):
+        return InputError.exit_code, f"fepen: bad input: {err}"
+    if isinstance(err, SimulationError):
+        return SimulationError.exit_code, f"fepen: simulation stopped: {err}"
+    if isinstance(err, Interrupted):
+        return MachineFault.exit_code, f"fepen: interrupted: {err}"
+    if isinstance(err, MachineFault):
+        return MachineFault.exit_code, f"fepen: stopped by a fault of the machine: {err}"
+    if isinstance(err, OSError):
+        return MachineFault.exit_code, f"fepen: stopped by a fault of the machine: {describe_os_error(err)}"
+    if isinstance(err, KeyboardInterrupt):
+        return MachineFault.exit_code, "fepen: interrupted (SIGINT) before the run had anything to keep"
+    if isinstance(err, MemoryError):
+        return MachineFault.exit_code, "fepen: stopped by a fault of the machine: out of memory"
+    text = " ".join(str(err).split())[:300]
+    return 1, (f"fepen: internal error (a bug in fepen; run again with --debug for the traceback and report "
+               f"it): {type(err).__name__}: {text}")
 
 
 def _quiet() -> None:
@@ -346,8 +404,11 @@ def _quiet() -> None:
 def _error(line: str) -> None:
     from mpi4py import MPI
 
+    from fepen.io import rundir
+
     if MPI.COMM_WORLD.rank == 0:
         print(line, file=sys.stderr, flush=True)
+        rundir.log_line(line)
 
 
 if __name__ == "__main__":  # pragma: no cover

@@ -1,6 +1,13 @@
 """Exceptions that the command line turns into one readable line and an exit code.
 
-Exit codes (contract): 2 for bad input, 3 for a simulation that became unstable or invalid.
+Exit codes (contract, docs/results.md):
+
+    0  success
+    1  an internal error: a bug in fepen (one line; ``fepen --debug ...`` shows the traceback)
+    2  bad input (InputError): one line naming the key or argument and what is allowed
+    3  the simulation cannot go on (SimulationError): what, where and when; what it wrote is kept
+    4  a fault of the machine (MachineFault): disk full, permission, a file that cannot be read, or a signal
+       (SIGTERM, SIGINT) that stopped the run after a checkpoint; ``fepen run --resume DIR`` continues it
 """
 
 
@@ -31,3 +38,39 @@ class BeyondMethod(SimulationError):
 
     def __init__(self, message: str):
         super().__init__(f"beyond the method: {message}")
+
+
+class MachineFault(OSError):
+    """A fault of the machine, not of the input or the physics: no space left, no permission, an I/O error,
+    or a signal that stopped the run (Interrupted). Exit code 4. The message says what failed and where; the
+    files written before are complete (each is replaced whole, fepen.atomic)."""
+
+    exit_code = 4
+
+    def __init__(self, message: str):
+        super().__init__(message)
+        self.message = message
+
+    def __str__(self) -> str:
+        return self.message
+
+    def __reduce__(self):
+        return (type(self), (self.message,))
+
+
+class Interrupted(MachineFault):
+    """A signal (SIGTERM from a scheduler, SIGINT from Ctrl-C) stopped the run after it wrote a checkpoint.
+    Exit code 4; ``fepen run --resume DIR`` finishes it with the same results."""
+
+
+def describe_os_error(err: OSError) -> str:
+    """One line for an OSError: what the system said and the file it concerns."""
+    import errno
+    import os
+
+    what = {errno.ENOSPC: "no space left on device", errno.EDQUOT: "disk quota exceeded",
+            errno.EACCES: "permission denied", errno.EPERM: "operation not permitted",
+            errno.EROFS: "read-only file system", errno.EIO: "input/output error"}.get(
+        err.errno, err.strerror or os.strerror(err.errno or 0) or type(err).__name__)
+    path = f" ({err.filename})" if err.filename else ""
+    return f"{what}{path}"

@@ -29,7 +29,7 @@ CONTACTS = ("tied", "frictional")
 def run(contact: str, out: Path, ranks: int, sets: list[str]) -> dict:
     from fepen.studies.processes import run_fepen_process
 
-    args = ["run", str(HERE / "charge_800.toml"), "--out", str(out), "--set", f'charge.contact="{contact}"']
+    args = ["run", str(HERE / "charge_800.toml"), "--out", str(out), "--force", "--set", f'charge.contact="{contact}"']
     for s in sets:
         args += ["--set", s]
     code, wall, last = run_fepen_process(args, ranks)

@@ -19,8 +19,8 @@ HERE = Path(__file__).resolve().parent
 
 
 def run(case: Path, size: float, ranks: int, out: Path) -> dict:
-    code, wall, message = run_fepen_process(["run", case, "--out", out, "--set", f"mesh.size={size}", "--set",
-                                             "run.fields=false"], ranks)
+    code, wall, message = run_fepen_process(["run", case, "--out", out, "--force", "--set", f"mesh.size={size}",
+                                             "--set", "run.fields=false"], ranks)
     row = {"case": case.stem, "h_mm": size * 1e3, "exit": code, "process_s": wall}
     if code == 0:
         row.update(json.loads((out / "summary.json").read_text()))

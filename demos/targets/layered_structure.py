@@ -60,7 +60,7 @@ material = "soil"
 """
 
 scene = fepen.Scene(STRUCTURE, sets=[f"effects.fidelity={args.fidelity}", *args.set])
-result = fepen.run(scene, out=out, comm=comm)
+result = fepen.run(scene, out=out, comm=comm, force=True)
 
 # Per layer: when and how fast the nose entered it, and when the whole projectile had left it.
 

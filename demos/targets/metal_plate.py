@@ -62,7 +62,7 @@ rows = []
 for v in (float(x) for x in args.speeds.split(",")):
     scene = fepen.Scene(None, sets=[*ROD, "effects.fidelity=rigid", "effects.free_surface=false",
                                     "target.onset_angle_deg=0", f"impact.velocity={v}", *args.set])
-    depth = fepen.run(scene, out=out / f"rigid-{v:.0f}", comm=comm).summary["depth_mm"]
+    depth = fepen.run(scene, out=out / f"rigid-{v:.0f}", comm=comm, force=True).summary["depth_mm"]
     rows.append((v, depth, 1e3 * closed_form(scene)))
 
 if comm.rank == 0:
@@ -78,6 +78,6 @@ if comm.rank == 0:
 if args.deformable:
     scene = fepen.Scene("[target]\nthickness = 0.06\n", sets=[*ROD, "impact.velocity=800", "mesh.size=0.0015",
                                                                *args.set])
-    s = fepen.run(scene, out=out / "deformable", comm=comm).summary
+    s = fepen.run(scene, out=out / "deformable", comm=comm, force=True).summary
     if comm.rank == 0:
         print(f"deformable: {s['outcome']}, residual {s['residual_speed_m_s']:.0f} m/s, max PEEQ {s['max_peeq']:.3f}")

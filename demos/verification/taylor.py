@@ -30,7 +30,7 @@ def main():
         toml, measured = CASES[name]
         for h in args.sizes:
             out = Path(args.out) / f"{toml[:-5]}_{h:g}mm"
-            r = subprocess.run([sys.executable, "-m", "fepen", "run", str(HERE / toml), "--out", str(out),
+            r = subprocess.run([sys.executable, "-m", "fepen", "run", str(HERE / toml), "--out", str(out), "--force",
                                 "--set", f"mesh.size={h * 1e-3}", "--set", "run.fields=false"],
                                capture_output=True, text=True)
             if r.returncode:

@@ -104,18 +104,29 @@ class FieldWriter:
             values: name -> nodal (n_owned, 3), cell (n_cells,) or nodal scalar (n_owned,) array (longer
                 arrays are cut), for every name given.
         """
+        from fepen.io import files
+
         data = {}
         for name in self.nodal + self.nodal_scalar:
             data[name] = self._gather(values[name][: self._n_owned])
         for name in self.cell:
             data[name] = self._gather(values[name][: self._n_cells])
-        if self.comm.rank == 0:
-            data = {k: (v.reshape(-1, 1) if v.ndim == 1 else v) for k, v in data.items()}
-            data = {k: (np.rint(v).astype(np.int32) if k in self.integer else v) for k, v in data.items()}
-            self._write_h5(self._step_file(len(self.times)), data)
-        self.times.append(float(t))
-        if self.comm.rank == 0:
-            self._write_index()
+
+        def write():  # the step file, then the index naming it: a failure leaves the index of the times before
+            files.inject("fields")
+            arrays = {k: (v.reshape(-1, 1) if v.ndim == 1 else v) for k, v in data.items()}
+            arrays = {k: (np.rint(v).astype(np.int32) if k in self.integer else v) for k, v in arrays.items()}
+            self._write_h5(self._step_file(len(self.times)), arrays)
+            self.times.append(float(t))
+            try:
+                self._write_index()
+            except OSError:
+                self.times.pop()
+                raise
+
+        files.agree(self.comm, f"{self.out / 'fields.xdmf'} at t = {t * 1e6:.3f} us", write)
+        if self.comm.rank != 0:
+            self.times.append(float(t))
 
     def _write_index(self) -> None:
         """fields.h5 of external links and fields.xdmf, each replaced atomically (rank 0)."""

@@ -56,15 +56,56 @@ def history_row(t, tip, tail, velocity, force, mass, energies: dict, contact: in
 
 
 def write_history(rows, out: Path, comm=MPI.COMM_WORLD, columns=None) -> None:
-    """history.csv (rank 0, atomically); columns: HISTORY_COLUMNS (default), + CHARGE_COLUMNS with a charge."""
-    if comm.rank != 0:
-        return
-    buf = io.StringIO()
-    w = csv.writer(buf)
-    w.writerow(columns or HISTORY_COLUMNS)
-    for r in rows:
-        w.writerow([f"{v:.9g}" for v in r])
-    files.write_text(Path(out) / "history.csv", buf.getvalue(), comm)
+    """history.csv (rank 0, atomically; collective: a failed write raises MachineFault on every rank, and
+    the file keeps its last complete version); columns: HISTORY_COLUMNS (default), + CHARGE_COLUMNS with a
+    charge."""
+
+    def write():
+        files.inject("history")
+        buf = io.StringIO()
+        w = csv.writer(buf)
+        w.writerow(columns or HISTORY_COLUMNS)
+        for r in rows:
+            w.writerow([f"{v:.9g}" for v in r])
+        files.write_text(Path(out) / "history.csv", buf.getvalue(), comm)
+
+    files.agree(comm, f"{Path(out) / 'history.csv'}", write)
+
+
+def write_summary(out: Path, summary: dict, comm=MPI.COMM_WORLD) -> None:
+    """summary.json (rank 0, atomically; collective like write_history)."""
+
+    def write():
+        files.inject("summary")
+        files.write_json(Path(out) / "summary.json", summary, comm)
+
+    files.agree(comm, f"{Path(out) / 'summary.json'}", write)
+
+
+def stop_summary(scene, rows, outcome: str, reason: str, where: dict, extra: dict) -> dict:
+    """The summary.json of a run that stopped before its end (no collective call: the stop may have come
+    from one rank). It reports no result (no Hx_mm, depth_mm, ...): where the run was when it stopped is in
+    ``stop_where``.
+
+    Args:
+        rows: the history rows so far (possibly none).
+        outcome: "stopped" (exit 3: the simulation could not go on), "interrupted" (exit 4: a signal, after a
+            checkpoint) or "fault" (exit 4: disk full, permission).
+        reason: the one line the console showed.
+        where: step, time and place of the stop (step, t_s, nose_y_mm, ...).
+        extra: further keys (steps, ranks, ...).
+    """
+    where = dict(where)
+    if rows:  # the last recorded state, as a place: no result is reported for a run that did not end
+        last = rows[-1]
+        where.update({"history_t_s": last[COL["t_s"]], "nose_x_mm": last[COL["nose_x_mm"]],
+                      "nose_y_mm": last[COL["nose_y_mm"]], "speed_m_s": last[COL["speed_m_s"]]})
+    out = {"outcome": outcome, "stop_reason": reason, "stop_time_s": where.get("t_s"), "stop_where": where,
+           "exit_code": 3 if outcome == "stopped" else 4, "resumable": outcome != "stopped"}
+    out.update(extra)
+    out["scene"] = scene.as_dict()
+    out["versions"] = {"fepen": files.__version__}
+    return out
 
 
 def comparison(scene, summary: dict) -> dict | None:

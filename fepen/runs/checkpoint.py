@@ -10,6 +10,7 @@ and reads it. Resuming needs the same number of ranks as the run it continues.
 
 from __future__ import annotations
 
+import hashlib
 import json
 import shutil
 from pathlib import Path
@@ -18,11 +19,25 @@ import numpy as np
 
 from fepen.atomic import replacing
 from fepen.errors import InputError
+from fepen.io import files
+from fepen.version import __version__
 
 
-def _atomic_savez(path: Path, **arrays) -> None:
+def _save(path: Path, arrays: dict) -> str:
+    """Write one rank's arrays (atomically); the sha256 of the file."""
+    files.inject("checkpoint")
     with replacing(path, ".npz") as tmp:
         np.savez(tmp, **arrays)
+        digest = _sha256(tmp)
+    return digest
+
+
+def _sha256(path: Path) -> str:
+    h = hashlib.sha256()
+    with open(path, "rb") as f:
+        for block in iter(lambda: f.read(1 << 20), b""):
+            h.update(block)
+    return h.hexdigest()
 
 
 def write(out: Path, comm, step: int, t: float, arrays: dict, meta: dict) -> None:
@@ -35,19 +50,21 @@ def write(out: Path, comm, step: int, t: float, arrays: dict, meta: dict) -> Non
         meta: rank 0's small state (JSON-serialisable), stored in state.json.
     """
     d = Path(out) / "checkpoint"
-    if comm.rank == 0:
-        d.mkdir(exist_ok=True)
-    comm.barrier()
-    _atomic_savez(d / f"step{step:09d}-rank{comm.rank}.npz", **arrays)
-    comm.barrier()
-    if comm.rank == 0:
-        state = {"step": step, "t_s": t, "ranks": comm.size, **meta}
+    files.agree(comm, f"{d}", lambda: d.mkdir(exist_ok=True))
+    name = f"step{step:09d}-rank{comm.rank}.npz"
+    digest = files.agree(comm, f"{d / name}", lambda: _save(d / name, arrays), root_only=False)
+    digests = comm.gather(digest, root=0)
+
+    def finish():  # state.json last, then the older steps' files
+        files.inject("checkpoint")
+        state = {"step": step, "t_s": t, "ranks": comm.size, "fepen": __version__, "sha256": digests, **meta}
         with replacing(d / "state.json") as tmp:
             tmp.write_text(json.dumps(state, indent=1) + "\n")
         for f in d.iterdir():
             if f.name.startswith("step") and not f.name.startswith(f"step{step:09d}-"):
                 f.unlink()
-    comm.barrier()
+
+    files.agree(comm, f"{d / 'state.json'}", finish)
 
 
 def read_state(out: Path, comm) -> dict:
@@ -56,7 +73,15 @@ def read_state(out: Path, comm) -> dict:
     if not path.exists():
         raise InputError("--resume", f"{out} holds no checkpoint (checkpoint/state.json); the deformable "
                                      "fidelities write one every run.checkpoint_interval of simulated time")
-    state = json.loads(path.read_text())
+    try:
+        state = json.loads(path.read_text())
+        state["ranks"], state["step"]  # noqa: B018 - the fields every checkpoint has
+    except (ValueError, KeyError, TypeError):
+        raise InputError("--resume", f"{path} is damaged (not the JSON a checkpoint writes); the run cannot be "
+                                     "resumed from it: run it again with --force") from None
+    if state.get("fepen") != __version__:
+        raise InputError("--resume", f"the checkpoint in {out} was written by fepen {state.get('fepen', '< 0.1')}"
+                                     f", not this fepen {__version__}: run it again with --force")
     if state["ranks"] != comm.size:
         raise InputError("--resume", f"the run in {out} ran on {state['ranks']} ranks; resume it on the same "
                                      f"number (mpirun -n {state['ranks']}), not {comm.size}")
@@ -66,9 +91,20 @@ def read_state(out: Path, comm) -> dict:
 def read_arrays(out: Path, comm, state: dict, root_names: tuple[str, ...]) -> dict:
     """This rank's arrays of the checkpoint that state.json names; ``root_names``, stored by rank 0 only,
     are sent to every rank (absent ones are left out)."""
-    with np.load(Path(out) / "checkpoint" / f"step{state['step']:09d}-rank{comm.rank}.npz") as z:
-        arrays = {k: z[k] for k in z.files if k not in root_names}
-        root = {k: z[k] for k in root_names if k in z.files} if comm.rank == 0 else None
+    path = Path(out) / "checkpoint" / f"step{state['step']:09d}-rank{comm.rank}.npz"
+    arrays, root, problem = {}, None, None
+    try:
+        if _sha256(path) != state["sha256"][comm.rank]:
+            problem = f"{path} does not match its checksum in state.json (a damaged file)"
+        else:
+            with np.load(path) as z:
+                arrays = {k: z[k] for k in z.files if k not in root_names}
+                root = {k: z[k] for k in root_names if k in z.files} if comm.rank == 0 else None
+    except (OSError, ValueError, KeyError, IndexError, TypeError) as err:
+        problem = f"{path} cannot be read ({type(err).__name__}: {err})"
+    problems = [p for p in comm.allgather(problem) if p]
+    if problems:
+        raise InputError("--resume", f"{problems[0]}; the run cannot be resumed from it: run it again with --force")
     arrays.update(comm.bcast(root, root=0))
     return arrays
 

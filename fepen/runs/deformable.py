@@ -7,19 +7,20 @@ travel, y depth into the target, both from the impact point, in mm.
 
 from __future__ import annotations
 
+import logging
 import time
 
 import numpy as np
 from mpi4py import MPI
 
-from fepen.errors import BeyondMethod, InputError
+from fepen.errors import BeyondMethod, InputError, Interrupted, MachineFault, SimulationError
 from fepen.experiments import shot
 from fepen.geometry.frames import unit_axis
 from fepen.io import files, results
 from fepen.io.fields import FieldWriter
 from fepen.laws import layers as fl
 from fepen.post import analyses, paraview, signals, slices
-from fepen.runs import checkpoint, events, model, outputs, rigid
+from fepen.runs import checkpoint, events, interrupts, model, outputs, rigid
 from fepen.solver import explicit
 
 #: steps between two checks of the stop rules in the target (each costs a few reductions)
@@ -61,6 +62,7 @@ class DeformableRun:
         self.profile: dict | None = None
         self.output_s = 0.0
         self.wall_before = 0.0
+        self.stop: BaseException | None = None  # what stopped the run before its end
         sc = scene.run
         self.history = outputs.History(min(sc.output_interval / 10.0, 1e-6))
         self.fields_out = outputs.Fields(sc.output_interval) if sc.fields else None
@@ -85,36 +87,96 @@ class DeformableRun:
 
     # ------------------------------------------------------------------------------------------------
     def run(self) -> dict:
-        """Advance to run.end_time or a stop event; write the outputs; return the summary."""
-        s = self.solver
+        """Advance to run.end_time or a stop event; write the outputs; return the summary. A stop (SimulationError,
+        a signal, a full disk) closes the outputs, writes summary.json with the stop and raises again."""
         t_loop = time.perf_counter()
         outcome, completed = None, False
-        m = self.model
         try:
-            while outcome is None and s.t < self.hard_end:
-                for o in self.outputs:
-                    if o.due(self):
-                        o.write(self)
-                s.step()
-                if m.recession is not None and s.step_count % m.recession.every == 0:
-                    m.recession.apply()
-                if m.erosion is not None:
-                    inside = m.erosion.take_pending()  # cells that inverted within the step, eroded
-                    if (s.step_count % explicit.STEP_EVERY == 1 and m.erosion.check()) or inside:
-                        self._after_erosion()
-                outcome = self.stop_rules()
+            with interrupts.Interrupts(self.comm) as signals:
+                outcome = self.advance(signals)
             self.record()  # the final state
             if self.fields is not None:
                 self.write_fields()
             completed = True
+        except BaseException as err:
+            self.stop = err
+            raise
         finally:
             t_out = time.perf_counter()
-            for o in reversed(self.outputs):
-                o.close(self, completed)
+            self.close_outputs(completed)
             if completed:
                 self.write_analyses()
             self.output_s += time.perf_counter() - t_out
+            if self.stop is not None:
+                self.write_stop(self.stop)
         return self.write_summary(outcome or "ended", time.perf_counter() - t_loop)
+
+    def advance(self, signals) -> str | None:
+        """The time loop: outputs, a step, wear and erosion, the stop rules, and every EVENT_EVERY steps the
+        signals (a caught SIGTERM or SIGINT: interrupt after the next outputs, as a timed checkpoint would).
+        Returns the outcome of a stop rule, or None at the end of time."""
+        s, m = self.solver, self.model
+        outcome = caught = None
+        while outcome is None and s.t < self.hard_end:
+            for o in self.outputs:
+                if o.due(self):
+                    o.write(self)
+            if caught is not None:  # where a checkpoint of the outputs' clock would be taken
+                self.interrupt(caught)
+            s.step()
+            if m.recession is not None and s.step_count % m.recession.every == 0:
+                m.recession.apply()
+            if m.erosion is not None:
+                inside = m.erosion.take_pending()  # cells that inverted within the step, eroded
+                if (s.step_count % explicit.STEP_EVERY == 1 and m.erosion.check()) or inside:
+                    self._after_erosion()
+            outcome = self.stop_rules()
+            if s.step_count % EVENT_EVERY == 0:
+                caught = signals.stop()
+        return outcome
+
+    def interrupt(self, name: str) -> None:
+        """A signal: write a checkpoint of this step and history.csv, then raise Interrupted (collective)."""
+        s = self.solver
+        self.write_history()
+        self.write_checkpoint()
+        raise Interrupted(f"{name} at step {s.step_count}, t = {s.t * 1e6:.3f} us: a checkpoint of that step is "
+                          f"written; `fepen run --resume {self.out}` finishes the run with the same results")
+
+    def close_outputs(self, completed: bool) -> None:
+        """Close every output (history.csv, the fields, the checkpoints, the bar); while stopping, a failing
+        close is logged, not raised (the stop's own error is the one to report)."""
+        for o in reversed(self.outputs):
+            if self.stop is None:
+                o.close(self, completed)
+                continue
+            try:
+                o.close(self, completed)
+            except (OSError, SimulationError) as err:
+                logging.getLogger("fepen").warning(f"while stopping, {type(o).__name__.lower()} output: {err}")
+
+    def write_stop(self, err: BaseException) -> None:
+        """summary.json of a stopped run: outcome, stop_reason, stop_time_s, where (rank 0, no collective; a
+        full disk leaves the previous one)."""
+        s = self.solver
+        if isinstance(err, (Interrupted, KeyboardInterrupt)):
+            outcome = "interrupted"
+        elif isinstance(err, (MachineFault, OSError)):
+            outcome = "fault"
+        elif isinstance(err, SimulationError):
+            outcome = "stopped"
+        else:
+            outcome = "error"
+        where = {"step": s.step_count, "t_s": s.t}
+        reason = str(err).splitlines()[0] if str(err) else type(err).__name__
+        extra = {"steps": s.step_count, "end_time_s": s.t, "ranks": self.comm.size, "mass_kg": s.total_mass,
+                 "wall_s": self.wall_before + time.perf_counter() - self.wall_t0}
+        summary = results.stop_summary(self.scene, self.rows, outcome, reason, where, extra)
+        if self.comm.rank == 0:
+            try:
+                files.write_json(self.out / "summary.json", summary, self.comm)
+            except OSError as e:
+                logging.getLogger("fepen").warning(f"summary.json of the stop not written: {e}")
 
     def stop_rules(self) -> str | None:
         """The outcome if a stop rule fires (fepen.runs.events), else None; BeyondMethod past the failure
@@ -289,7 +351,7 @@ class DeformableRun:
         summary = results.summary(self.scene, self.rows, outcome, extra)
         if self.crossings is not None:
             summary.update(self.crossings.summary(self.model.law, 1e-3 * summary["depth_mm"]))
-        files.write_json(self.out / "summary.json", summary, self.comm)
+        results.write_summary(self.out, summary, self.comm)
         return summary
 
     def removal_summary(self) -> dict:

@@ -63,7 +63,10 @@ class Fields(Timed):
         run.output_s += perf_counter() - t0
 
     def close(self, run, completed: bool) -> None:
-        run.fields.consolidate()
+        from fepen.errors import MachineFault
+
+        if completed or not isinstance(run.stop, (MachineFault, KeyboardInterrupt)):
+            run.fields.consolidate()  # else left as the per-time files a resume goes on from
 
 
 class Checkpoint(Timed):

@@ -66,7 +66,7 @@ def _run(cmd_sets: list[str], out: Path, ranks: int, fresh: bool) -> dict:
         old = json.loads(summary_path.read_text())
         if old.get("scene") == want and old.get("ranks") == ranks and "process_s" in old:
             return old
-    args = ["run", "--out", out]
+    args = ["run", "--out", out, "--force"]
     for s in cmd_sets:
         args += ["--set", s]
     code, process_s, message = processes.run_fepen_process(args, ranks)

@@ -126,7 +126,7 @@ def run_shot(i: int, scene, out, comm) -> dict:
         if out is None and scene.effects.fidelity == "rigid":
             summary = RigidRun(scene, None, comm).run()
         else:
-            summary = api.run(scene, out=out, comm=comm).summary
+            summary = api.run(scene, out=out, comm=comm, force=True).summary  # the study owns its shots' folders
     except SimulationError as err:
         status, message = "stopped", str(err)
     except InputError as err:

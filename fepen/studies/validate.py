@@ -93,7 +93,8 @@ def _side_by_side(scenes, out: Path) -> dict:
             d = files.prepare(out / name, MPI.COMM_SELF)
             files.write_text(d / "scene.toml", fscene.to_toml(sc), MPI.COMM_SELF)
             log = open(d / "run.log", "w")
-            proc = subprocess.Popen([sys.executable, "-m", "fepen", "run", str(d / "scene.toml"), "--out", str(d)],
+            proc = subprocess.Popen([sys.executable, "-m", "fepen", "run", str(d / "scene.toml"), "--out", str(d),
+                                     "--force"],
                                     stdout=log, stderr=subprocess.STDOUT)
             running.append((name, proc, log))
         time.sleep(0.5)

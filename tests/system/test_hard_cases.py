@@ -6,6 +6,7 @@ under mesh refinement, and gives the same result on 1 and 2 ranks; the case beyo
 projectile that would fracture) stops with a clear message, and inverted elements are detected, not hidden.
 """
 
+import json
 import tempfile
 
 import numpy as np
@@ -66,14 +67,17 @@ def test_hard_case_is_stable(name, tmp_path):
 
 def test_case_beyond_the_method_says_so(tmp_path):
     """A projectile that passes the failure strain the user asked to stop at: exit 3, one line saying beyond
-    the method, where and when; the history up to then is kept, no summary (no result) is written."""
+    the method, where and when; the history up to then is kept, the summary says why and where, and reports
+    no result."""
     r = run_fepen("run", CASES / "soft_breaks.toml", "--set", "mesh.size=0.005", "--set", "run.fields=false",
                   "--set", "projectile.failure_strain=0.5", "--out", tmp_path)
     assert r.returncode == 3
     line = r.stderr.strip().splitlines()[-1]
     assert "beyond the method" in line and "behind the nose tip" in line and " us" in line
     assert "Traceback" not in r.stderr
-    assert (tmp_path / "history.csv").exists() and not (tmp_path / "summary.json").exists()
+    assert (tmp_path / "history.csv").exists()
+    summary = json.loads((tmp_path / "summary.json").read_text())
+    assert summary["outcome"] == "stopped" and summary["stop_reason"] in line and "depth_mm" not in summary
 
 
 def test_inverted_elements_are_detected(tmp_path):

@@ -1,5 +1,6 @@
 """The explicit solver against analytic solutions: bar impact, energy, locking, rank-count invariance."""
 
+import json
 import math
 
 import numpy as np
@@ -204,7 +205,10 @@ def test_inverted_elements_stop_the_run(fepen_cli, tmp_path):
     line = [ln for ln in r.stderr.splitlines() if ln.startswith("fepen: simulation stopped:")]
     assert line and " us" in line[0] and ("inverted" in line[0] or "collapsed" in line[0])
     assert "Traceback" not in r.stderr
-    assert (tmp_path / "history.csv").is_file() and not (tmp_path / "summary.json").exists()
+    assert (tmp_path / "history.csv").is_file()
+    summary = json.loads((tmp_path / "summary.json").read_text())  # why and where it stopped, and no result
+    assert summary["outcome"] == "stopped" and summary["exit_code"] == 3 and "Hy_mm" not in summary
+    assert summary["stop_reason"] in line[0] and 0.0 < summary["stop_time_s"] < 1e-4
 
 
 def free_vibration_grows(sc_mesh, dt_over_critical, steps=600):
