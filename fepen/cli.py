@@ -349,7 +349,11 @@ def version_line() -> str:
 def main(argv: list[str] | None = None) -> int:
     """Entry point of the ``fepen`` console script. Returns the exit code (fepen.errors): every error is one
     line on stderr, with its traceback only under --debug."""
+    from fepen.io import rundir
+
     argv = list(sys.argv[1:] if argv is None else argv)
+    rundir.command_line = ["fepen", *map(str, argv)]
+    rundir.forget()
     debug = "--debug" in argv
     argv = [a for a in argv if a != "--debug"]
     try:

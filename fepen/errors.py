@@ -73,4 +73,5 @@ def describe_os_error(err: OSError) -> str:
             errno.EROFS: "read-only file system", errno.EIO: "input/output error"}.get(
         err.errno, err.strerror or os.strerror(err.errno or 0) or type(err).__name__)
     path = f" ({err.filename})" if err.filename else ""
-    return f"{what}{path}"
+    note = " (injected)" if "injected" in (err.strerror or "") else ""
+    return f"{what}{path}{note}"

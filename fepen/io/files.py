@@ -29,7 +29,7 @@ def inject(kind: str) -> None:
     for item in spec.split(","):
         name, _, k = item.partition(":")
         if name == kind and k.isdigit() and _writes[kind] == int(k):
-            raise OSError(errno.ENOSPC, "No space left on device (injected)", f"{kind} write {k}")
+            raise OSError(errno.ENOSPC, f"No space left on device (injected at write {k} of the {kind})")
 
 
 def agree(comm: MPI.Comm, what: str, fn, root_only: bool = True):

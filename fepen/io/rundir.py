@@ -41,6 +41,15 @@ OUTPUT_NAMES = ("summary.json", "run.json", "fepen.log", "scene.toml", "history.
 
 _log_path: Path | None = None
 _transcript: list[str] = []
+#: the command line being run (fepen.cli.main sets it; else this process's)
+command_line: list[str] | None = None
+
+
+def forget() -> None:
+    """A new command: no log yet, nothing kept."""
+    global _log_path
+    _log_path = None
+    _transcript.clear()
 
 
 def log_line(line: str) -> None:
@@ -48,6 +57,7 @@ def log_line(line: str) -> None:
     one is."""
     if _log_path is None:
         _transcript.append(line)
+        del _transcript[:-200]  # what a command says before its run directory exists is short
         return
     _append(_log_path, [line])
 
@@ -125,12 +135,16 @@ class RunDirectory:
 
     def __init__(self, out, comm=MPI.COMM_WORLD, mode: str = "new", command: list[str] | None = None):
         self.out, self.comm, self.mode = Path(out), comm, mode
-        self.command = list(command) if command is not None else [Path(sys.argv[0]).name, *sys.argv[1:]]
+        if command is None:
+            command = command_line or [Path(sys.argv[0]).name, *sys.argv[1:]]
+        self.command = list(command)
         self.record: dict = {}
 
     # ------------------------------------------------------------------------------------------------
     def __enter__(self) -> RunDirectory:
         global _log_path
+        _log_path = None  # lines from here on belong to this run
+        tee_logging(self.comm.rank)
         problem = self._claim() if self.comm.rank == 0 else None
         if self.comm.size > 1:
             problem = self.comm.bcast(problem, root=0)
@@ -138,7 +152,6 @@ class RunDirectory:
             kind, key, message = problem
             raise MachineFault(message) if kind == "fault" else InputError(key, message)
         _log_path = self.out / "fepen.log"
-        tee_logging(self.comm.rank)
         if self.comm.rank == 0:
             _append(_log_path, [f"# {_now()} {self.mode}: {' '.join(self.command)}", *_transcript])
             _transcript.clear()

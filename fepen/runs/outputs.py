@@ -85,7 +85,8 @@ class Checkpoint(Timed):
 
 
 class Progress:
-    """The tqdm bar of rank 0, refreshed every EVERY steps, in microseconds of simulated time."""
+    """The tqdm bar of rank 0, refreshed every EVERY steps, in microseconds of simulated time, to the run's
+    expected end (DeformableRun.expected_end)."""
 
     EVERY = 200
 
@@ -99,6 +100,7 @@ class Progress:
 
     def write(self, run) -> None:
         self.bar.n = round(run.solver.t * 1e6)
+        self.bar.total = max(self.bar.total, self.bar.n)  # a run longer than expected
         self.bar.refresh()
 
     def close(self, run, completed: bool) -> None:

@@ -13,6 +13,7 @@ import time
 import numpy as np
 from mpi4py import MPI
 
+from fepen.errors import Interrupted, SimulationError
 from fepen.geometry import mesh as fmesh
 from fepen.geometry import revolution, tags
 from fepen.io import files, results
@@ -27,7 +28,7 @@ from fepen.laws.rigid_body import (
     quat_to_matrix,
     tet_mass_properties,
 )
-from fepen.runs import events, setup
+from fepen.runs import events, interrupts, setup
 
 #: default RK4 step: the time to travel this fraction of a diameter at the striking speed, and at most
 #: 1/STOP_STEPS of the time the quasi-static force alone would take to stop the projectile
@@ -35,6 +36,8 @@ STEP_FRACTION = 0.2
 STOP_STEPS = 150
 #: load points per ring of the default (mesh-free) rigid body
 RING_SECTORS = 12
+#: steps between two looks at the signals (one reduction under MPI)
+SIGNAL_EVERY = 64
 #: a layered target's run without run.end_time lasts at least this many times the time to reach its last
 #: face at the striking speed
 LAYERED_TIME = 20.0
@@ -191,7 +194,21 @@ class RigidRun:
         self.rows.append(row)
 
     def run(self) -> dict:
-        """Integrate to a stop event or run.end_time; write the outputs; return the summary."""
+        """Integrate to a stop event or run.end_time; write the outputs; return the summary. A stop (a signal,
+        a non-finite state, a full disk) writes summary.json with the stop (when the run has a directory) and
+        raises again."""
+        try:
+            with interrupts.Interrupts(self.comm) as signals:
+                outcome, t_loop = self.integrate(signals)
+            return self.finish(outcome, t_loop)
+        except BaseException as err:
+            if self.out is not None:
+                self.write_stop(err)
+            raise
+
+    def integrate(self, signals) -> tuple[str | None, float]:
+        """The RK4 loop to a stop event or the end time (a caught signal: Interrupted). Returns (the outcome
+        or None, the loop's start on the wall clock)."""
         end = self.scene.get("run.end_time")
         hard_end = end if end is not None else 0.05
         hist_every = max(1, round(1e-6 / self.dt))
@@ -231,9 +248,17 @@ class RigidRun:
                 break
             if self.steps % hist_every == 0:
                 self.record(s, F)
+            if self.steps % SIGNAL_EVERY == 0 and (name := signals.stop()) is not None:
+                raise Interrupted(f"{name} at step {self.steps}, t = {self.t * 1e6:.3f} us: a rigid run keeps no "
+                                  "checkpoint (it takes seconds); `fepen run --resume DIR` runs it again")
         _, F, M = body.derivative(s, self.force_fn)
         self.record(s, F)
         self.state = s
+        return outcome, t_loop
+
+    def finish(self, outcome: str | None, t_loop: float) -> dict:
+        """The summary; history.csv and summary.json when the run has a directory."""
+        body = self.body
         loop_s = time.perf_counter() - t_loop
         extra = {"steps": self.steps, "dt_s": self.dt, "end_time_s": self.t,
                  "wall_s": time.perf_counter() - self.t0,
@@ -247,10 +272,33 @@ class RigidRun:
         if self.crossings is not None:
             summary.update(self.crossings.summary(self.law, 1e-3 * summary["depth_mm"]))
         if self.out is not None:
-            results.write_history(self.rows, self.out, self.comm, results.HISTORY_COLUMNS
-                                  + (results.WEAR_COLUMNS if self.wear is not None else []))
-            files.write_json(self.out / "summary.json", summary, self.comm)
+            results.write_history(self.rows, self.out, self.comm, self.columns)
+            results.write_summary(self.out, summary, self.comm)
         return summary
+
+    @property
+    def columns(self) -> list[str]:
+        return results.HISTORY_COLUMNS + (results.WEAR_COLUMNS if self.wear is not None else [])
+
+    def write_stop(self, err: BaseException) -> None:
+        """history.csv so far and summary.json of the stop (rank 0, no collective; best effort)."""
+        if isinstance(err, (Interrupted, KeyboardInterrupt)):
+            outcome = "interrupted"
+        elif isinstance(err, OSError):
+            outcome = "fault"
+        else:
+            outcome = "stopped" if isinstance(err, SimulationError) else "error"
+        steps, t = getattr(self, "steps", 0), getattr(self, "t", 0.0)
+        reason = str(err).splitlines()[0] if str(err) else type(err).__name__
+        summary = results.stop_summary(self.scene, self.rows, outcome, reason, {"step": steps, "t_s": t},
+                                       {"steps": steps, "ranks": self.comm.size, "fidelity": "rigid"})
+        if self.comm.rank == 0:
+            try:
+                if self.rows:
+                    results.write_history(self.rows, self.out, MPI.COMM_SELF, self.columns)
+                files.write_json(self.out / "summary.json", summary, MPI.COMM_SELF)
+            except OSError:
+                pass
 
 
 class Wear:
