@@ -90,11 +90,18 @@ class FieldWriter:
 
     @staticmethod
     def _write_h5(path: Path, datasets: dict) -> None:
+        """One HDF5 file, made in memory and written as plain bytes: a full disk is then an OSError of Python's
+        write, never an error inside the HDF5 library (which leaves it unable to close its files)."""
+        import io
+
         import h5py
 
-        with replacing(path) as tmp, h5py.File(tmp, "w") as h5:
+        buf = io.BytesIO()
+        with h5py.File(buf, "w") as h5:
             for name, data in datasets.items():
                 h5.create_dataset(name, data=data)
+        with replacing(path) as tmp:
+            tmp.write_bytes(buf.getbuffer())
 
     def write(self, t: float, values: dict[str, np.ndarray]) -> None:
         """Write one output time (collective).
@@ -130,16 +137,20 @@ class FieldWriter:
 
     def _write_index(self) -> None:
         """fields.h5 of external links and fields.xdmf, each replaced atomically (rank 0)."""
+        import io
+
         import h5py
 
-        path = self.out / "fields.h5"
-        with replacing(path) as tmp, h5py.File(tmp, "w") as h5:
+        buf = io.BytesIO()
+        with h5py.File(buf, "w") as h5:
             for name in ("geometry", "topology"):
                 h5[f"/Mesh/mesh/{name}"] = h5py.ExternalLink("fields.d/mesh.h5", f"/{name}")
             for k, t in enumerate(self.times):
                 for name in self.names:
                     h5[f"/Function/{name}/{_time_name(t)}"] = h5py.ExternalLink(
                         f"fields.d/{self._step_file(k).name}", f"/{name}")
+        with replacing(self.out / "fields.h5") as tmp:
+            tmp.write_bytes(buf.getbuffer())
         self._write_xdmf()
 
     def _write_xdmf(self, consolidated: bool = False) -> None:
@@ -187,6 +198,12 @@ class FieldWriter:
         if self.comm.rank == 0 and self.dir.exists():
             import h5py
 
+            need = sum(f.stat().st_size for f in self.dir.iterdir())
+            free = shutil.disk_usage(self.out).free
+            if free < 1.1 * need + (1 << 20):  # HDF5 must not meet a full disk: it cannot recover
+                raise OSError(28, f"No space left on device: {need / 1e6:.1f} MB needed to consolidate the "
+                                  f"fields, {free / 1e6:.1f} MB free (fields.d is kept, readable)",
+                              str(self.out / "fields.h5"))
             path = self.out / "fields.h5"
             with replacing(path) as tmp, h5py.File(tmp, "w") as dst:
                 with h5py.File(self.dir / "mesh.h5", "r") as src:

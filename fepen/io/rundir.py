@@ -31,13 +31,15 @@ from fepen.errors import InputError, MachineFault, describe_os_error
 from fepen.version import __version__
 
 LOCK = ".fepen.lock"
+#: space held back while a run goes on, given back to write the record of a stop on a full disk
+RESERVE, RESERVE_BYTES = ".fepen.reserve", 256 * 1024
 #: a directory holding one of these holds a run's results
 MARKERS = ("summary.json", "run.json", "history.csv", "fields.xdmf", "checkpoint")
 #: what a fepen run writes into its directory: ``--force`` removes these and nothing else
 OUTPUT_NAMES = ("summary.json", "run.json", "fepen.log", "scene.toml", "history.csv", "history.png", "checkpoint",
                 "fields.xdmf", "fields.h5", "fields.d", "fields_*.xdmf", "fields_*.h5", "view.py", "*.png",
                 "accelerations.csv", "gauges*.csv", "hazard*.csv", "sections*.csv", "charge*.csv", "charge*.json",
-                "nose_profile*.csv", "profile*.csv", "*.tmp*", "run.log")
+                "nose_profile*.csv", "profile*.csv", "strains*.csv", "*.vtu", "*.tmp*", "run.log", RESERVE)
 
 _log_path: Path | None = None
 _transcript: list[str] = []
@@ -50,6 +52,12 @@ def forget() -> None:
     global _log_path
     _log_path = None
     _transcript.clear()
+
+
+def release_reserve() -> None:
+    """Give back the space the run held (rank 0): the record of a stop fits in it on a full disk."""
+    if _log_path is not None:
+        (_log_path.parent / RESERVE).unlink(missing_ok=True)
 
 
 def log_line(line: str) -> None:
@@ -198,6 +206,8 @@ class RunDirectory:
             elif self.mode == "force":
                 self._clear()
             self._write_record()
+            with open(self.out / RESERVE, "wb") as f:
+                f.write(b"\0" * RESERVE_BYTES)
         except OSError as err:
             self._unlock()
             bad = err.errno in (errno.ENOSPC, errno.EDQUOT, errno.EIO)
@@ -272,6 +282,7 @@ class RunDirectory:
         last.update(end=_now(), outcome=outcome, exit_code=code, **({"message": message} if message else {}))
         if "resumes" in self.record:  # the first invocation's record stays; the whole run's verdict beside it
             self.record.update(final_outcome=outcome, final_exit_code=code)
+        (self.out / RESERVE).unlink(missing_ok=True)
         try:
             self._save()
         except OSError:  # a full disk: run.json keeps its "running" record; the lock goes all the same

@@ -11,6 +11,7 @@ and reads it. Resuming needs the same number of ranks as the run it continues.
 from __future__ import annotations
 
 import hashlib
+import io
 import json
 import shutil
 from pathlib import Path
@@ -26,10 +27,11 @@ from fepen.version import __version__
 def _save(path: Path, arrays: dict) -> str:
     """Write one rank's arrays (atomically); the sha256 of the file."""
     files.inject("checkpoint")
+    buf = io.BytesIO()  # made in memory: a full disk is then an OSError of one write, not inside zipfile
+    np.savez(buf, **arrays)
     with replacing(path, ".npz") as tmp:
-        np.savez(tmp, **arrays)
-        digest = _sha256(tmp)
-    return digest
+        tmp.write_bytes(buf.getbuffer())
+    return hashlib.sha256(buf.getbuffer()).hexdigest()
 
 
 def _sha256(path: Path) -> str:

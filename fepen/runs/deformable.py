@@ -7,7 +7,6 @@ travel, y depth into the target, both from the impact point, in mm.
 
 from __future__ import annotations
 
-import logging
 import time
 
 import numpy as np
@@ -16,7 +15,7 @@ from mpi4py import MPI
 from fepen.errors import BeyondMethod, InputError, Interrupted, MachineFault, SimulationError
 from fepen.experiments import shot
 from fepen.geometry.frames import unit_axis
-from fepen.io import files, results
+from fepen.io import files, results, rundir
 from fepen.io.fields import FieldWriter
 from fepen.laws import layers as fl
 from fepen.post import analyses, paraview, signals, slices
@@ -164,8 +163,8 @@ class DeformableRun:
                 continue
             try:
                 o.close(self, completed)
-            except (OSError, SimulationError) as err:
-                logging.getLogger("fepen").warning(f"while stopping, {type(o).__name__.lower()} output: {err}")
+            except (OSError, SimulationError) as err:  # into fepen.log: the console says only the stop
+                rundir.log_line(f"fepen: while stopping, {type(o).__name__.lower()} output: {err}")
 
     def write_stop(self, err: BaseException) -> None:
         """summary.json of a stopped run: outcome, stop_reason, stop_time_s, where (rank 0, no collective; a
@@ -185,10 +184,11 @@ class DeformableRun:
                  "wall_s": self.wall_before + time.perf_counter() - self.wall_t0}
         summary = results.stop_summary(self.scene, self.rows, outcome, reason, where, extra)
         if self.comm.rank == 0:
+            rundir.release_reserve()
             try:
                 files.write_json(self.out / "summary.json", summary, self.comm)
             except OSError as e:
-                logging.getLogger("fepen").warning(f"summary.json of the stop not written: {e}")
+                rundir.log_line(f"fepen: summary.json of the stop not written: {e}")
 
     def stop_rules(self) -> str | None:
         """The outcome if a stop rule fires (fepen.runs.events), else None; BeyondMethod past the failure

@@ -16,7 +16,7 @@ from mpi4py import MPI
 from fepen.errors import Interrupted, SimulationError
 from fepen.geometry import mesh as fmesh
 from fepen.geometry import revolution, tags
-from fepen.io import files, results
+from fepen.io import files, results, rundir
 from fepen.laws import layers as fl
 from fepen.laws import target as tg
 from fepen.laws import wear
@@ -293,6 +293,7 @@ class RigidRun:
         summary = results.stop_summary(self.scene, self.rows, outcome, reason, {"step": steps, "t_s": t},
                                        {"steps": steps, "ranks": self.comm.size, "fidelity": "rigid"})
         if self.comm.rank == 0:
+            rundir.release_reserve()
             try:
                 if self.rows:
                     results.write_history(self.rows, self.out, MPI.COMM_SELF, self.columns)

@@ -48,8 +48,19 @@ def kill_after_checkpoints(proc, out, n=2, timeout=300):
         assert proc.poll() is None, f"the run ended before it could be killed: {proc.stderr.read()}"
         time.sleep(0.01)
     time.sleep(0.05)
+    import subprocess
+
+    ranks = [int(p) for p in subprocess.run(["pgrep", "-P", str(proc.pid)], capture_output=True,
+                                            text=True).stdout.split()]  # mpirun gives them groups of their own
     os.killpg(proc.pid, signal.SIGKILL)
+    for pid in ranks:
+        try:
+            os.kill(pid, signal.SIGKILL)
+        except ProcessLookupError:
+            pass
     proc.wait()
+    while any(os.path.exists(f"/proc/{pid}") for pid in ranks):  # gone, as a killed job's ranks are
+        time.sleep(0.01)
     return json.loads(state.read_text())["t_s"]
 
 
