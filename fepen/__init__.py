@@ -14,7 +14,8 @@ from pathlib import Path
 
 from fepen.version import __version__
 
-__all__ = ["Scene", "Result", "run", "load", "resume", "InputError", "SimulationError", "__version__"]
+__all__ = ["Scene", "Result", "run", "load", "resume", "InputError", "SimulationError", "MachineFault", "Interrupted",
+           "__version__"]
 
 # numba highlights its error messages with colorama when colorama is installed (Debian's paraview brings
 # it): colorama then writes an ANSI reset to a terminal's stdout at exit, which under mpirun (whose ranks'
@@ -50,7 +51,7 @@ def __getattr__(name):
         from fepen import api
 
         return getattr(api, name)
-    if name in ("InputError", "SimulationError"):
+    if name in ("InputError", "SimulationError", "MachineFault", "Interrupted"):
         from fepen import errors
 
         return getattr(errors, name)
