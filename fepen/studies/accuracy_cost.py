@@ -86,7 +86,9 @@ def study(out: str | Path = "results/study", ranks: int = 2, quick: bool = False
         One row per run and shot.
     """
     out = Path(out)
-    out.mkdir(parents=True, exist_ok=True)
+    from mpi4py import MPI
+
+    out = files.prepare(out, MPI.COMM_SELF)  # a file or a place that cannot be made: bad input, one line
     rows = []
     confs = configurations(quick)
     if quick:

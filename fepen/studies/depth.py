@@ -283,8 +283,11 @@ def validate_depth(paths=(), sets=(), out="results/validate-depth", workers: int
     scene.load(None, ["effects.fidelity=rigid", *sets])  # bad --set: InputError before any run
     data = gather_sets(paths, shipped)
     results = predict_sets(data, sets, workers)
-    out = Path(out)
-    out.mkdir(parents=True, exist_ok=True)
+    from mpi4py import MPI
+
+    from fepen.io import files
+
+    out = files.prepare(out, MPI.COMM_SELF)  # a file or a place that cannot be made: bad input, one line
     fields = ["set", *Row.__dataclass_fields__, *METHODS]
     with open(out / "depth.csv", "w", newline="") as f:
         w = csv.DictWriter(f, fieldnames=fields)
