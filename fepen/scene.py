@@ -13,6 +13,7 @@ from __future__ import annotations
 
 import difflib
 import math
+import sys
 import tomllib
 from dataclasses import dataclass
 from pathlib import Path
@@ -48,7 +49,7 @@ class Key:
         if self.kind is bool:
             return "true or false"
         if self.kind is str:
-            return "a string"
+            return self.form or "a string"
         if self.kind is list:
             return self.form or "a list"
         lo = "-inf" if self.lo is None else f"{self.lo:g}"
@@ -61,30 +62,55 @@ class Key:
     def check(self, name: str, value: Any) -> Any:
         """Return the value converted to the key's type, or raise InputError."""
         if self.kind is float:
-            if isinstance(value, bool) or not isinstance(value, (int, float)):
-                raise InputError(name, f"got {value!r}, expected {self.allowed()}")
+            if isinstance(value, bool) or not isinstance(value, (int, float)) or not _finite(value):
+                raise InputError(name, f"got {_shown(value)}, expected {self.allowed()}")
             value = float(value)
-            if not math.isfinite(value):
-                raise InputError(name, f"got {value!r}, expected {self.allowed()}")
         elif self.kind is int:
             if isinstance(value, bool) or not isinstance(value, int):
-                raise InputError(name, f"got {value!r}, expected {self.allowed()}")
+                raise InputError(name, f"got {_shown(value)}, expected {self.allowed()}")
         elif self.kind is bool:
             if not isinstance(value, bool):
-                raise InputError(name, f"got {value!r}, expected true or false")
+                raise InputError(name, f"got {_shown(value)}, expected true or false")
         elif self.kind is str:
             if not isinstance(value, str):
-                raise InputError(name, f"got {value!r}, expected {self.allowed()}")
+                raise InputError(name, f"got {_shown(value)}, expected {self.allowed()}")
+            if self.form and (not value.strip() or "\x00" in value):  # a path: open() fails on both
+                raise InputError(name, f"got {_shown(value)}, expected {self.allowed()}")
         elif self.kind is list:
             return LIST_CHECKS[name](name, value)
         if self.choices and value not in self.choices:
-            raise InputError(name, f"got {value!r}, expected {self.allowed()}")
+            raise InputError(name, f"got {_shown(value)}, expected {self.allowed()}")
         if self.kind in (int, float):
             bad_lo = self.lo is not None and (value < self.lo or (self.lo_open and value == self.lo))
             bad_hi = self.hi is not None and (value > self.hi or (self.hi_open and value == self.hi))
             if bad_lo or bad_hi:
-                raise InputError(name, f"got {value:g}, expected {self.allowed()}")
+                raise InputError(name, f"got {_shown(value)}, expected {self.allowed()}")
         return value
+
+
+def _finite(value: int | float) -> bool:
+    """A finite number, as a float can hold it (TOML integers have no bound: 10**400 is not)."""
+    try:
+        return math.isfinite(value)
+    except OverflowError:
+        return False
+
+
+def _shown(value: Any, limit: int = 60) -> str:
+    """A value as an error line shows it: floats as %g, others by repr, long ones cut, always one line."""
+    if isinstance(value, float):
+        return f"{value:g}"
+    try:
+        text = repr(value)
+    except ValueError:  # an int past Python's 4300-digit limit of conversion to text
+        text = f"an integer of more than {sys.get_int_max_str_digits()} digits"
+    text = " ".join(text.split())
+    return text if len(text) <= limit else text[:limit - 3] + "..."
+
+
+def _name(name: str, limit: int = 80) -> str:
+    """A key or a path as the user wrote it, shown on one line (TOML allows any character in a quoted key)."""
+    return name if name.isprintable() and len(name) <= limit else _shown(name, limit)
 
 
 def _num(default, unit, lo=None, hi=None, lo_open=False, hi_open=False, doc=""):
@@ -120,18 +146,21 @@ SCHEMA: dict[str, Key] = {
     "projectile.boattail_length": _num(0.0, "m", 0.0, 10.0, doc="tapered rear; 0: none"),
     "projectile.boattail_diameter": _pos(_ABSENT, "m", 1.0, doc="rear-face diameter of the boat-tail"),
     "projectile.profile": Key(str, _ABSENT, doc="CSV of the outer profile, rows z_m, r_m[, arc_radius_m] from the "
-                                                "nose (projectile.nose = 'profile'; sets diameter and length)"),
+                                                "nose (projectile.nose = 'profile'; sets diameter and length)",
+                              form="a file path (CSV)"),
     "projectile.inner_profile": Key(str, _ABSENT, doc="CSV of the cavity profile, rows z_m, r_m[, arc_radius_m] "
-                                                      "(a fixed cavity: the mass follows from it)"),
+                                                      "(a fixed cavity: the mass follows from it)",
+                                    form="a file path (CSV)"),
     "projectile.cavity_sections": Key(list, _ABSENT, doc="cavity as [[length_m, diameter_m], ...] front to rear; "
                                                          "the rear one's length is sized to projectile.mass",
                                       form="a list of [length, diameter] pairs in metres, each > 0"),
     "projectile.cad": Key(str, _ABSENT, doc="STEP or BREP file of the projectile body (axis +y, nose toward -y); "
-                                            "meshed as is, mass from the mesh (docs/projectiles-and-targets.md)"),
+                                            "meshed as is, mass from the mesh (docs/projectiles-and-targets.md)",
+                          form="a file path (STEP or BREP)"),
     "projectile.cad_scale": _pos(1.0, "m per file unit", 1.0e3, doc="lengths of projectile.cad times this are "
                                                                      "metres (0.001 for a file in mm)"),
-    "projectile.diameter": _pos(0.0236, "m", 1.0),
-    "projectile.length": _pos(0.144, "m", 10.0),
+    "projectile.diameter": _num(0.0236, "m", 1.0e-3, 1.0, doc="calibre (fepen's laws are for 1 mm and more)"),
+    "projectile.length": _num(0.144, "m", 1.0e-3, 10.0),
     "projectile.crh": _num(3.0, "", 0.5, 50.0, doc="ogive radius over diameter (0.5: hemisphere)"),
     "projectile.mass": _pos(0.367, "kg", 1.0e4,
                             doc="total mass; the cavity is sized, reduced or dropped to reach it (theory §1.1)"),
@@ -272,13 +301,13 @@ def _check_sections(name: str, value: Any) -> list:
     """projectile.cavity_sections: [[length, diameter], ...] of positive finite numbers (m)."""
     form = SCHEMA[name].allowed()
     if not isinstance(value, list) or not value:
-        raise InputError(name, f"got {value!r}, expected {form}")
+        raise InputError(name, f"got {_shown(value)}, expected {form}")
     out = []
     for i, row in enumerate(value):
         if (not isinstance(row, list) or len(row) != 2
                 or not all(isinstance(v, (int, float)) and not isinstance(v, bool) for v in row)
-                or not all(math.isfinite(v) and v > 0 for v in row)):
-            raise InputError(f"{name}[{i}]", f"got {row!r}, expected [length, diameter] in metres, each > 0")
+                or not all(_finite(v) and v > 0 for v in row)):
+            raise InputError(f"{name}[{i}]", f"got {_shown(row)}, expected [length, diameter] in metres, each > 0")
         out.append([float(row[0]), float(row[1])])
     return out
 
@@ -290,13 +319,13 @@ LAYER_KEYS = ("material", "thickness", "gap", "crater", "family")
 def _check_layers(name: str, value: Any) -> list:
     """target.layers: tables with material, thickness, gap and target constants, types and ranges checked."""
     if not isinstance(value, list) or not value or not all(isinstance(v, dict) for v in value):
-        raise InputError(name, f"got {value!r}, expected {SCHEMA[name].allowed()} ([[target.layers]] in TOML)")
+        raise InputError(name, f"got {_shown(value)}, expected {SCHEMA[name].allowed()} ([[target.layers]] in TOML)")
     out = []
     for i, table in enumerate(value):
         here = f"{name}[{i}]"
         layer = {}
         for k, v in table.items():
-            key = f"{here}.{k}"
+            key = f"{here}.{_name(k)}"
             if k == "material":
                 layer[k] = SCHEMA["target.material"].check(key, v)
             elif k == "thickness":
@@ -412,9 +441,10 @@ def _given(source) -> dict[str, Any]:
         return read_toml(source)
     if isinstance(source, str):
         try:
-            return _flatten(tomllib.loads(source))
-        except tomllib.TOMLDecodeError as err:
-            raise InputError("SCENE", f"the scene text is not valid TOML: {err}") from None
+            tree = tomllib.loads(source)
+        except ValueError as err:  # TOMLDecodeError, or an integer past Python's 4300 digits
+            raise InputError("SCENE", f"the scene text is not valid TOML: {_name(str(err), 200)}") from None
+        return _flatten(tree)
     raise InputError("SCENE", f"expected a TOML file, TOML text, a dict or a Scene, got {type(source).__name__}")
 
 
@@ -424,7 +454,7 @@ def _flatten(tree: dict, prefix: str = "") -> dict[str, Any]:
         name = f"{prefix}{k}"
         if isinstance(v, dict):
             if not v:
-                raise InputError(name, "empty table")
+                raise InputError(_name(name), "empty table")
             flat.update(_flatten(v, name + "."))
         else:
             flat[name] = v
@@ -432,12 +462,12 @@ def _flatten(tree: dict, prefix: str = "") -> dict[str, Any]:
 
 
 def _unknown(name: str) -> InputError:
-    close = difflib.get_close_matches(name, SCHEMA.keys(), n=1, cutoff=0.5)
-    if not close:  # a key in the wrong table: match on the last part
-        tail = name.split(".")[-1]
-        close = [k for k in SCHEMA if k.split(".")[-1] == tail][:1]
+    tail = name.split(".")[-1]
+    same_leaf = [k for k in SCHEMA if k.split(".")[-1] == tail]  # a key in the wrong table, first
+    close = difflib.get_close_matches(name, same_leaf, n=1, cutoff=0.0) or difflib.get_close_matches(
+        name, SCHEMA.keys(), n=1, cutoff=0.5)
     hint = f" (did you mean '{close[0]}'?)" if close else f" (sections: {', '.join(SECTIONS)})"
-    return InputError(name, "unknown key" + hint)
+    return InputError(_name(name), "unknown key" + hint)
 
 
 def parse_set(item: str) -> tuple[str, Any]:
@@ -456,7 +486,7 @@ def parse_set(item: str) -> tuple[str, Any]:
         raise InputError("--set", f"expected KEY=VALUE, got {item!r}")
     try:
         value = tomllib.loads(f"v = {text}")["v"]
-    except tomllib.TOMLDecodeError:
+    except ValueError:  # TOMLDecodeError, or an integer past Python's 4300 digits: a bare word
         value = text
     return key, value
 
@@ -464,13 +494,17 @@ def parse_set(item: str) -> tuple[str, Any]:
 def read_toml(path: str | Path) -> dict[str, Any]:
     """Read a scene file into a flat {dotted key: value} dict, without validating the keys."""
     p = Path(path)
-    if not p.is_file():
-        raise InputError("SCENE", f"no such scene file: {p}")
+    try:
+        found = p.is_file()
+    except (OSError, ValueError):  # a name too long, or holding a NUL
+        found = False
+    if not found:
+        raise InputError("SCENE", f"no such scene file: {_name(str(p), 200)}")
     try:
         with open(p, "rb") as fh:
             tree = tomllib.load(fh)
-    except tomllib.TOMLDecodeError as err:
-        raise InputError("SCENE", f"{p} is not valid TOML: {err}") from None
+    except ValueError as err:  # TOMLDecodeError, text that is not UTF-8, an integer past 4300 digits
+        raise InputError("SCENE", f"{_name(str(p), 200)} is not valid TOML: {_name(str(err), 200)}") from None
     return _flatten(tree)
 
 
@@ -565,6 +599,7 @@ def _resolve_target(flat: dict, given: dict) -> None:
             here = {**{k: v for k, v in layer.items() if k in ("material", "thickness", "gap")},
                     **_material_constants(layer["material"], {k: v for k, v in layer.items() if k in CONSTANTS},
                                           crater or layer.get("crater"))}
+            _check_target(f"target.layers[{i}]", here, here["family"], set(layer))
             if here["crater"] == "energy" and here.get("lock_density", 2650.0) <= here["density"]:
                 raise InputError(f"target.layers[{i}].lock_density", "must exceed the layer's density with the "
                                                                      "energy crater")
@@ -609,7 +644,8 @@ def _check_geometry_keys(flat: dict, given: dict) -> None:
             if key in given:
                 raise InputError(key, "is set by projectile.profile: drop it")
         if "projectile.mass" not in given and not any(k in given for k in (
-                "projectile.cavity_diameter", "projectile.cavity_sections", "projectile.inner_profile")):
+                "projectile.cavity_diameter", "projectile.cavity_length", "projectile.cavity_sections",
+                "projectile.inner_profile")):
             flat["projectile.cavity_diameter"] = 0.0  # the paper's cavity belongs to the paper's body
     elif nose == "profile":
         raise InputError("projectile.nose", "'profile' needs projectile.profile, the CSV of the outside")
@@ -652,6 +688,9 @@ def _check_consistency(flat: dict, given: dict) -> None:
             raise InputError("projectile.mass",
                              "a solid body (projectile.cavity_diameter = 0) has its mass set by its shape; "
                              "drop projectile.mass")
+        if "projectile.cavity_length" in given:
+            raise InputError("projectile.cavity_length", "a solid body (projectile.cavity_diameter = 0) has no "
+                                                         "cavity: drop projectile.cavity_length")
         flat.pop("projectile.mass", None)
         flat.pop("projectile.cavity_length", None)
     if flat["effects.charge"] and flat["projectile.cavity_diameter"] == 0.0:
@@ -669,6 +708,70 @@ def _check_consistency(flat: dict, given: dict) -> None:
                                                     f"must be at most target.friction = {flat['target.friction']:g}")
     if "mesh.nose_size" in flat and flat["mesh.nose_size"] > flat["mesh.size"]:
         raise InputError("mesh.nose_size", f"must be at most mesh.size = {flat['mesh.size']:g} m")
+    _check_physics(flat, given)
+    if "target.layers" not in flat:
+        _check_target("target", {k: flat[f"target.{k}"] for k in CONSTANTS if f"target.{k}" in flat},
+                      TARGETS[flat["target.material"]]["family"], {k[7:] for k in given if k.startswith("target.")})
+
+
+def _given_one(given: dict, *names: str) -> str:
+    """The first of these keys the user gave, else the first: the key an error across keys names."""
+    return next((n for n in names if n in given), names[0])
+
+
+def _check_physics(flat: dict, given: dict) -> None:
+    """Checks across keys a ballistics engineer makes at a glance (CROSS_CHECKS, docs/scenes.md)."""
+    melt, room = flat["projectile.material.melt_temperature"], flat["projectile.material.room_temperature"]
+    if melt <= room:
+        key = _given_one(given, "projectile.material.melt_temperature", "projectile.material.room_temperature")
+        raise InputError(key, f"melting temperature {melt:g} K must exceed room temperature {room:g} K "
+                              "(projectile.material.*: Johnson-Cook's T* = (T - T_room)/(T_melt - T_room))")
+    theta = flat["impact.obliquity_deg"] + flat["impact.attack_deg"]
+    if theta >= 90.0:
+        raise InputError(_given_one(given, "impact.attack_deg", "impact.obliquity_deg"),
+                         f"obliquity + attack = {theta:g} deg turns the projectile's axis to or past the target "
+                         "face (its tail would start inside the target): the sum must be < 90 deg")
+    end = flat.get("run.end_time")
+    for key in ("run.output_interval", "run.rigid_step"):
+        if end is not None and key in given and "run.end_time" in given and flat[key] > end:
+            raise InputError(key, f"{flat[key]:g} s: must be at most run.end_time = {end:g} s")
+    E, Et = flat["charge.material.youngs_modulus"], flat["charge.material.tangent_modulus"]
+    if Et >= E:
+        raise InputError(_given_one(given, "charge.material.tangent_modulus", "charge.material.youngs_modulus"),
+                         f"the charge's tangent modulus {Et:g} Pa must be below its Young's modulus {E:g} Pa "
+                         "(charge.material.*: bilinear hardening H = E Et / (E - Et))")
+
+
+def _check_target(where: str, c: dict, family: str, given: set) -> None:
+    """One target material's constants (c: target.* names without the prefix; given: those the user gave)
+    make a law: a metal's law for a metal and only for it, its yield below 2E/3; a concrete's, rock's or soil's
+    tensile strength below its compressive strength and a plastic zone wider than the cavity (docs/theory.md
+    §8.1, §16)."""
+    model = c.get("strength_model")
+    if family == "metal" and model not in (None, "metal"):
+        raise InputError(f"{where}.strength_model", f"got {model!r}: a metal target's law is 'metal' (drop the key)")
+    if family != "metal" and model == "metal":
+        raise InputError(f"{where}.strength_model", f"'metal' is the law of a metal target.material (6061-T6511, "
+                                                    f"armour-steel), not of a {family} one")
+    if family == "metal":
+        Y, E = c.get("yield_stress"), c.get("youngs_modulus")
+        if Y is not None and E is not None and 1.5 * Y >= E:
+            key = _given_one(given, "yield_stress", "youngs_modulus")
+            raise InputError(f"{where}.{key}", f"a metal target's yield stress {Y:g} Pa must be below 2/3 of its "
+                                               f"Young's modulus {E:g} Pa (Forrestal-Warren: 3Y/(2E) < 1)")
+        return
+    fc, T = c["compressive_strength"], c["tensile_strength"]
+    if T >= fc:
+        key = _given_one(given, "tensile_strength", "compressive_strength")
+        raise InputError(f"{where}.{key}", f"tensile strength {T:g} Pa must be below compressive strength "
+                                           f"{fc:g} Pa")
+    E = c.get("youngs_modulus") or 4.7e9 * math.sqrt(fc / 1e6)  # ACI 318, as fepen.laws.target's default
+    ratio = 9.0 * fc / (4.0 * E) * math.sqrt(fc / (2.0 * T))
+    if ratio >= 1.0:
+        key = _given_one(given, "youngs_modulus", "tensile_strength", "compressive_strength")
+        raise InputError(f"{where}.{key}", f"Young's modulus {E:g} Pa, compressive strength {fc:g} Pa and tensile "
+                                           f"strength {T:g} Pa leave no plastic zone around the cavity: (9 fc/(4 "
+                                           f"E)) sqrt(fc/(2 ft)) = {ratio:.3g} must be below 1")
 
 
 def load(path: str | Path | None = None, sets: list[str] | tuple[str, ...] = ()) -> Scene:
@@ -685,17 +788,12 @@ def load(path: str | Path | None = None, sets: list[str] | tuple[str, ...] = ())
 
 
 def to_toml(scene: Section) -> str:
-    """The resolved scene as TOML text (every key, SI units), for results directories."""
-    lines: list[str] = []
-
-    def value(v) -> str:
-        if isinstance(v, bool):
-            return "true" if v else "false"
-        if isinstance(v, str):
-            return f'"{v}"'
-        if isinstance(v, list):
-            return "[" + ", ".join(value(x) for x in v) + "]"
-        return repr(v)
+    """The resolved scene as TOML text (every key, SI units), for results directories: the keys the user gave
+    as values, the others (defaults, a named material's constants, what resolution derived) as comments, so
+    that the text resolves to the same scene with the same given keys (``fepen run --resume``, api.load): the
+    mass rule, a drawn or CAD body and a layer's own crater depend on which keys were given."""
+    given = getattr(scene, "explicit", None)
+    lines: list[str] = ["# fepen scene: the keys given as values; defaults and derived values as comments", ""]
 
     def tables(v) -> bool:
         return isinstance(v, list) and bool(v) and all(isinstance(x, dict) for x in v)
@@ -703,14 +801,15 @@ def to_toml(scene: Section) -> str:
     def emit(prefix: str, node: dict) -> None:
         scalars = {k: v for k, v in node.items() if not isinstance(v, dict) and not tables(v)}
         if scalars:
-            lines.append(f"[{prefix}]")
-            lines.extend(f"{k} = {value(v)}" for k, v in scalars.items())
+            mine = {k for k in scalars if given is None or f"{prefix}.{k}" in given}
+            lines.append(f"[{prefix}]" if mine else f"# [{prefix}]")
+            lines.extend(("" if k in mine else "# ") + f"{k} = {_toml_value(v)}" for k, v in scalars.items())
             lines.append("")
         for k, v in node.items():
             if tables(v):  # an array of tables: [[prefix.k]]
                 for table in v:
                     lines.append(f"[[{prefix}.{k}]]")
-                    lines.extend(f"{kk} = {value(vv)}" for kk, vv in table.items() if vv is not None)
+                    lines.extend(f"{kk} = {_toml_value(vv)}" for kk, vv in table.items() if vv is not None)
                     lines.append("")
         for k, v in node.items():
             if isinstance(v, dict):
@@ -720,8 +819,42 @@ def to_toml(scene: Section) -> str:
     return "\n".join(lines)
 
 
+def _toml_value(v) -> str:
+    """A value in TOML syntax (strings escaped as TOML's basic strings want)."""
+    if isinstance(v, bool):
+        return "true" if v else "false"
+    if isinstance(v, str):
+        return '"' + "".join(f"\\{c}" if c in '"\\' else f"\\u{ord(c):04x}" if ord(c) < 0x20 or ord(c) == 0x7F
+                             else c for c in v) + '"'
+    if isinstance(v, list):
+        return "[" + ", ".join(_toml_value(x) for x in v) + "]"
+    return repr(v)
+
+
+#: the checks across keys, as ``fepen keys`` lists them under the table (each refusal names the key)
+CROSS_CHECKS = (
+    "projectile.material.melt_temperature > projectile.material.room_temperature (Johnson-Cook's T*)",
+    "charge.material.tangent_modulus < charge.material.youngs_modulus (bilinear hardening)",
+    "impact.obliquity_deg + impact.attack_deg < 90 deg: the axis points into the target",
+    "run.output_interval and run.rigid_step at most run.end_time, when both are given",
+    "a concrete, rock or soil target (or layer): tensile_strength < compressive_strength, and a plastic zone "
+    "wider than the cavity, (9 fc/(4 E)) sqrt(fc/(2 ft)) < 1; strength_model 'metal' for metals only",
+    "a metal target (or layer): yield_stress < 2/3 youngs_modulus (Forrestal-Warren)",
+    "target.lock_density > target.density with the energy crater; target.friction_dynamic <= target.friction; "
+    "mesh.nose_size <= mesh.size",
+    "effects.charge needs a cavity (not a solid or CAD body); projectile.mass and projectile.cavity_length not "
+    "both; neither with a solid body (projectile.cavity_diameter = 0)",
+    "the projectile, built from its exact outside before any mesh: the nose shorter than the body, the meplat "
+    "and boat-tail narrower than it, the cavity inside it with a wall of 5 % of the calibre and the base "
+    "behind it, projectile.mass within the reach of the cavity (docs/theory.md §1.1)",
+    "noted, not refused: a target (or a layer) thinner than the nose is long (the cavity-expansion law is a "
+    "thick-target law)",
+)
+
+
 def describe() -> str:
-    """A Markdown table of every scene key: default, unit, allowed values, meaning."""
+    """A Markdown table of every scene key (default, unit, allowed values, meaning), then the checks across
+    keys."""
     rows = ["| key | default | allowed | meaning |", "|---|---|---|---|"]
     for name, key in SCHEMA.items():
         if key.default is _ABSENT:
@@ -733,4 +866,6 @@ def describe() -> str:
         else:
             default = f"{key.default:g}"
         rows.append(f"| `{name}` | {default} | {key.allowed()} | {key.doc} |")
+    rows += ["", "Checks across keys, before anything is meshed (bad input, exit 2, naming the key):", ""]
+    rows += [f"- {check}" for check in CROSS_CHECKS]
     return "\n".join(rows)

@@ -567,7 +567,17 @@ class Shape:
             A new Shape. Raises InputError (key projectile.mass) when the mass cannot be reached.
         """
         rho_fill = charge_density or 0.0
-        longest = replace(self, cavity_length=self.max_cavity_length())
+        top, fore = self.max_cavity_length(), self.fore_length()
+        if top <= fore:  # not even the forward sections fit: no mass range to speak of
+            rear = replace(self, step_length=0.0, step_diameter=0.0, cavity_table=())
+            key = ("projectile.cavity_diameter" if not fore or not rear._fits(1e-9 * self.length) else
+                   "projectile.cavity_sections" if self.cavity_table else "projectile.cavity_step_length")
+            raise InputError(key, f"the cavity ({1e3 * self.cavity_diameter:g} mm rear section"
+                                  + (f" behind {1e3 * fore:g} mm of forward sections" if fore else "")
+                                  + f") does not fit this nose, diameter, boat-tail and base thickness with the "
+                                    f"minimum wall {self._min_wall():g} m" + (f": at most {top:.4g} m of cavity fits"
+                                                                              if top > 0 else ""))
+        longest = replace(self, cavity_length=top)
         shortest = replace(self, cavity_length=self.fore_length() + 1e-9 * self.length)
         m_hi = shortest.mass(shell_density, charge_density)
         m_lo = longest.mass(shell_density, charge_density)

@@ -180,10 +180,37 @@ def _projectile(scene) -> Built:
         shape.check()
     else:  # the outside only: a default cavity that does not fit is left to the mass rule
         replace(shape, cavity_diameter=0.0, cavity_table=()).check()
+        _check_base(scene, shape)
     if mass is None or (solid and explicit) or inner:
         return Built(shape, p.material.density)
     rho_c = scene.charge.material.density if scene.effects.charge else None
     return reach_mass(shape, mass, p.material.density, rho_c, adapt=not explicit and not scene.effects.charge)
+
+
+def _check_base(scene, shape: Shape) -> None:
+    """A base thickness the user gave leaves room for a cavity behind the nose (the mass rule would otherwise
+    drop the cavity and say so only in a note)."""
+    room = shape.length - shape.nose_length
+    if "projectile.base_thickness" in scene.explicit and shape.base_thickness >= room:
+        raise InputError("projectile.base_thickness", f"{shape.base_thickness:g} m: must be less than the body "
+                                                      f"behind the nose, {room:g} m")
+
+
+def thin_target_note(scene, built: Built) -> str | None:
+    """A line when the target, or one of its layers, is thinner than the nose is long: the nose is through
+    before its shoulder enters, and the cavity-expansion law is a law of thick targets (docs/theory.md §16)."""
+    nose = built.shape.nose_length
+    layers = scene.get("target.layers")
+    if scene.target.kind != "concrete" or not nose:
+        return None
+    for i, layer in enumerate(layers or [{"thickness": scene.get("target.thickness")}]):
+        t = layer.get("thickness")
+        if t is not None and t < nose:
+            key = f"target.layers[{i}].thickness" if layers else "target.thickness"
+            return (f"{key} {1e3 * t:g} mm is less than the nose length {1e3 * nose:.3g} mm: the nose is through "
+                    "before its shoulder enters; the cavity-expansion law is a thick-target law, and a thin "
+                    "plate's plugging, petalling or scabbing is beyond the method (docs/theory.md §16)")
+    return None
 
 
 def friction_note(scene) -> str | None:
@@ -207,7 +234,7 @@ def announce(scene, comm) -> Built:
     if comm.rank == 0:
         import logging
 
-        for note in (built.note, friction_note(scene)):
+        for note in (built.note, friction_note(scene), thin_target_note(scene, built)):
             if note:
                 logging.getLogger("fepen").warning(note)
     return built

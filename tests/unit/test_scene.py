@@ -46,6 +46,33 @@ def test_resolved_scene_round_trips_through_toml(tmp_path):
     assert again.as_dict() == sc.as_dict()
 
 
+@pytest.mark.parametrize("sets", [
+    ['projectile.cad="body.step"'],  # the CAD body's derived keys would be refused if given
+    ['projectile.profile="outer.csv"'],
+    ['projectile.inner_profile="inner.csv"'],
+    ["projectile.cavity_sections=[[0.01, 0.005], [0.05, 0.01]]"],
+    ["projectile.mass=0.2"],  # the mass rule adapts only a cavity the user did not give
+    ['target.layers=[{material="soil", thickness=0.1}, {material="granite"}]'],  # soil keeps its own crater
+    ['projectile.profile="a\\"b\\\\c d.csv"'],  # a quote and a backslash in a path
+])
+def test_scene_toml_resolves_to_the_same_scene_with_the_same_given_keys(sets):
+    """scene.toml (fepen run --resume, api.load) gives the keys the user gave as values, the rest as comments:
+    the mass rule, drawn and CAD bodies and a layer's crater depend on which keys were given."""
+    sc = scene.load(None, sets)
+    text = scene.to_toml(sc)
+    again = scene.Scene(text)
+    assert again.as_dict() == sc.as_dict() and again.explicit == sc.explicit
+    assert "# crh = 3.0" in text or "crh" in str(sets)  # every default is still there to read
+
+
+def test_the_mass_rule_builds_the_same_projectile_from_scene_toml():
+    from fepen.runs import setup
+
+    sc = scene.load(None, ["projectile.mass=0.2"])
+    first, again = setup.projectile(sc), setup.projectile(scene.Scene(scene.to_toml(sc)))
+    assert first.note and again.shape == first.shape and again.shell_density == first.shell_density
+
+
 @pytest.mark.parametrize("item, key, words", [
     ("impact.velocty=600", "impact.velocty", "did you mean 'impact.velocity'"),
     ("impact.velocity=-50", "impact.velocity", "(0, 3000] m/s"),
