@@ -226,6 +226,8 @@ def _numbers(option: str, text: str) -> list[float]:
 
 def _limit_study(args) -> int:
     """fepen study ballistic-limit | ricochet, on the ranks it was started on."""
+    import math
+
     from mpi4py import MPI
 
     from fepen.studies import limits
@@ -234,13 +236,21 @@ def _limit_study(args) -> int:
     comm = MPI.COMM_WORLD
     if args.ranks_per_shot < 1 or comm.size % args.ranks_per_shot:
         raise InputError("--ranks-per-shot", f"must divide the number of ranks ({comm.size})")
+    if args.tol is not None and not (math.isfinite(args.tol) and args.tol > 0):
+        raise InputError("--tol", f"a positive number (m/s or deg), got {args.tol!r}")
+    if not (math.isfinite(args.obliquity_max) and 0.0 < args.obliquity_max < 90.0):
+        raise InputError("--obliquity-max", f"in (0, 90) deg, got {args.obliquity_max!r}")
     if args.which == "ballistic-limit":
-        lo, hi = _numbers("--speeds", args.speeds) if args.speeds else (100.0, 1500.0)
+        bracket = _numbers("--speeds", args.speeds) if args.speeds is not None else [100.0, 1500.0]
+        if len(bracket) != 2:
+            raise InputError("--speeds", f"two speeds LOW,HIGH (m/s), got {args.speeds!r}")
+        lo, hi = bracket
         limits.ballistic_limit(args.scene, args.sets, args.out, comm, args.ranks_per_shot, lo, hi,
                                args.tol or 2.0, say=_say)
         _say(f"written: {args.out}/ballistic_limit.json, ballistic_limit.png")
     else:
-        speeds = _numbers("--speeds", args.speeds) if args.speeds else [300.0 + 100 * j for j in range(7)]
+        speeds = (_numbers("--speeds", args.speeds) if args.speeds is not None
+                  else [300.0 + 100 * j for j in range(7)])
         limits.ricochet(args.scene, args.sets, args.out, comm, args.ranks_per_shot, speeds, args.obliquity_max,
                         args.tol or 0.5, say=_say)
         _say(f"written: {args.out}/ricochet.json, ricochet.png")
@@ -378,7 +388,14 @@ def main(argv: list[str] | None = None) -> int:
 
 
 def _verdict(err: BaseException) -> tuple[int, str]:
-    """The exit code and the one line of an error."""
+    """The exit code and the one line of an error (whitespace, newlines in a path included, collapsed)."""
+    code, line = _verdict_line(err)
+    return code, " ".join(line.split())
+
+
+def _verdict_line(err: BaseException) -> tuple[int, str]:
+    if isinstance(err, ValueError) and "null byte" in str(err):  # a path holding NUL, from a script
+        return InputError.exit_code, "fepen: bad input: a file name holds a NUL byte"
     if isinstance(err, InputError):
         return InputError.exit_code, f"fepen: bad input: {err}"
     if isinstance(err, SimulationError):

@@ -145,7 +145,7 @@ CASES = [
         "target.yield_stress", r"must be below 2/3 of its Young's modulus"),
     row("metal-law-for-concrete", sets('target.strength_model="metal"'), None, "target.strength_model",
         r"'metal' is the law of a metal target.material"),
-    row("output-after-the-end", sets("run.end_time=1e-4", "run.output_interval=1e-3"), None, "run.output_interval",
+    row("rigid-step-after-the-end", sets("run.end_time=1e-4", "run.rigid_step=1e-3"), None, "run.rigid_step",
         r"0.001 s: must be at most run.end_time = 0.0001 s"),
     row("erosion-with-rigid", sets("effects.erosion=true", "effects.fidelity=rigid"), None, "effects.erosion",
         r"use it with effects.fidelity = 'elastic' or 'plastic'"),
