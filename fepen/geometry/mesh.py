@@ -8,6 +8,7 @@ from __future__ import annotations
 import functools
 import hashlib
 import json
+import logging
 import math
 import os
 import time
@@ -20,6 +21,7 @@ from mpi4py import MPI
 from fepen.atomic import replacing
 from fepen.geometry import gmsh_model, tags, tetra
 from fepen.geometry.shape import Shape
+from fepen.version import __version__
 
 #: mesh-mass tolerance of the cavity sizing (kg)
 MASS_TOLERANCE = 2.5e-4
@@ -80,6 +82,90 @@ def _key(shape: Shape, opts: gmsh_model.MeshOptions, charge: bool, mass, rho_s, 
     return hashlib.sha256(blob.encode()).hexdigest()[:20]
 
 
+class _BadEntry(Exception):
+    """A mesh-cache entry that must not be used (the message says why)."""
+
+
+def _entry_stamp() -> dict:
+    """What a cache entry records of the code that wrote it, and must match to be read."""
+    import gmsh
+
+    return {"fepen": __version__, "gmsh": gmsh.__version__, "code": _code_hash()}
+
+
+def _sha256(path: Path) -> str:
+    h = hashlib.sha256()
+    with open(path, "rb") as f:
+        for block in iter(lambda: f.read(1 << 20), b""):
+            h.update(block)
+    return h.hexdigest()
+
+
+def _check_entry(msh: Path, side: Path) -> Shape:
+    """The shape a cache entry holds after checking its sidecar, versions and checksum; raises _BadEntry."""
+    try:
+        meta = json.loads(side.read_text())
+    except (UnicodeDecodeError, json.JSONDecodeError) as e:
+        raise _BadEntry(f"sidecar {side.name} is not JSON ({e})") from None
+    if not isinstance(meta, dict):
+        raise _BadEntry(f"sidecar {side.name} is not a JSON object")
+    missing = [k for k in ("shape", "sha256", "fepen", "gmsh", "code") if k not in meta]
+    if missing:
+        raise _BadEntry(f"sidecar {side.name} lacks {', '.join(missing)} (an older or foreign entry)")
+    for name, ours in _entry_stamp().items():
+        if meta[name] != ours:
+            raise _BadEntry(f"written by {name} {meta[name]!r}, this is {ours!r}")
+    if not msh.is_file():
+        raise _BadEntry(f"{msh.name} is missing")
+    if _sha256(msh) != meta["sha256"]:
+        raise _BadEntry(f"{msh.name} does not match its SHA-256 (damaged or truncated)")
+    return Shape(**meta["shape"])
+
+
+def _read_entry(key: str, msh: Path, side: Path) -> Shape | None:
+    """Rank 0: open a checked cache entry in gmsh and return its shape; or, for an entry that fails a check
+    or cannot be read, log one warning, delete the entry and return None (the caller meshes afresh)."""
+    import gmsh
+
+    opened = False
+    try:
+        shape = _check_entry(msh, side)
+        opened = True
+        gmsh.open(str(msh))
+        if 4 not in gmsh.model.mesh.getElementTypes(3):  # 4: tetrahedra
+            raise _BadEntry(f"{msh.name} holds no tetrahedra")
+        return shape
+    except Exception as e:  # whatever is wrong with an entry, it is rebuilt
+        why = str(e) if isinstance(e, _BadEntry) else f"cannot be read ({type(e).__name__}: {e})"
+        logging.getLogger("fepen").warning(f"mesh cache entry {key}: {why}; rebuilding")
+        if opened:  # a read that failed inside gmsh leaves it locked ("I'm busy"; gmsh.clear() does not
+            # help), and the rebuild would mesh nothing: start gmsh afresh (it keeps no state between meshes)
+            gmsh.finalize()
+            gmsh.initialize(interruptible=False)
+            gmsh.option.setNumber("General.Terminal", 0)
+        for path in (side, msh):  # the sidecar first: a .msh without one is never read
+            try:
+                path.unlink(missing_ok=True)
+            except OSError:
+                pass
+        return None
+
+
+def _write_entry(msh: Path, side: Path, shape: Shape, seconds: float) -> None:
+    """Rank 0: write the model in gmsh as a cache entry, the .msh first and its sidecar (shape, SHA-256 of the
+    .msh, the versions that wrote it) last, each replaced whole: a sidecar only exists for a complete .msh."""
+    import gmsh
+
+    msh.parent.mkdir(parents=True, exist_ok=True)
+    side.unlink(missing_ok=True)  # no sidecar of an older entry beside the new .msh, even for a moment
+    with replacing(msh, ".msh") as tmp:
+        gmsh.write(str(tmp))
+        digest = _sha256(tmp)
+    meta = {"shape": asdict(shape), "mesh_s": seconds, "sha256": digest, **_entry_stamp()}
+    with replacing(side) as tmp:
+        tmp.write_text(json.dumps(meta))
+
+
 def _gmsh_mass(rho_s: float, rho_c: float | None) -> float:
     m = rho_s * gmsh_model.tet_volumes(tags.SHELL).sum()
     if rho_c is not None:
@@ -98,10 +184,10 @@ def _mesh_on_root(shape: Shape, opts, charge: bool, mass, rho_s, rho_c, use_cach
     folder = cache_dir()
     key = _key(shape, opts, charge, mass, rho_s, rho_c)
     msh, side = folder / f"{key}.msh", folder / f"{key}.json"
-    if use_cache and msh.is_file() and side.is_file():
-        meta = json.loads(side.read_text())
-        gmsh.open(str(msh))
-        return Shape(**meta["shape"]), 0.0, True
+    if use_cache and side.is_file():
+        cached = _read_entry(key, msh, side)
+        if cached is not None:
+            return cached, 0.0, True
 
     t0 = time.perf_counter()
     current = shape
@@ -124,11 +210,7 @@ def _mesh_on_root(shape: Shape, opts, charge: bool, mass, rho_s, rho_c, use_cach
         current = replace(current, tip_point=tip, tail_point=tail)
     seconds = time.perf_counter() - t0
     if use_cache:
-        folder.mkdir(parents=True, exist_ok=True)
-        with replacing(msh, ".msh") as tmp:
-            gmsh.write(str(tmp))
-        with replacing(side) as tmp:
-            tmp.write_text(json.dumps({"shape": asdict(current), "mesh_s": seconds}))
+        _write_entry(msh, side, current, seconds)
         # the run goes on with the mesh as the cache holds it: the .msh file keeps 16 significant digits,
         # so a mesh used straight from gmsh would differ in the last bits from the same mesh read back,
         # and a run's numbers would depend on whether its mesh was cached
