@@ -210,7 +210,12 @@ def _mesh_on_root(shape: Shape, opts, charge: bool, mass, rho_s, rho_c, use_cach
         current = replace(current, tip_point=tip, tail_point=tail)
     seconds = time.perf_counter() - t0
     if use_cache:
-        _write_entry(msh, side, current, seconds)
+        try:
+            _write_entry(msh, side, current, seconds)
+        except OSError as err:  # a full disk or a read-only cache: the run goes on without caching its mesh
+            logging.getLogger("fepen").warning(f"mesh cache entry {key}: not written ({err}); the mesh is used "
+                                               "as gmsh made it")
+            return current, seconds, False
         # the run goes on with the mesh as the cache holds it: the .msh file keeps 16 significant digits,
         # so a mesh used straight from gmsh would differ in the last bits from the same mesh read back,
         # and a run's numbers would depend on whether its mesh was cached
