@@ -28,3 +28,15 @@ def replacing(path, suffix: str = "") -> Iterator[Path]:
     finally:
         if tmp.exists():
             tmp.unlink()
+
+
+def sha256_file(path) -> str:
+    """The SHA-256 of a file's bytes (hex), read in blocks: the checksum checkpoints and mesh-cache entries
+    carry."""
+    import hashlib
+
+    h = hashlib.sha256()
+    with open(path, "rb") as f:
+        for block in iter(lambda: f.read(1 << 20), b""):
+            h.update(block)
+    return h.hexdigest()

@@ -18,7 +18,7 @@ from pathlib import Path
 import numpy as np
 from mpi4py import MPI
 
-from fepen.atomic import replacing
+from fepen.atomic import replacing, sha256_file
 from fepen.geometry import gmsh_model, tags, tetra
 from fepen.geometry.shape import Shape
 from fepen.version import __version__
@@ -93,14 +93,6 @@ def _entry_stamp() -> dict:
     return {"fepen": __version__, "gmsh": gmsh.__version__, "code": _code_hash()}
 
 
-def _sha256(path: Path) -> str:
-    h = hashlib.sha256()
-    with open(path, "rb") as f:
-        for block in iter(lambda: f.read(1 << 20), b""):
-            h.update(block)
-    return h.hexdigest()
-
-
 def _check_entry(msh: Path, side: Path) -> Shape:
     """The shape a cache entry holds after checking its sidecar, versions and checksum; raises _BadEntry."""
     try:
@@ -117,7 +109,7 @@ def _check_entry(msh: Path, side: Path) -> Shape:
             raise _BadEntry(f"written by {name} {meta[name]!r}, this is {ours!r}")
     if not msh.is_file():
         raise _BadEntry(f"{msh.name} is missing")
-    if _sha256(msh) != meta["sha256"]:
+    if sha256_file(msh) != meta["sha256"]:
         raise _BadEntry(f"{msh.name} does not match its SHA-256 (damaged or truncated)")
     return Shape(**meta["shape"])
 
@@ -160,7 +152,7 @@ def _write_entry(msh: Path, side: Path, shape: Shape, seconds: float) -> None:
     side.unlink(missing_ok=True)  # no sidecar of an older entry beside the new .msh, even for a moment
     with replacing(msh, ".msh") as tmp:
         gmsh.write(str(tmp))
-        digest = _sha256(tmp)
+        digest = sha256_file(tmp)
     meta = {"shape": asdict(shape), "mesh_s": seconds, "sha256": digest, **_entry_stamp()}
     with replacing(side) as tmp:
         tmp.write_text(json.dumps(meta))

@@ -18,7 +18,7 @@ from pathlib import Path
 
 import numpy as np
 
-from fepen.atomic import replacing
+from fepen.atomic import replacing, sha256_file
 from fepen.errors import InputError
 from fepen.io import files
 from fepen.version import __version__
@@ -32,14 +32,6 @@ def _save(path: Path, arrays: dict) -> str:
     with replacing(path, ".npz") as tmp:
         tmp.write_bytes(buf.getbuffer())
     return hashlib.sha256(buf.getbuffer()).hexdigest()
-
-
-def _sha256(path: Path) -> str:
-    h = hashlib.sha256()
-    with open(path, "rb") as f:
-        for block in iter(lambda: f.read(1 << 20), b""):
-            h.update(block)
-    return h.hexdigest()
 
 
 def write(out: Path, comm, step: int, t: float, arrays: dict, meta: dict) -> None:
@@ -96,7 +88,7 @@ def read_arrays(out: Path, comm, state: dict, root_names: tuple[str, ...]) -> di
     path = Path(out) / "checkpoint" / f"step{state['step']:09d}-rank{comm.rank}.npz"
     arrays, root, problem = {}, None, None
     try:
-        if _sha256(path) != state["sha256"][comm.rank]:
+        if sha256_file(path) != state["sha256"][comm.rank]:
             problem = f"{path} does not match its checksum in state.json (a damaged file)"
         else:
             with np.load(path) as z:
