@@ -21,7 +21,7 @@ from __future__ import annotations
 import argparse
 import sys
 
-from fepen.errors import InputError, Interrupted, MachineFault, SimulationError, describe_os_error
+from fepen.errors import InputError, Interrupted, MachineFault, SimulationError, describe_os_error, stop_outcome
 
 
 class _Parser(argparse.ArgumentParser):
@@ -394,25 +394,28 @@ def _verdict(err: BaseException) -> tuple[int, str]:
 
 
 def _verdict_line(err: BaseException) -> tuple[int, str]:
+    """The exit code (fepen.errors.stop_outcome, the one classification) and the line before its whitespace is
+    collapsed."""
+    code = stop_outcome(err).exit_code
     if isinstance(err, ValueError) and "null byte" in str(err):  # a path holding NUL, from a script
-        return InputError.exit_code, "fepen: bad input: a file name holds a NUL byte"
+        return code, "fepen: bad input: a file name holds a NUL byte"
     if isinstance(err, InputError):
-        return InputError.exit_code, f"fepen: bad input: {err}"
+        return code, f"fepen: bad input: {err}"
     if isinstance(err, SimulationError):
-        return SimulationError.exit_code, f"fepen: simulation stopped: {err}"
+        return code, f"fepen: simulation stopped: {err}"
     if isinstance(err, Interrupted):
-        return MachineFault.exit_code, f"fepen: interrupted: {err}"
+        return code, f"fepen: interrupted: {err}"
     if isinstance(err, MachineFault):
-        return MachineFault.exit_code, f"fepen: stopped by a fault of the machine: {err}"
+        return code, f"fepen: stopped by a fault of the machine: {err}"
     if isinstance(err, OSError):
-        return MachineFault.exit_code, f"fepen: stopped by a fault of the machine: {describe_os_error(err)}"
+        return code, f"fepen: stopped by a fault of the machine: {describe_os_error(err)}"
     if isinstance(err, KeyboardInterrupt):
-        return MachineFault.exit_code, "fepen: interrupted (SIGINT) before the run had anything to keep"
+        return code, "fepen: interrupted (SIGINT) before the run had anything to keep"
     if isinstance(err, MemoryError):
-        return MachineFault.exit_code, "fepen: stopped by a fault of the machine: out of memory"
+        return code, "fepen: stopped by a fault of the machine: out of memory"
     text = " ".join(str(err).split())[:300]
-    return 1, (f"fepen: internal error (a bug in fepen; run again with --debug for the traceback and report "
-               f"it): {type(err).__name__}: {text}")
+    return code, (f"fepen: internal error (a bug in fepen; run again with --debug for the traceback and report "
+                  f"it): {type(err).__name__}: {text}")
 
 
 def _quiet() -> None:

@@ -8,7 +8,14 @@ Exit codes (contract, docs/results.md):
     3  the simulation cannot go on (SimulationError): what, where and when; what it wrote is kept
     4  a fault of the machine (MachineFault): disk full, permission, a file that cannot be read, or a signal
        (SIGTERM, SIGINT) that stopped the run after a checkpoint; ``fepen run --resume DIR`` continues it
+
+How a run ended is one of OUTCOMES; ``stop_outcome(err)`` is the one place an exception is classified, for
+summary.json, run.json and the command line alike.
 """
+
+from __future__ import annotations
+
+from dataclasses import dataclass
 
 
 class InputError(ValueError):
@@ -75,3 +82,51 @@ def describe_os_error(err: OSError) -> str:
     path = f" ({err.filename})" if err.filename else ""
     note = " (injected)" if "injected" in (err.strerror or "") else ""
     return f"{what}{path}{note}"
+
+
+@dataclass(frozen=True)
+class Outcome:
+    """How a run ended.
+
+    Attributes:
+        name: summary.json's and run.json's ``outcome``.
+        exit_code: the command's exit code.
+        resumable: ``fepen run --resume DIR`` can finish the run (a rigid run: runs it again).
+        result: the run reports a result (Hx_mm, depth_mm, ...); a stop reports none.
+        meaning: one line for docs/results.md.
+    """
+
+    name: str
+    exit_code: int
+    resumable: bool
+    result: bool
+    meaning: str
+
+
+#: every outcome a run can have, by name (docs/results.md "Exit codes" is built on this table)
+OUTCOMES = {o.name: o for o in (
+    Outcome("embedded", 0, False, True, "stopped in the target"),
+    Outcome("perforated", 0, False, True, "left through the rear face of a finite target"),
+    Outcome("ricochet", 0, False, True, "left through the front face after entering"),
+    Outcome("rebound", 0, False, True, "came off the rigid wall"),
+    Outcome("eroded", 0, False, True, "erosion left less than 5 % of the projectile's mass"),
+    Outcome("ended", 0, False, True, "reached run.end_time before any of the above"),
+    Outcome("bad-input", 2, False, False, "the input was refused (InputError) after the run had started"),
+    Outcome("stopped", 3, False, False, "the simulation could not go on (SimulationError)"),
+    Outcome("interrupted", 4, True, False, "a signal (SIGTERM, SIGINT) stopped it after a checkpoint"),
+    Outcome("fault", 4, True, False, "a fault of the machine (MachineFault: disk full, permission, I/O)"),
+    Outcome("error", 1, False, False, "an internal error: a bug in fepen"),
+)}
+
+
+def stop_outcome(err: BaseException) -> Outcome:
+    """The outcome of a run that an exception stopped (OUTCOMES)."""
+    if isinstance(err, (Interrupted, KeyboardInterrupt)):
+        return OUTCOMES["interrupted"]
+    if isinstance(err, InputError) or (isinstance(err, ValueError) and "null byte" in str(err)):
+        return OUTCOMES["bad-input"]
+    if isinstance(err, SimulationError):
+        return OUTCOMES["stopped"]
+    if isinstance(err, (OSError, MemoryError)):
+        return OUTCOMES["fault"]
+    return OUTCOMES["error"]

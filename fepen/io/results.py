@@ -10,7 +10,7 @@ from pathlib import Path
 import numpy as np
 from mpi4py import MPI
 
-from fepen.errors import SimulationError
+from fepen.errors import OUTCOMES, SimulationError
 from fepen.experiments import shot
 from fepen.geometry.frames import unit_axis
 from fepen.io import files
@@ -89,8 +89,8 @@ def stop_summary(scene, rows, outcome: str, reason: str, where: dict, extra: dic
 
     Args:
         rows: the history rows so far (possibly none).
-        outcome: "stopped" (exit 3: the simulation could not go on), "interrupted" (exit 4: a signal, after a
-            checkpoint) or "fault" (exit 4: disk full, permission).
+        outcome: a stop's name in fepen.errors.OUTCOMES ("stopped", "interrupted", "fault", "error", ...),
+            which gives its exit code and whether it is resumable.
         reason: the one line the console showed.
         where: step, time and place of the stop (step, t_s, nose_y_mm, ...).
         extra: further keys (steps, ranks, ...).
@@ -100,8 +100,9 @@ def stop_summary(scene, rows, outcome: str, reason: str, where: dict, extra: dic
         last = rows[-1]
         where.update({"history_t_s": last[COL["t_s"]], "nose_x_mm": last[COL["nose_x_mm"]],
                       "nose_y_mm": last[COL["nose_y_mm"]], "speed_m_s": last[COL["speed_m_s"]]})
+    o = OUTCOMES[outcome]
     out = {"outcome": outcome, "stop_reason": reason, "stop_time_s": where.get("t_s"), "stop_where": where,
-           "exit_code": 3 if outcome == "stopped" else 4, "resumable": outcome != "stopped"}
+           "exit_code": o.exit_code, "resumable": o.resumable}
     out.update(extra)
     out["scene"] = scene.as_dict()
     out["versions"] = {"fepen": files.__version__}

@@ -166,20 +166,13 @@ class RunDirectory:
         return self
 
     def __exit__(self, kind, err, tb) -> None:
-        from fepen.errors import SimulationError
+        from fepen.errors import stop_outcome
 
         if kind is None:
             outcome, code = "finished", 0
-        elif issubclass(kind, MachineFault) or issubclass(kind, OSError):
-            outcome, code = ("interrupted" if type(err).__name__ == "Interrupted" else "fault"), 4
-        elif issubclass(kind, SimulationError):
-            outcome, code = "stopped", 3
-        elif issubclass(kind, InputError):
-            outcome, code = "bad-input", 2
-        elif issubclass(kind, KeyboardInterrupt):
-            outcome, code = "interrupted", 4
         else:
-            outcome, code = "error", 1
+            o = stop_outcome(err)
+            outcome, code = o.name, o.exit_code
         if self.comm.rank == 0:
             self._close(outcome, code, None if err is None else str(err).splitlines()[0] if str(err) else kind.__name__)
 
