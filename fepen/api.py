@@ -123,19 +123,19 @@ def run(scene, out=None, comm=None, progress: bool = False, force: bool = False)
     """
     from fepen import scene as fscene
     from fepen.io import files, rundir
-    from fepen.runs import run_scene, setup
+    from fepen.runs import resolve, run_scene, setup
 
     comm = _comm(comm)
     sc = scene if isinstance(scene, Scene) else Scene(scene)
-    setup.check_supported(sc)
-    setup.announce(sc, comm)
+    sh = resolve(sc)  # bad input before anything is written; the projectile built once
+    setup.announce(sc, comm, sh.built)
     if out is None:
         out = comm.bcast(tempfile.mkdtemp(prefix="fepen-") if comm.rank == 0 else None, root=0)
     out = Path(out)
     with rundir.RunDirectory(out, comm, "force" if force else "new"):
         files.agree(comm, "scene.toml", lambda: files.write_text(out / "scene.toml", fscene.to_toml(sc), comm))
         try:
-            run_scene(sc, out, comm, progress=progress)
+            run_scene(sc, out, comm, progress=progress, sh=sh)
         finally:
             _figure(out, sc, comm)
     return load(out)

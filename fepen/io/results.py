@@ -25,10 +25,8 @@ COL = {k: i for i, k in enumerate(HISTORY_COLUMNS)}
 #: appended with a charge: mass-averaged acceleration of each body along the axis (tail to nose), in g
 #: (negative while the projectile decelerates)
 CHARGE_COLUMNS = ["shell_acc_g", "charge_acc_g"]
-#: appended with effects.wear: the projectile's mass and the interface heat so far (fepen.laws.wear)
-WEAR_COLUMNS = ["mass_kg", "wear_heat_J"]
-#: appended in a deformable run with effects.wear or effects.erosion: the mass, the interface heat, the
-#: eroded cells and the kinetic energy the removed material carried away, so far
+#: appended with effects.wear or effects.erosion (either fidelity): the mass, the interface heat, the eroded
+#: cells and the kinetic energy the removed material carried away, so far
 REMOVAL_COLUMNS = ["mass_kg", "wear_heat_J", "eroded_cells", "removed_kinetic_J"]
 #: appended with a charge in frictional contact (fepen.solver.shell_charge): friction dissipation, the largest gap,
 #: interpenetration and slip over the wall's node pairs, the fractions of pairs open and sliding
@@ -82,12 +80,13 @@ def write_summary(out: Path, summary: dict, comm=MPI.COMM_WORLD) -> None:
     files.agree(comm, f"{Path(out) / 'summary.json'}", write)
 
 
-def stop_summary(scene, rows, outcome: str, reason: str, where: dict, extra: dict) -> dict:
+def stop_summary(scene: dict, rows, outcome: str, reason: str, where: dict, extra: dict) -> dict:
     """The summary.json of a run that stopped before its end (no collective call: the stop may have come
     from one rank). It reports no result (no Hx_mm, depth_mm, ...): where the run was when it stopped is in
     ``stop_where``.
 
     Args:
+        scene: the resolved scene as a dict (Scene.as_dict()).
         rows: the history rows so far (possibly none).
         outcome: a stop's name in fepen.errors.OUTCOMES ("stopped", "interrupted", "fault", "error", ...),
             which gives its exit code and whether it is resumable.
@@ -104,15 +103,14 @@ def stop_summary(scene, rows, outcome: str, reason: str, where: dict, extra: dic
     out = {"outcome": outcome, "stop_reason": reason, "stop_time_s": where.get("t_s"), "stop_where": where,
            "exit_code": o.exit_code, "resumable": o.resumable}
     out.update(extra)
-    out["scene"] = scene.as_dict()
+    out["scene"] = scene
     out["versions"] = {"fepen": files.__version__}
     return out
 
 
-def comparison(scene, summary: dict) -> dict | None:
-    """Errors against Table 1 when the scene names a shot: nose error |H_sim − H_exp| / |H_exp| with
+def comparison(name: str | None, summary: dict) -> dict | None:
+    """Errors against Table 1 when a shot is named (impact.shot): nose error |H_sim − H_exp| / |H_exp| with
     H = (Hx, Hy) 2-vectors, likewise the tail; and each component's relative error."""
-    name = scene.get("impact.shot")
     if name is None:
         return None
     s = shot(name)
@@ -125,8 +123,13 @@ def comparison(scene, summary: dict) -> dict | None:
             "Hy_error": float(summary["Hy_mm"] / s.Hy_mm - 1), "Ty_error": float(summary["Ty_mm"] / s.Ty_mm - 1)}
 
 
-def summary(scene, rows, outcome: str, extra: dict) -> dict:
-    """summary.json content (contract keys first)."""
+def summary(scene: dict, experiment: str | None, rows, outcome: str, extra: dict) -> dict:
+    """summary.json content (contract keys first).
+
+    Args:
+        scene: the resolved scene as a dict (Scene.as_dict()). experiment: the Table 1 shot compared with, or
+            None. rows: the history rows. outcome: fepen.errors.OUTCOMES' name. extra: further keys.
+    """
     last = rows[-1]
     out = {"Hx_mm": abs(last[COL["nose_x_mm"]]), "Hy_mm": abs(last[COL["nose_y_mm"]]),
            "Tx_mm": abs(last[COL["tail_x_mm"]]), "Ty_mm": abs(last[COL["tail_y_mm"]]),
@@ -134,8 +137,8 @@ def summary(scene, rows, outcome: str, extra: dict) -> dict:
            "residual_speed_m_s": last[COL["speed_m_s"]], "outcome": outcome,
            "energy_error": max(r[COL["energy_error"]] for r in rows), "max_peeq": last[COL["max_peeq"]]}
     out.update(extra)
-    out["experiment"] = comparison(scene, out)
-    out["scene"] = scene.as_dict()
+    out["experiment"] = comparison(experiment, out)
+    out["scene"] = scene
     out["versions"] = files.versions()
     return out
 

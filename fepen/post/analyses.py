@@ -67,6 +67,14 @@ class Gauges:
         self.columns = ["t_s"] + [f"{name}_{round(frac * 100)}pctL" for frac, name, _ in self.targets]
         self.rows = []
 
+    def state(self) -> dict[str, np.ndarray]:
+        """The rows so far (for checkpoints)."""
+        return {"rows": np.array(self.rows, dtype=float)}
+
+    def restore(self, state: dict) -> None:
+        """Put back what state() returned."""
+        self.rows = [list(r) for r in state["rows"]]
+
     def axial_strains(self) -> list[float]:
         """Axial logarithmic strain ln|F a0| of the gauge cells (a0 = reference axis), every rank."""
         s = self.solver
@@ -161,20 +169,27 @@ def deformed_picture(solver, path: Path, title: str = "") -> None:
 PROFILE_BIN = 0.5e-3
 
 
-def nose_profile(solver, model, out: Path) -> dict | None:
+def nose_profile(solver, shape, tip_node, tail_node, tri: np.ndarray, out: Path) -> dict | None:
     """nose_profile.csv and nose_profile.png: the nose's outer radius against the distance behind the
     original tip, before (the exact shape) and after (the largest radius of the final surface's nodes in
     each PROFILE_BIN, in the frame of the deformed axis: tail node to tip node), over the nose and one
-    calibre behind it (collective; rank 0 writes). Returns {"tip_recession_mm", "max_radius_mm"} on every rank.
+    calibre behind it (collective; rank 0 writes).
+
+    Args:
+        solver: the ExplicitSolver. shape: the exact projectile (fepen.geometry.shape.Shape).
+        tip_node, tail_node: node handles of the nose tip and the tail centre (ExplicitSolver.node_at).
+        tri: the surface's facets (node indices, fepen.solver.surface.Surface.tri). out: the results directory.
+
+    Returns:
+        {"tip_recession_mm", "max_radius_mm"} on every rank.
     """
     from fepen.io import files
 
     comm = solver.comm
-    shape = model.pm.shape
     x = solver.positions()
-    tip, tail = solver.node_value(model.tip, x), solver.node_value(model.tail, x)
+    tip, tail = solver.node_value(tip_node, x), solver.node_value(tail_node, x)
     axis = unit_axis(tip, tail)  # tail to nose
-    nodes = np.unique(model.surface.tri)
+    nodes = np.unique(tri)
     nodes = nodes[~solver.orphans[nodes]]
     rel = x[nodes] - tail
     along = rel @ axis
@@ -258,6 +273,14 @@ class ChargeSections:
         self.cells = [nearest_cell(centres, mine, p, self.comm) for _, p in self.points]
         self.columns = ["t_s"] + [f"{n}_{q}_Pa" for n, _ in self.points for q in ("axial", "shear")]
         self.rows = []
+
+    def state(self) -> dict[str, np.ndarray]:
+        """The rows so far (for checkpoints)."""
+        return {"rows": np.array(self.rows, dtype=float)}
+
+    def restore(self, state: dict) -> None:
+        """Put back what state() returned."""
+        self.rows = [list(r) for r in state["rows"]]
 
     def record(self, tip: np.ndarray, tail: np.ndarray) -> None:
         """One row: the stresses at every point (collective); tip, tail: current nose tip and tail centre."""

@@ -1,16 +1,44 @@
-"""Runs: one scene into one results directory (set-up, time loops, stop rules, outputs, checkpoints)."""
+"""Runs: one scene into one results directory.
+
+    shot         the scene resolved once (Shot): the only reader of the scene in fepen.runs
+    setup        the builders of every law, shape and mesh from a scene (used by shot)
+    run          the Run skeleton both fidelities share: loop, stop, summary, history rows
+    rigid        RigidRun: the rigid body (no mesh by default)
+    model        the deformable model: mesh, solver, target, contact, wear, erosion
+    deformable   DeformableRun: the explicit solver's time loop, its outputs, checkpoints and analyses
+    events       the stop rules
+    outputs      History, Fields, Checkpoint, Progress: due / write / close on one clock
+    checkpoint   checkpoint files and --resume
+    interrupts   SIGTERM / SIGINT during a run
+"""
 
 from __future__ import annotations
 
 from mpi4py import MPI
 
-from fepen.runs import setup
+from fepen.runs import setup, shot
 from fepen.runs.rigid import RigidRun
+from fepen.runs.shot import Shot, resolve
 
-__all__ = ["setup", "model", "deformable", "rigid", "events", "outputs", "checkpoint", "run_scene", "RigidRun"]
+__all__ = ["shot", "setup", "run", "rigid", "model", "deformable", "events", "outputs", "checkpoint",
+           "interrupts", "run_scene", "expected_end", "resolve", "Shot", "RigidRun"]
 
 
-def run_scene(scene, out, comm=MPI.COMM_WORLD, progress: bool = False, resume: dict | None = None) -> dict:
+def expected_end(scene, sh: Shot) -> float:
+    """The time a deformable run is expected to end at, for the progress bar: run.end_time, else the end of
+    the same shot with the rigid projectile (a fraction of a second to compute), else its hard end."""
+    if sh.end_time is not None or sh.law is None:
+        return sh.hard_end
+    try:
+        quick = RigidRun(scene.with_sets(["effects.fidelity=rigid", "effects.erosion=false"]), None,
+                         MPI.COMM_SELF).run()
+        return min(sh.hard_end, 1.05 * float(quick["end_time_s"]))
+    except Exception:  # noqa: BLE001 - only the bar's length depends on it
+        return sh.hard_end
+
+
+def run_scene(scene, out, comm=MPI.COMM_WORLD, progress: bool = False, resume: dict | None = None,
+              sh: Shot | None = None) -> dict:
     """Run one scene into a results directory, with the rigid or the deformable projectile.
 
     Args:
@@ -19,13 +47,15 @@ def run_scene(scene, out, comm=MPI.COMM_WORLD, progress: bool = False, resume: d
         comm: the communicator of the run.
         progress: a progress bar on rank 0 (deformable runs).
         resume: a checkpoint's state (fepen.runs.checkpoint.read_state) to continue from (deformable runs).
+        sh: the scene's Shot when already resolved.
 
     Returns:
         The summary (the content of summary.json).
     """
-    setup.check_supported(scene)
-    if scene.effects.fidelity == "rigid":
-        return RigidRun(scene, out, comm).run()
+    sh = sh or resolve(scene)
+    if sh.rigid:
+        return RigidRun(sh, out, comm).run()
     from fepen.runs.deformable import DeformableRun  # dolfinx: only a deformable run pays for importing it
 
-    return DeformableRun(scene, out, comm, progress, resume).run()
+    end = expected_end(scene, sh) if progress and comm.rank == 0 else None
+    return DeformableRun(sh, out, comm, end, resume).run()

@@ -1,5 +1,5 @@
-"""The deformable model of a scene: mesh, explicit solver, target or wall, contact and initial state
-(dolfinx; the scene is read through fepen.runs.setup)."""
+"""The deformable model of a shot: mesh, explicit solver, target or wall, contact, wear, erosion and the
+initial state (dolfinx; built from a fepen.runs.shot.Shot, never from the scene)."""
 
 from __future__ import annotations
 
@@ -12,8 +12,7 @@ from mpi4py import MPI
 from fepen.geometry import mesh as fmesh
 from fepen.geometry import tags
 from fepen.laws import target as tg
-from fepen.laws import wear
-from fepen.runs import setup
+from fepen.runs import setup, shot
 from fepen.solver import erosion, explicit, recession, rigid_wall, shell_charge, surface, target_load
 
 
@@ -48,58 +47,58 @@ class Model:
     recession: recession.Recession | None = None
 
 
-def solver(scene, pm: fmesh.ProjectileMesh, kernel: str | None = None) -> explicit.ExplicitSolver:
-    """The explicit solver on a scene's mesh: the shell's material, and the charge's on its cells.
+def solver(sh, pm: fmesh.ProjectileMesh, kernel: str | None = None) -> explicit.ExplicitSolver:
+    """The explicit solver on a shot's mesh: the shell's material, and the charge's on its cells.
 
     Args:
+        sh: the Shot (a Scene is resolved).
         kernel: "C", "numba" or None (the C trial pass where it can be built).
     """
-    mats = [setup.projectile_material(scene)]
+    sh = shot.of(sh)
+    mats = [sh.materials[0]]
     cellmat = np.zeros(pm.mesh.topology.index_map(3).size_local, dtype=np.int64)
     if pm.charge:  # material 1: the charge, tied through shared wall nodes or in contact (split)
-        mats.append(setup.charge_material(scene))
+        mats.append(sh.materials[1])
         cellmat[fmesh.owned_cells_tagged(pm, tags.CHARGE)] = 1
-    s = explicit.ExplicitSolver(pm.mesh, mats, cellmat, scene.run.safety_factor, kernel=kernel)
-    if scene.run.stable_step == "eigenvalue":
+    s = explicit.ExplicitSolver(pm.mesh, mats, cellmat, sh.safety_factor, kernel=kernel)
+    if sh.stable_step == "eigenvalue":
         s.calibrate_step()
     return s
 
 
-def build(scene, comm: MPI.Comm = MPI.COMM_WORLD) -> Model:
-    """Mesh, solver, target or wall, contact and initial state of a deformable run."""
+def build(sh, comm: MPI.Comm = MPI.COMM_WORLD) -> Model:
+    """Mesh, solver, target or wall, contact and initial state of a deformable run.
+
+    Args:
+        sh: the Shot (a Scene is resolved).
+    """
+    sh = shot.of(sh)
     t0 = time.perf_counter()
-    pm = setup.mesh(scene, comm)
+    pm = setup.build_mesh(sh.built, sh.mesh, comm)
     mesh_s = time.perf_counter() - t0
     t0 = time.perf_counter()
-    s = solver(scene, pm)
+    s = solver(sh, pm)
     contact = None
     if pm.split:
-        contact = shell_charge.ShellChargeContact(s, pm.facet_tags, scene.charge.friction)
+        contact = shell_charge.ShellChargeContact(s, pm.facet_tags, sh.charge_friction)
         s.interface = contact
     tip = s.node_at(pm.shape.tip)
     tail = s.node_at(pm.shape.tail)
-    R, v = setup.placement(scene)
-    v0 = float(np.linalg.norm(v))
-    surf = law = None
-    if scene.target.kind == "concrete":
-        law = setup.target_law(scene)
+    surf = None
+    if sh.law is not None:
         surf = surface.outer_surface(s.V, pm.facet_tags, pm.shape)
-        load = target_load.TargetLoad(s, surf, law, tip, tail, setup.crater(scene, law, s.total_mass, v0))
+        load = target_load.TargetLoad(s, surf, sh.law, tip, tail, sh.crater(s.total_mass))
     else:
         load = rigid_wall.RigidWall(s)
     s.external = load
     eroding = receding = None
-    if scene.effects.erosion:
-        pe = scene.projectile.erosion
-        eroding = erosion.Erosion(s, surf, pe.strain, pe.step_ratio)
-    if scene.effects.wear and surf is not None:
-        m = scene.projectile.material
-        mu = scene.get("projectile.wear.friction")
-        h = wear.melt_enthalpy(m.specific_heat, m.melt_temperature, m.room_temperature,
-                               scene.projectile.wear.latent_heat)
-        receding = recession.Recession(s, surf, scene.target.friction if mu is None else mu,
-                                       scene.projectile.wear.efficiency, h, m.density)
+    if sh.erosion is not None:
+        eroding = erosion.Erosion(s, surf, sh.erosion.strain, sh.erosion.step_ratio)
+    if sh.wear is not None and surf is not None:
+        w = sh.wear
+        receding = recession.Recession(s, surf, w.friction, w.efficiency, w.enthalpy, w.density)
         load.wear = receding
+    R, v = sh.rotation, sh.velocity
     s.set_initial(displacement=lambda X: X @ R.T - X, velocity=lambda X: np.tile(v, (len(X), 1)))
-    return Model(pm, s, load, contact, tip, tail, v0, surf, law, mesh_s, time.perf_counter() - t0, eroding,
-                 receding)
+    return Model(pm, s, load, contact, tip, tail, sh.speed, surf, sh.law, mesh_s, time.perf_counter() - t0,
+                 eroding, receding)

@@ -1,7 +1,7 @@
-"""What a deformable run writes while it advances, as objects the time loop iterates over: each has
-``due(run)``, ``write(run)`` and ``close(run, completed)``; the timed ones share one catch-up clock.
+"""What a run writes while it advances, as objects the time loop (fepen.runs.run.Run.advance) iterates over:
+each has ``due(run)``, ``write(run)`` and ``close(run, completed)``; the timed ones share one catch-up clock.
 
-    History      a history row (with the gauges and the charge sections) every history interval
+    History      a history row (with the gauges and the charge sections) every history interval (both fidelities)
     Fields       the fields (fepen.io.fields) every run.output_interval, and history.csv with them
     Checkpoint   a checkpoint (fepen.runs.checkpoint) every run.checkpoint_interval, and history.csv
     Progress     the tqdm bar on rank 0
@@ -38,15 +38,24 @@ class Timed:
         self.clock = Clock(interval, first)
 
     def due(self, run) -> bool:
-        return self.clock.due(run.solver.t)
+        return self.clock.due(run.t)
+
+    def state(self) -> dict:
+        """The next output time (for checkpoints)."""
+        return {"next": self.clock.next}
+
+    def restore(self, state: dict) -> None:
+        """Put back what state() returned."""
+        self.clock.next = state["next"]
 
 
 class History(Timed):
-    """The history row, strain gauges and charge sections (``run.record()``) at every interval."""
+    """The history row (``run.record()``: with the strain gauges and charge sections of a deformable run) at every
+    interval; history.csv at the close, kept even when the run failed."""
 
     def write(self, run) -> None:
         run.record()
-        self.clock.advance(run.solver.t)
+        self.clock.advance(run.t)
 
     def close(self, run, completed: bool) -> None:
         run.write_history()  # kept even when the run failed
@@ -59,7 +68,7 @@ class Fields(Timed):
         t0 = perf_counter()
         run.write_fields()
         run.write_history()
-        self.clock.advance(run.solver.t)
+        self.clock.advance(run.t)
         run.output_s += perf_counter() - t0
 
     def close(self, run, completed: bool) -> None:
@@ -74,7 +83,7 @@ class Checkpoint(Timed):
 
     def write(self, run) -> None:
         t0 = perf_counter()
-        self.clock.advance(run.solver.t)
+        self.clock.advance(run.t)
         run.write_history()
         run.write_checkpoint()
         run.output_s += perf_counter() - t0
@@ -86,7 +95,7 @@ class Checkpoint(Timed):
 
 class Progress:
     """The tqdm bar of rank 0, refreshed every EVERY steps, in microseconds of simulated time, to the run's
-    expected end (DeformableRun.expected_end)."""
+    expected end (fepen.runs.expected_end)."""
 
     EVERY = 200
 
@@ -96,10 +105,10 @@ class Progress:
         self.bar = tqdm(total=round(end * 1e6), initial=round(t * 1e6), unit="us", desc="fepen", leave=False)
 
     def due(self, run) -> bool:
-        return run.solver.step_count % self.EVERY == 0
+        return run.step_count % self.EVERY == 0
 
     def write(self, run) -> None:
-        self.bar.n = round(run.solver.t * 1e6)
+        self.bar.n = round(run.t * 1e6)
         self.bar.total = max(self.bar.total, self.bar.n)  # a run longer than expected
         self.bar.refresh()
 

@@ -6,7 +6,7 @@ Scene (the deformable model on top of them: fepen.runs.model). No module below f
 from __future__ import annotations
 
 import math
-from dataclasses import replace
+from dataclasses import dataclass, replace
 
 import numpy as np
 from mpi4py import MPI
@@ -24,17 +24,26 @@ from fepen.targets import CONSTANTS, TARGETS
 # ---------------------------------------------------------------------------------------------------------
 # laws and shape from the scene
 # ---------------------------------------------------------------------------------------------------------
-def projectile_material(scene):
-    """The projectile material (fepen.laws.materials.Material): elastic or Johnson-Cook by effects.fidelity."""
+def projectile_material(scene, built: Built | None = None):
+    """The projectile material (fepen.laws.materials.Material): elastic or Johnson-Cook by effects.fidelity.
+
+    Args:
+        built: the projectile, when already built (its shell density); default: projectile(scene).
+    """
     from fepen.laws import materials as M  # numba: only a deformable run pays for importing it
 
     m = scene.projectile.material
-    rho = projectile(scene).shell_density
+    rho = (built or projectile(scene)).shell_density
     if scene.effects.fidelity == "elastic":
         return M.elastic(m.youngs_modulus, m.poisson_ratio, rho)
     return M.johnson_cook(m.youngs_modulus, m.poisson_ratio, rho, m.A, m.B, m.n, m.C, m.m,
                           m.melt_temperature, m.room_temperature, m.reference_strain_rate, m.specific_heat,
                           m.taylor_quinney, scene.effects.strain_rate, scene.effects.thermal)
+
+
+def materials(scene, built: Built) -> list:
+    """The deformable fidelities' materials: the shell's, then the charge's when effects.charge."""
+    return [projectile_material(scene, built)] + ([charge_material(scene)] if scene.effects.charge else [])
 
 
 def charge_material(scene):
@@ -227,10 +236,10 @@ def friction_note(scene) -> str | None:
             "and give target.S_coefficient and target.S_size (docs/validation-depth.md)")
 
 
-def announce(scene, comm) -> Built:
-    """projectile(scene), with its note (if any) and the friction note logged once, on rank 0: the front door
-    of a run or a mesh."""
-    built = projectile(scene)
+def announce(scene, comm, built: Built | None = None) -> Built:
+    """projectile(scene) (or ``built``), with its note (if any) and the friction note logged once, on rank 0:
+    the front door of a run or a mesh."""
+    built = built or projectile(scene)
     if comm.rank == 0:
         import logging
 
@@ -255,26 +264,71 @@ def placement(scene) -> tuple[np.ndarray, np.ndarray]:
     return R, v
 
 
-def check_supported(scene) -> None:
-    """Raise InputError for settings this version cannot simulate, before anything is meshed."""
-    projectile_shape(scene)
+def check_supported(scene, built: Built | None = None) -> Built:
+    """Raise InputError for settings this version cannot simulate, before anything is meshed.
+
+    Args:
+        built: the projectile, when already built; default: projectile(scene) (InputError on its geometry).
+
+    Returns:
+        The built projectile.
+    """
+    built = built or projectile(scene)
     if scene.effects.fidelity == "rigid" and scene.target.kind != "concrete":
         raise InputError("effects.fidelity", "'rigid' runs against target.kind = 'concrete'; a rigid "
                                              "projectile on a rigid wall has nothing to compute")
+    return built
 
 
-def crater(scene, law: tg.TargetLaw, mass: float, v0: float) -> tg.ForrestalCrater | None:
-    """Forrestal's linear crater when effects.crater = "linear", else None (the energy crater is in the law)."""
-    if law.crater != "linear":
-        return None
-    shape = projectile(scene).shape
-    return tg.ForrestalCrater(law, mass, v0, scene.projectile.crh,
-                              None if shape.nose == "ogive" and not shape.meplat_diameter else shape.nose_factor())
+def body_key(scene) -> tuple:
+    """What identifies a scene's projectile body: its projectile.* and charge.* keys, effects.charge and
+    mesh.rigid_panel (a sweep's shots with equal keys share one body)."""
+    return tuple((k, repr(scene.get(k))) for k in SCHEMA
+                 if k.startswith(("projectile.", "charge.")) or k in ("effects.charge", "mesh.rigid_panel"))
 
 
 # ---------------------------------------------------------------------------------------------------------
 # the mesh
 # ---------------------------------------------------------------------------------------------------------
+@dataclass(frozen=True)
+class MeshRequest:
+    """The volume mesh of a projectile, as fepen.geometry.mesh.create takes it.
+
+    Attributes:
+        options: gmsh's sizes and optimiser. charge: mesh the charge. split: give the charge its own wall
+        nodes (a deformable charge in frictional contact). mass: projectile.mass or None.
+        charge_density: kg/m^3. rigid_panel: mesh.rigid_panel (the rigid body's load-point panels) or None.
+    """
+
+    options: gmsh_model.MeshOptions
+    charge: bool
+    split: bool
+    mass: float | None
+    charge_density: float
+    rigid_panel: float | None
+
+
+def mesh_request(scene) -> MeshRequest:
+    """The MeshRequest of a scene."""
+    charge = bool(scene.effects.charge)
+    split = charge and scene.charge.contact == "frictional" and scene.effects.fidelity != "rigid"
+    opts = gmsh_model.MeshOptions(scene.mesh.size, scene.get("mesh.nose_size"), scene.mesh.optimize)
+    return MeshRequest(opts, charge, split, scene.get("projectile.mass"), scene.charge.material.density,
+                       scene.get("mesh.rigid_panel"))
+
+
+def build_mesh(built: Built, request: MeshRequest, comm: MPI.Comm = MPI.COMM_WORLD, use_cache: bool = True,
+               split: bool | None = None) -> fmesh.ProjectileMesh:
+    """The distributed mesh of a built projectile.
+
+    Args:
+        split: override request.split (give the charge its own wall nodes).
+    """
+    return fmesh.create(built.shape, request.options, comm, charge=request.charge, mass=request.mass,
+                        shell_density=built.shell_density, charge_density=request.charge_density,
+                        split=request.split if split is None else split, use_cache=use_cache)
+
+
 def mesh(scene, comm: MPI.Comm = MPI.COMM_WORLD, use_cache: bool = True,
          split: bool | None = None) -> fmesh.ProjectileMesh:
     """The distributed projectile mesh of a scene.
@@ -282,14 +336,7 @@ def mesh(scene, comm: MPI.Comm = MPI.COMM_WORLD, use_cache: bool = True,
     Args:
         split: give the charge its own wall nodes; default: a deformable charge in frictional contact.
     """
-    built = projectile(scene)  # InputError on impossible geometry, on every rank
-    charge = bool(scene.effects.charge)
-    if split is None:
-        split = charge and scene.charge.contact == "frictional" and scene.effects.fidelity != "rigid"
-    opts = gmsh_model.MeshOptions(scene.mesh.size, scene.get("mesh.nose_size"), scene.mesh.optimize)
-    return fmesh.create(built.shape, opts, comm, charge=charge, mass=scene.get("projectile.mass"),
-                        shell_density=built.shell_density,
-                        charge_density=scene.charge.material.density, split=split, use_cache=use_cache)
+    return build_mesh(projectile(scene), mesh_request(scene), comm, use_cache, split)
 
 
 def densities(scene) -> dict[int, float]:

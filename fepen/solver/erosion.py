@@ -46,6 +46,14 @@ class Erosion:
         self.pending = False  # cells eroded inside a step since the run last looked (take_pending)
         solver.on_inverted = self._erode_inverted
 
+    def state(self) -> dict:
+        """The count of eroded cells (for checkpoints; the mesh's state is the solver's)."""
+        return {"count": self.count}
+
+    def restore(self, state: dict) -> None:
+        """Put back what state() returned."""
+        self.count = int(state["count"])
+
     def _face_codes(self, cells: np.ndarray) -> np.ndarray:
         """One int64 code per face (4 per cell, in _FACES order) from its nodes' sorted global numbers."""
         if self._n_global > 2_000_000:

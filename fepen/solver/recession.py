@@ -60,6 +60,16 @@ class Recession:
         self._adj = None
 
     # --------------------------------------------------------------------------------------------------
+    def state(self) -> dict[str, np.ndarray]:
+        """The heat and recession so far (for checkpoints)."""
+        return {"heat_nodes": self.heat_nodes, "depth": self.depth, "heat_total": np.array([self.heat_total])}
+
+    def restore(self, state: dict) -> None:
+        """Put back what state() returned."""
+        self.heat_nodes[:] = state["heat_nodes"]
+        self.depth[:] = state["depth"]
+        self.heat_total = float(state["heat_total"][0])
+
     def add(self, force: np.ndarray, n: np.ndarray, v: np.ndarray, dt: float) -> None:
         """Record one step's heat at the surface's points (their target forces, normals, velocities): the
         heat of fepen.laws.wear.heat_rates × Δt, a third to each of the point's facet nodes."""

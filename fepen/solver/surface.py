@@ -133,6 +133,15 @@ class Surface:
 
     FIELDS = ("tri", "X", "area0", "flat0", "N0", "n_flat0", "radius", "R_meridian", "sin_phi0", "cell")
 
+    def state(self) -> dict[str, np.ndarray]:
+        """The load points (for checkpoints: wear and erosion change them)."""
+        return {k: getattr(self, k) for k in self.FIELDS}
+
+    def restore(self, state: dict) -> None:
+        """Put back what state() returned."""
+        for k in self.FIELDS:
+            setattr(self, k, np.ascontiguousarray(state[k]))
+
     def keep(self, mask: np.ndarray) -> None:
         """Keep only the facets where mask is True (in place)."""
         for k in self.FIELDS:

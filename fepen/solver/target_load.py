@@ -70,3 +70,12 @@ class TargetLoad:
         solver.fext[:n_own] += arr[:n_own]
         self.force, self.contact_nodes, self.area = load.total, load.loaded, load.area
         solver.times.target_comm += comm_s
+
+    def state(self) -> dict[str, np.ndarray]:
+        """The load's last totals (for checkpoints; the same on every rank)."""
+        return {"force": np.asarray(self.force, dtype=float), "totals": np.array([self.contact_nodes, self.area])}
+
+    def restore(self, state: dict) -> None:
+        """Put back what state() returned."""
+        self.force = np.array(state["force"][:3])
+        self.contact_nodes, self.area = int(state["totals"][0]), float(state["totals"][1])

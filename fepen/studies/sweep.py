@@ -384,13 +384,13 @@ def _product(lists):
 
 def _check_shots(sweep: Sweep) -> None:
     """Resolve every shot's scene and build each distinct projectile once: bad input before any shot runs."""
-    from fepen.runs import rigid, setup
+    from fepen.runs import setup
 
     seen = set()
     for i in range(len(sweep.shots)):
         sc = sweep.scene(i)
         try:
-            key = rigid._body_key(sc)
+            key = setup.body_key(sc)
             if key not in seen or (sc.effects.fidelity == "rigid" and sc.target.kind != "concrete"):
                 seen.add(key)
                 setup.check_supported(sc)  # builds the projectile: once per distinct one

@@ -125,7 +125,7 @@ def test_rigid_rings_give_the_closed_form_nose_force(name):
     sc = scene.Scene(None, ["effects.fidelity=rigid", "effects.crater=none", "effects.free_surface=false",
                             "target.onset_angle_deg=0"])
     law = setup.target_law(sc)
-    pts = rigid.ring_points(sc, shape)
+    pts = rigid.ring_points(shape)
     V = 800.0
     x = pts["X"] - np.array([0.0, 10.0, 0.0])
     v = np.tile([0.0, -V, 0.0], (len(x), 1))

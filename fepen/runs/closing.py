@@ -1,0 +1,75 @@
+"""The closing analyses of a completed deformable run: the gauges and hazard map, the charge's sections and
+report, the accelerations (raw and filtered), the stress maps and the trajectory, or the deformed picture,
+and the nose profile. Each computes and writes its own quantity; ``Closing.summary()`` hands the peaks, the
+charge report and the nose profile to the summary.
+"""
+
+from __future__ import annotations
+
+import numpy as np
+
+from fepen.experiments import shot as table1_shot
+from fepen.io import files, results
+from fepen.post import analyses, signals, slices
+
+
+class Closing:
+    """What a completed deformable run writes after its loop, and the summary keys it gives."""
+
+    def __init__(self):
+        self.peaks: dict | None = None
+        self.charge: dict | None = None
+        self.profile: dict | None = None
+
+    def write(self, run) -> None:
+        """Write the closing analyses of ``run`` (a fepen.runs.deformable.DeformableRun; collective)."""
+        run.gauges.write(run.out)
+        if run.sections is not None:
+            run.sections.write(run.out)
+        self.peaks = accelerations(run)
+        if run.pm.charge:
+            report = None
+            if run.comm.rank == 0:
+                report = slices.charge_report(run.out, run.sections.sections, self.peaks["charge_acc"]["t_s"])
+            self.charge = run.comm.bcast(report, root=0)
+        s = run.solver
+        if run.fields is not None:  # the cut planes at peak load and at the end, and the shot (Figs. 18, 20-21)
+            if run.comm.rank == 0:
+                name = run.shot.experiment
+                slices.stress_maps(run.out, run.out / "stress_maps_peak.png", self.peaks["decel"]["t_s"])
+                slices.stress_maps(run.out, run.out / "stress_maps_end.png")
+                slices.trajectory_figure(run.out, run.out / "trajectory.png", table1_shot(name) if name else None)
+        else:
+            analyses.deformed_picture(s, run.out / "deformed.png",
+                                      f"t = {s.t * 1e6:.0f} us, max PEEQ {s.max_peeq():.3g}")
+        m = run.model
+        if m.surface is not None:
+            self.profile = analyses.nose_profile(s, run.pm.shape, m.tip, m.tail, m.surface.tri, run.out)
+
+    def summary(self) -> dict:
+        """The summary keys of the closing analyses (None where they were not written)."""
+        return {"peak_accelerations": self.peaks, "charge": self.charge, "nose_profile": self.profile}
+
+
+def accelerations(run) -> dict:
+    """accelerations.csv: the target deceleration (and with a charge each body's axial acceleration), raw and
+    low-pass filtered (run.acceleration_filter_hz). Returns the peaks."""
+    rows = np.array(run.rows)
+    t = rows[:, 0]
+    columns = run.columns
+    names = ["decel_g"] + (results.CHARGE_COLUMNS if run.pm.charge else [])
+    cut = run.shot.outputs.acceleration_filter_hz
+    cols, header, peaks = [t], ["t_s"], {}
+    for name in names:
+        raw = rows[:, columns.index(name)]
+        filt = signals.lowpass(t, raw, cut)
+        cols += [raw, filt]
+        header += [name, name.replace("_g", "_filtered_g")]
+        k = int(np.argmax(np.abs(filt)))
+        depth = rows[k, columns.index("nose_y_mm")]
+        peaks[name.replace("_g", "")] = {"filtered_g": float(filt[k]), "t_s": float(t[k]),
+                                         "nose_depth_mm": float(depth),
+                                         "raw_peak_g": float(raw[np.argmax(np.abs(raw))])}
+    body = "\n".join(",".join(f"{v:.9g}" for v in r) for r in np.column_stack(cols))
+    files.write_text(run.out / "accelerations.csv", ",".join(header) + "\n" + body + "\n", run.comm)
+    return peaks

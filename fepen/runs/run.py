@@ -1,0 +1,280 @@
+"""What the rigid and the deformable run share: one skeleton (a template method) that both fidelities fill in.
+
+    Run.run()       the signals, the time loop, the end or the stop, the summary
+    Run.advance()   the loop: the due outputs, a step, the stop rules, every SIGNAL_EVERY steps the signals
+    Run.record()    a history row from the body's snapshot(), with the layer crossings sampled there
+    Run.summary()   the summary with the removal keys and the crossings, once for both
+    Run.write_stop  summary.json of a stop, its outcome from fepen.errors.stop_outcome
+
+A body (fepen.runs.rigid.RigidRun, fepen.runs.deformable.DeformableRun) gives its step (``step``), its
+stop-rule sample (``extent``), its history snapshot (``snapshot``), its outputs, its summary keys and
+``state()/restore()``. This module never imports its subclasses.
+"""
+
+from __future__ import annotations
+
+import time
+from dataclasses import dataclass, field
+
+import numpy as np
+from mpi4py import MPI
+
+from fepen.errors import stop_outcome
+from fepen.io import files, results, rundir
+from fepen.laws import layers as fl
+from fepen.runs import events, interrupts, outputs
+from fepen.runs.shot import Shot
+
+#: steps between two looks at the signals (one reduction under MPI)
+SIGNAL_EVERY = 20
+
+
+@dataclass
+class Snapshot:
+    """The state a history row is made of (world frame, SI).
+
+    Attributes:
+        tip, tail: positions of the nose tip and the tail centre (m). velocity: centre-of-mass velocity (m/s).
+        force: the target's force (N). mass: the projectile's mass now (kg). energies: fepen.io.results.
+        history_row's energies. contact: loaded points. dt: the step (s). peeq: the largest plastic strain.
+        area: the loaded area (m^2). rear_depth: the shallowest load point's depth (m; the crossings).
+        extra: the body's own columns (charge, interface), in Run.columns' order.
+    """
+
+    tip: np.ndarray
+    tail: np.ndarray
+    velocity: np.ndarray
+    force: np.ndarray
+    mass: float
+    energies: dict
+    contact: int
+    dt: float
+    peeq: float
+    area: float
+    rear_depth: float
+    extra: list = field(default_factory=list)
+
+
+@dataclass
+class Removal:
+    """What wear and erosion took off so far (every rank the same numbers)."""
+
+    mass_kg: float = 0.0
+    heat_J: float = 0.0
+    eroded_cells: int = 0
+    kinetic_J: float = 0.0
+    elastic_J: float = 0.0
+
+
+class Run:
+    """One shot into one results directory: the skeleton both fidelities share.
+
+    Args:
+        shot: the resolved shot (fepen.runs.shot.Shot).
+        out: the results directory (None: write nothing).
+        comm: the run's communicator.
+    """
+
+    fidelity: str = ""
+    #: steps between two checks of the stop rules
+    check_every: int = 1
+
+    def __init__(self, shot: Shot, out, comm=MPI.COMM_WORLD):
+        self.shot, self.comm = shot, comm
+        self.wall_t0 = time.perf_counter()
+        self.wall_before = 0.0  # wall seconds of the runs this one resumes
+        self.output_s = 0.0
+        self.out = files.prepare(out, comm) if out is not None else None
+        self.rows: list[list[float]] = []
+        law = shot.law
+        self.rules = events.StopRules(law.thickness if law is not None else None, shot.end_time is None)
+        self.crossings = fl.Crossings(law.faces()) if shot.layered else None
+        self.removing = shot.wear is not None or shot.erosion is not None
+        self.history = outputs.History(shot.outputs.history_interval)
+        self.outputs: list = [self.history]
+        self.stop: BaseException | None = None  # what stopped the run before its end
+
+    # ---- what a body gives ------------------------------------------------------------------------------
+    t: float
+    step_count: int
+
+    def step(self) -> None:
+        """Advance one step."""
+        raise NotImplementedError
+
+    def extent(self) -> tuple[float, float, np.ndarray, np.ndarray, float, float] | None:
+        """(lowest and highest load-point y, centre-of-mass velocity, axis tail to nose, mass, striking
+        kinetic energy) for the stop rules, or None when the rules need not look (collective)."""
+        raise NotImplementedError
+
+    def snapshot(self) -> Snapshot:
+        """The state of a history row (collective)."""
+        raise NotImplementedError
+
+    def removal(self) -> Removal:
+        """What wear and erosion took off so far (collective)."""
+        return Removal()
+
+    def interrupt(self, name: str) -> None:
+        """A caught signal: keep what can be kept, then raise Interrupted (collective)."""
+        raise NotImplementedError
+
+    def finish_loop(self) -> None:
+        """After the loop's end: the final state's history row (and the body's other outputs of it)."""
+        self.record()
+
+    def summary_extra(self, loop_s: float) -> dict:
+        """The body's own summary keys."""
+        return {}
+
+    def stop_extra(self) -> dict:
+        """The body's keys of a stop's summary."""
+        return {}
+
+    def write_closing(self) -> None:
+        """The closing analyses of a completed run."""
+
+    @property
+    def columns(self) -> list[str]:
+        """history.csv's columns."""
+        return results.HISTORY_COLUMNS + (results.REMOVAL_COLUMNS if self.removing else [])
+
+    @property
+    def wall_s(self) -> float:
+        return self.wall_before + time.perf_counter() - self.wall_t0
+
+    # ---- the skeleton -----------------------------------------------------------------------------------
+    def run(self) -> dict:
+        """Advance to the end time or a stop rule; write the outputs; return the summary. A stop (an error, a
+        signal, a full disk) closes the outputs, writes summary.json with the stop and raises again."""
+        t_loop = time.perf_counter()
+        outcome, completed = None, False
+        try:
+            with interrupts.Interrupts(self.comm) as signals:
+                outcome = self.advance(signals)
+            self.finish_loop()
+            completed = True
+        except BaseException as err:
+            self.stop = err
+            raise
+        finally:
+            t_out = time.perf_counter()
+            self.close_outputs(completed)
+            if completed:
+                self.write_closing()
+            self.output_s += time.perf_counter() - t_out
+            if self.stop is not None and self.out is not None:
+                self.write_stop(self.stop)
+        try:
+            return self.write_summary(outcome or "ended", time.perf_counter() - t_loop)
+        except BaseException as err:  # a full disk at the last write: the stop's record, in the space held back
+            self.stop = err
+            if self.out is not None:
+                self.write_stop(err)
+            raise
+
+    def advance(self, signals) -> str | None:
+        """The time loop: the due outputs, a step, the stop rules, every SIGNAL_EVERY steps the signals (a
+        caught SIGTERM or SIGINT interrupts after the next outputs). Returns the outcome of a stop rule, or
+        None at the end of time."""
+        outcome = caught = None
+        while outcome is None and self.t < self.shot.hard_end:
+            for o in self.outputs:
+                if o.due(self):
+                    o.write(self)
+            if caught is not None:
+                self.interrupt(caught)
+            self.step()
+            outcome = self.stop_rules()
+            if self.step_count % SIGNAL_EVERY == 0:
+                caught = signals.stop()
+        return outcome
+
+    def stop_rules(self) -> str | None:
+        """The outcome if a stop rule fires (fepen.runs.events), else None; checked every check_every steps."""
+        if self.step_count % self.check_every:
+            return None
+        sample = self.extent()
+        if sample is None:
+            return None
+        y_min, y_max, v_cm, axis, mass, ke0 = sample
+        if not (self.rules.entered or y_min < 0.0):
+            return None  # not in the target yet
+        return self.rules.penetration(y_min, y_max, v_cm, axis, mass, ke0)
+
+    def record(self) -> list[float]:
+        """Append one history row from the body's snapshot (and sample the layer crossings there)."""
+        s = self.snapshot()
+        row = results.history_row(self.t, s.tip, s.tail, s.velocity, s.force, s.mass, s.energies, s.contact,
+                                  s.dt, s.peeq, s.area) + list(s.extra)
+        if self.removing:
+            r = self.removal()
+            row += [s.mass, r.heat_J, r.eroded_cells, r.kinetic_J]
+        results.finite_row(row, self.step_count, self.t)
+        self.rows.append(row)
+        if self.crossings is not None:
+            self.crossings.update(self.t, -float(s.tip[1]), s.rear_depth, float(np.linalg.norm(s.velocity)))
+        return row
+
+    def close_outputs(self, completed: bool) -> None:
+        """Close every output (history.csv, the fields, the checkpoints, the bar); while stopping, a failing
+        close is logged, not raised (the stop's own error is the one to report)."""
+        for o in reversed(self.outputs):
+            if self.stop is None:
+                o.close(self, completed)
+                continue
+            try:
+                o.close(self, completed)
+            except Exception as err:  # noqa: BLE001 - into fepen.log: the console says only the stop
+                rundir.log_line(f"fepen: while stopping, {type(o).__name__.lower()} output: {err}")
+
+    def write_history(self) -> None:
+        """history.csv of the rows so far (collective)."""
+        if self.out is not None:
+            results.write_history(self.rows, self.out, self.comm, self.columns)
+
+    # ---- the summary --------------------------------------------------------------------------------------
+    def removal_summary(self) -> dict:
+        """Mass loss, length change, eroded cells, the wear heat and the removed energies (zero when wear and
+        erosion are off), and the layer crossings' state."""
+        r = self.removal()
+        mass0 = self.initial_mass
+        length0 = self.shot.built.shape.length * 1e3
+        length = self.rows[-1][results.COL["length_mm"]] if self.rows else length0
+        return {"mass_loss_kg": r.mass_kg, "mass_loss_percent": 100.0 * r.mass_kg / mass0,
+                "remaining_mass_kg": mass0 - r.mass_kg, "length_change_mm": length - length0,
+                "eroded_cells": r.eroded_cells,
+                "crossings": self.crossings.state() if self.crossings is not None else None,
+                "wear_heat_J": r.heat_J, "removed_kinetic_J": r.kinetic_J, "removed_elastic_J": r.elastic_J}
+
+    initial_mass: float
+
+    def write_summary(self, outcome: str, loop_s: float) -> dict:
+        """The summary (summary.json when the run has a directory)."""
+        extra = {"steps": self.step_count, "end_time_s": self.t, "wall_s": self.wall_s,
+                 "ranks": self.comm.size, "fidelity": self.fidelity,
+                 "peak_memory_bytes": files.peak_memory_bytes(self.comm)}
+        extra.update(self.summary_extra(loop_s))
+        extra.update(self.removal_summary())
+        summary = results.summary(self.shot.scene, self.shot.experiment, self.rows, outcome, extra)
+        if self.crossings is not None:
+            summary.update(self.crossings.summary(self.shot.law, 1e-3 * summary["depth_mm"]))
+        if self.out is not None:
+            results.write_summary(self.out, summary, self.comm)
+        return summary
+
+    def write_stop(self, err: BaseException) -> None:
+        """summary.json of a stopped run: its outcome (fepen.errors.OUTCOMES), stop_reason, stop_time_s,
+        where (rank 0, no collective: the stop may have come from one rank; a full disk leaves the last one)."""
+        steps, t = getattr(self, "step_count", 0), getattr(self, "t", 0.0)
+        reason = str(err).splitlines()[0] if str(err) else type(err).__name__
+        extra = {"steps": steps, "end_time_s": t, "ranks": self.comm.size, "fidelity": self.fidelity,
+                 "wall_s": self.wall_s, **self.stop_extra()}
+        summary = results.stop_summary(self.shot.scene, self.rows, stop_outcome(err).name, reason,
+                                       {"step": steps, "t_s": t}, extra)
+        if self.comm.rank == 0:
+            rundir.release_reserve()
+            try:
+                files.write_json(self.out / "summary.json", summary, MPI.COMM_SELF)
+            except OSError as e:
+                rundir.log_line(f"fepen: summary.json of the stop not written: {e}")

@@ -1,0 +1,198 @@
+"""A scene resolved once into what a run reads: the built projectile, the target law, the placement, the
+crater's inputs, the wear and erosion parameters, the end time and the output settings (a frozen ``Shot``).
+
+``resolve(scene)`` is the only reader of the scene in fepen.runs: the rigid and the deformable run, the
+deformable model and the outputs take a Shot. It builds the projectile once (a CAD file is imported once per
+run) with fepen.runs.setup, the builders of every law and shape.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass, field
+
+import numpy as np
+
+from fepen.geometry.shape import Built
+from fepen.laws import target as tg
+from fepen.laws import wear
+from fepen.runs import setup
+
+#: the longest a run without run.end_time may last (s): deformable, rigid
+MAX_TIME = {"deformable": 5e-3, "rigid": 5e-2}
+#: a layered target's run without run.end_time lasts at least this many times the time to reach its last
+#: face at the striking speed
+LAYERED_TIME = 20.0
+
+
+@dataclass(frozen=True)
+class WearParameters:
+    """The nose wear of both fidelities (docs/theory.md §14): interface friction μ, melt efficiency η, the
+    enthalpy to melt a kilogram h (J/kg) and the steel's density (kg/m^3)."""
+
+    friction: float
+    efficiency: float
+    enthalpy: float
+    density: float
+
+
+@dataclass(frozen=True)
+class ErosionParameters:
+    """Element erosion (docs/theory.md §15): the strain and the step ratio that erode a cell."""
+
+    strain: float | None
+    step_ratio: float
+
+
+@dataclass(frozen=True)
+class OutputSettings:
+    """What a run writes and how often (s of simulated time)."""
+
+    history_interval: float
+    output_interval: float
+    fields: bool
+    field_names: tuple[str, ...]
+    checkpoint_interval: float
+    acceleration_filter_hz: float
+
+
+@dataclass(frozen=True, eq=False)
+class Shot:
+    """One resolved shot.
+
+    Attributes:
+        fidelity: "rigid", "elastic" or "plastic".
+        built: the projectile (fepen.geometry.shape.Built), built once.
+        law: the target law (TargetLaw, or Layered), None on the rigid wall.
+        rotation, velocity: the body's rotation about the nose tip (3x3) and its velocity at impact (3,).
+        crh: the nose's calibre-radius-head (for Forrestal's linear crater).
+        wear, erosion: their parameters, or None when off.
+        end_time: run.end_time (s) or None (until a stop rule fires).
+        hard_end: the time the run ends at the latest (s).
+        failure_strain: projectile.failure_strain or None.
+        outputs: OutputSettings.
+        mesh: the volume mesh asked for (fepen.runs.setup.MeshRequest).
+        materials: the deformable fidelities' materials (fepen.laws.materials), shell first; () when rigid.
+        safety_factor, stable_step: the explicit step's safety factor and estimate ("eigenvalue", "altitude").
+        charge_friction: the shell-charge friction coefficient.
+        rigid_step: run.rigid_step or None.
+        experiment: the Table 1 shot's name (impact.shot) or None.
+        scene: the resolved scene as a dict (summary.json's "scene").
+        body_key: what identifies the projectile (a sweep's shots share a body).
+    """
+
+    fidelity: str
+    built: Built
+    law: object
+    rotation: np.ndarray
+    velocity: np.ndarray
+    crh: float
+    wear: WearParameters | None
+    erosion: ErosionParameters | None
+    end_time: float | None
+    hard_end: float
+    failure_strain: float | None
+    outputs: OutputSettings
+    mesh: setup.MeshRequest
+    materials: tuple
+    safety_factor: float
+    stable_step: str
+    charge_friction: float
+    rigid_step: float | None
+    experiment: str | None
+    scene: dict = field(repr=False)
+    body_key: tuple = field(repr=False, default=())
+
+    @property
+    def rigid(self) -> bool:
+        return self.fidelity == "rigid"
+
+    @property
+    def speed(self) -> float:
+        """The striking speed (m/s)."""
+        return float(np.linalg.norm(self.velocity))
+
+    @property
+    def layered(self) -> bool:
+        return getattr(self.law, "layered", False)
+
+    @property
+    def diameter(self) -> float:
+        return self.built.shape.diameter
+
+    def crater(self, mass: float) -> tg.ForrestalCrater | None:
+        """Forrestal's linear crater for a projectile of ``mass`` (kg) when effects.crater = "linear", else None
+        (the energy crater is in the law)."""
+        if self.law is None or self.law.crater != "linear":
+            return None
+        shape = self.built.shape
+        factor = None if shape.nose == "ogive" and not shape.meplat_diameter else shape.nose_factor()
+        return tg.ForrestalCrater(self.law, mass, self.speed, self.crh, factor)
+
+    def densities(self) -> dict[int, float]:
+        """Density (kg/m^3) per volume tag."""
+        from fepen.geometry import tags
+
+        return {tags.SHELL: self.built.shell_density, tags.CHARGE: self.mesh.charge_density}
+
+
+def _hard_end(law, end_time: float | None, speed: float, kind: str) -> float:
+    """run.end_time, else MAX_TIME, long enough for a layered target to reach its last face."""
+    if end_time is not None:
+        return end_time
+    if getattr(law, "layered", False):
+        return max(MAX_TIME[kind], LAYERED_TIME * law.faces()[-1][0] / speed)
+    return MAX_TIME[kind]
+
+
+def _wear(scene) -> WearParameters | None:
+    if not scene.effects.wear:
+        return None
+    m, w = scene.projectile.material, scene.projectile.wear
+    mu = scene.get("projectile.wear.friction")
+    return WearParameters(scene.target.friction if mu is None else mu, w.efficiency,
+                          wear.melt_enthalpy(m.specific_heat, m.melt_temperature, m.room_temperature, w.latent_heat),
+                          m.density)
+
+
+def _outputs(scene) -> OutputSettings:
+    r = scene.run
+    names = ["von_mises_Pa", "axial_stress_Pa"]  # fields of switched-off physics are not written
+    if scene.effects.fidelity == "plastic":
+        names.append("peeq")
+        if scene.effects.thermal:
+            names.append("temperature_K")
+    names.append("cell_tag")  # 1 shell, 2 charge, 0 eroded: for ParaView's Threshold
+    return OutputSettings(min(r.output_interval / 10.0, 1e-6), r.output_interval, bool(r.fields), tuple(names),
+                          r.checkpoint_interval, r.acceleration_filter_hz)
+
+
+def resolve(scene) -> Shot:
+    """The Shot of a resolved Scene (InputError on what this version cannot simulate, before any mesh).
+
+    Args:
+        scene: a resolved fepen.Scene.
+
+    Returns:
+        The frozen Shot.
+    """
+    built = setup.check_supported(scene)
+    rigid = scene.effects.fidelity == "rigid"
+    law = setup.target_law(scene) if scene.target.kind == "concrete" else None
+    R, v = setup.placement(scene)
+    end = scene.get("run.end_time")
+    materials = () if rigid else tuple(setup.materials(scene, built))
+    e = scene.projectile.erosion
+    return Shot(
+        fidelity=scene.effects.fidelity, built=built, law=law, rotation=R, velocity=v, crh=scene.projectile.crh,
+        wear=_wear(scene), erosion=ErosionParameters(e.strain, e.step_ratio) if scene.effects.erosion else None,
+        end_time=end, hard_end=_hard_end(law, end, float(np.linalg.norm(v)), "rigid" if rigid else "deformable"),
+        failure_strain=scene.get("projectile.failure_strain"), outputs=_outputs(scene), mesh=setup.mesh_request(scene),
+        materials=materials, safety_factor=scene.run.safety_factor, stable_step=scene.run.stable_step,
+        charge_friction=scene.charge.friction, rigid_step=scene.get("run.rigid_step"),
+        experiment=scene.get("impact.shot"), scene=scene.as_dict(), body_key=setup.body_key(scene))
+
+
+def of(shot_or_scene) -> Shot:
+    """A Shot as it is, or a Scene resolved (the runs take either)."""
+    return shot_or_scene if isinstance(shot_or_scene, Shot) else resolve(shot_or_scene)
+
