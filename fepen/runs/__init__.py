@@ -30,8 +30,7 @@ def expected_end(scene, sh: Shot) -> float:
     if sh.end_time is not None or sh.law is None:
         return sh.hard_end
     try:
-        quick = RigidRun(scene.with_sets(["effects.fidelity=rigid", "effects.erosion=false"]), None,
-                         MPI.COMM_SELF).run()
+        quick = RigidRun(shot.rigid_version(scene), None, MPI.COMM_SELF).run()
         return min(sh.hard_end, 1.05 * float(quick["end_time_s"]))
     except Exception:  # noqa: BLE001 - only the bar's length depends on it
         return sh.hard_end

@@ -196,3 +196,7 @@ def of(shot_or_scene) -> Shot:
     """A Shot as it is, or a Scene resolved (the runs take either)."""
     return shot_or_scene if isinstance(shot_or_scene, Shot) else resolve(shot_or_scene)
 
+
+def rigid_version(scene) -> Shot:
+    """The Shot of the same scene with the rigid projectile and no erosion (the progress bar's expected end)."""
+    return resolve(scene.with_sets(["effects.fidelity=rigid", "effects.erosion=false"]))

@@ -70,3 +70,21 @@ def test_bad_cad_input_names_its_key(sets, key):
     with pytest.raises(InputError) as err:
         setup.projectile(scene.Scene(None, sets))
     assert err.value.key == key
+
+
+def test_a_cad_body_is_read_once_per_run(step_file, tmp_path, monkeypatch):
+    """The scene is resolved once (fepen.runs.shot): the STEP file is read once for the body's size, and once
+    more only to mesh it when the mesh cache has no entry (before the redesign: once per setup call, 4-7 times)."""
+    import fepen
+    from fepen.geometry import cad
+
+    calls = []
+    real = cad._import
+    monkeypatch.setattr(cad, "_import", lambda path, scale: calls.append(path) or real(path, scale))
+    sc = scene.Scene(None, ["effects.fidelity=rigid", f"projectile.cad={str(step_file)!r}",
+                            "projectile.cad_scale=0.001", "mesh.size=0.004", *NORMAL])
+    fepen.run(sc, tmp_path / "first", comm=MPI.COMM_SELF)
+    assert 1 <= len(calls) <= 2  # the size, and the mesh unless cached
+    calls.clear()
+    fepen.run(sc, tmp_path / "second", comm=MPI.COMM_SELF)  # the mesh is cached now
+    assert len(calls) == 1
