@@ -121,6 +121,39 @@ def long_functions(limit: int = 80, roots=("fepen",)) -> list[tuple[str, int, st
     return out
 
 
+def large_classes(limit: int = 300, roots=("fepen",)) -> list[tuple[str, int, str, int]]:
+    """(path, line, name, length) of every class longer than ``limit`` lines."""
+    out = []
+    for root in roots:
+        for p in sorted((ROOT / root).rglob("*.py")):
+            for n in ast.walk(ast.parse(p.read_text())):
+                if isinstance(n, ast.ClassDef) and n.end_lineno - n.lineno + 1 > limit:
+                    out.append((str(p.relative_to(ROOT)), n.lineno, n.name, n.end_lineno - n.lineno + 1))
+    return out
+
+
+#: the floors of the package, bottom up (README "Layout"): a module may import only its own floor and below.
+#: Top-level modules not named here sit on floor 0 (errors, atomic, version, native).
+FLOORS = {"fepen.data": 0, "fepen.laws": 1, "fepen.geometry": 2, "fepen.solver": 3, "fepen.io": 4,
+          "fepen.post": 5, "fepen.scene": 5, "fepen.runs": 6, "fepen.studies": 7, "fepen.api": 8,
+          "fepen.cli": 9, "fepen": 10, "fepen.__main__": 11}
+
+
+def floor(module: str) -> int:
+    """The floor of a module: that of its subpackage (or top-level module) in FLOORS, else 0."""
+    parts = module.split(".")
+    for k in (".".join(parts[:2]), module):
+        if k in FLOORS:
+            return FLOORS[k]
+    return 0
+
+
+def upward_imports(graph) -> list[tuple[str, str]]:
+    """(importer, imported) pairs where a module imports one on a higher floor, function-level imports
+    included."""
+    return sorted((m, d) for m, deps in graph.items() for d in deps if floor(d) > floor(m))
+
+
 def layers(graph) -> dict[str, set[str]]:
     """Subpackage -> the subpackages it imports."""
     def sub(m):
@@ -147,7 +180,11 @@ def main() -> int:
     print("longest functions:", "; ".join(f"{w} ({n} lines)" for n, w in longest))
     over = long_functions(80)
     print("over 80 lines:", "; ".join(f"{p}:{line} {name} ({n})" for p, line, name, n in over) or "none")
-    return 1 if cycles(graph) or over else 0
+    big = large_classes(300)
+    print("classes over 300 lines:", "; ".join(f"{p}:{line} {name} ({n})" for p, line, name, n in big) or "none")
+    up = upward_imports(graph)
+    print("imports up a floor:", "; ".join(f"{a} -> {b}" for a, b in up) or "none")
+    return 1 if cycles(graph) or over or big or up else 0
 
 
 if __name__ == "__main__":

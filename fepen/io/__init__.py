@@ -1,3 +1,4 @@
-"""The files a run writes: atomic text and JSON, history and summary, crash-safe fields."""
+"""The files a run writes: atomic text and JSON, history and summary, crash-safe fields, the run directory
+(refusal, --force, lock, run.json, fepen.log)."""
 
-__all__ = ["files", "results", "fields"]
+__all__ = ["files", "results", "fields", "rundir"]

@@ -1,6 +1,7 @@
-"""Laws on plain arrays: materials, the target, the shell-charge contact, rigid-body mechanics.
+"""Laws on plain arrays: materials, the target (and layered targets), the shell-charge contact, rigid-body
+mechanics, nose wear, element erosion, the energy balance.
 
 No dolfinx, no MPI, no scene: parameters are plain numbers (docs/theory.md §3-§5, §13).
 """
 
-__all__ = ["materials", "uniaxial", "target", "contact", "rigid_body"]
+__all__ = ["materials", "uniaxial", "target", "layers", "contact", "rigid_body", "wear", "erosion", "energy"]

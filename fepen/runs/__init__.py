@@ -5,7 +5,8 @@
     run          the Run skeleton both fidelities share: loop, stop, summary, history rows
     rigid        RigidRun: the rigid body (no mesh by default)
     model        the deformable model: mesh, solver, target, contact, wear, erosion
-    deformable   DeformableRun: the explicit solver's time loop, its outputs, checkpoints and analyses
+    deformable   DeformableRun: the explicit solver's time loop, its outputs and checkpoints
+    closing      the closing analyses of a completed deformable run
     events       the stop rules
     outputs      History, Fields, Checkpoint, Progress: due / write / close on one clock
     checkpoint   checkpoint files and --resume
@@ -20,7 +21,7 @@ from fepen.runs import setup, shot
 from fepen.runs.rigid import RigidRun
 from fepen.runs.shot import Shot, resolve
 
-__all__ = ["shot", "setup", "run", "rigid", "model", "deformable", "events", "outputs", "checkpoint",
+__all__ = ["shot", "setup", "run", "rigid", "model", "deformable", "closing", "events", "outputs", "checkpoint",
            "interrupts", "run_scene", "expected_end", "resolve", "Shot", "RigidRun"]
 
 

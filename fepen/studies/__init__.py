@@ -1,3 +1,5 @@
-"""Studies of many runs: the Table 1 validation, the accuracy-cost study, process launching."""
+"""Many runs: Table 1 (validate), the public depth sets (depth, calibration), the accuracy/cost study, whole
+fepen processes, the shot engine on MPI groups, sweeps and their figures, the limit studies (ballistic limit,
+ricochet) and the closed forms they are checked against."""
 
-__all__ = ["validate", "accuracy_cost", "processes"]
+__all__ = ["validate", "depth", "calibration", "accuracy_cost", "processes", "engine", "sweep", "sweep_figures", "limits", "closed_forms"]
