@@ -19,10 +19,8 @@ from dataclasses import dataclass
 from pathlib import Path
 from typing import Any
 
+from fepen.data import CONSTANTS, FAMILIES, SHOTS, STEELS, TARGETS, shot
 from fepen.errors import InputError
-from fepen.experiments import SHOTS, shot
-from fepen.steels import STEELS
-from fepen.targets import CONSTANTS, FAMILIES, TARGETS
 
 _ABSENT = object()  # marks an optional key whose absence means something (e.g. semi-infinite target)
 

@@ -12,8 +12,8 @@ import time
 import numpy as np
 from mpi4py import MPI
 
+from fepen.data import shot
 from fepen.errors import BeyondMethod, InputError, Interrupted, MachineFault, SimulationError
-from fepen.experiments import shot
 from fepen.geometry.frames import unit_axis
 from fepen.io import files, results, rundir
 from fepen.io.fields import FieldWriter

@@ -10,6 +10,8 @@ import csv
 from dataclasses import dataclass
 from importlib import resources
 
+__all__ = ["Shot", "SHOTS", "shot"]
+
 
 @dataclass(frozen=True)
 class Shot:
@@ -26,7 +28,7 @@ class Shot:
 
 
 def _read() -> dict[str, Shot]:
-    text = resources.files("fepen").joinpath("data/table1.csv").read_text()
+    text = resources.files("fepen.data").joinpath("table1.csv").read_text()
     rows = csv.DictReader(text.splitlines())
     return {
         r["shot"]: Shot(r["shot"], float(r["v0_m_s"]), float(r["obliquity_deg"]), float(r["attack_deg"]),
