@@ -41,5 +41,12 @@ SHOTS: dict[str, Shot] = _read()
 
 
 def shot(name: str) -> Shot:
-    """The Table 1 row of a shot ("C1" ... "C8")."""
+    """The Table 1 row of a shot.
+
+    Args:
+        name: "C1" ... "C8".
+
+    Returns:
+        The Shot (KeyError for another name).
+    """
     return SHOTS[name]
