@@ -10,8 +10,8 @@ from pathlib import Path
 import numpy as np
 from mpi4py import MPI
 
+from fepen.data import shot
 from fepen.errors import OUTCOMES, SimulationError
-from fepen.experiments import shot
 from fepen.geometry.frames import unit_axis
 from fepen.io import files
 

@@ -25,9 +25,15 @@ SCALED_S_SIZE = 0.05953
 # ---------------------------------------------------------------------------------------------------------
 # §4.1 quasi-static cavity expansion
 # ---------------------------------------------------------------------------------------------------------
+def a_over_c_cubed(Y: float, E: float, T: float) -> float:
+    """(a/c)^3 = (9Y/(4E)) (Y/(2T))^(1/2) of the elastic–cracked–plastic cavity expansion: below 1 when the
+    plastic zone is wider than the cavity (the scene refuses the constants otherwise)."""
+    return 9.0 * Y / (4.0 * E) * math.sqrt(Y / (2.0 * T))
+
+
 def cavity_ratio(Y: float, E: float, T: float) -> float:
     """c/a of the elastic–cracked–plastic cavity expansion: (a/c)^3 = (9Y/(4E)) (Y/(2T))^(1/2)."""
-    return (9.0 * Y / (4.0 * E) * math.sqrt(Y / (2.0 * T))) ** (-1.0 / 3.0)
+    return a_over_c_cubed(Y, E, T) ** (-1.0 / 3.0)
 
 
 def quasi_static_stress(Y, E, T, lam, c_over_a=None):

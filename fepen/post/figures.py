@@ -8,7 +8,7 @@ from pathlib import Path
 import numpy as np
 from mpi4py import MPI
 
-from fepen.experiments import shot
+from fepen.data import shot
 from fepen.geometry import mesh as fmesh
 from fepen.geometry import tags
 

@@ -233,7 +233,7 @@ def trajectory_figure(out: Path, path: Path, experiment=None, outlines: int = 6)
     of history.csv and, for a Table 1 shot, the test's final nose and tail.
 
     Args:
-        experiment: fepen.experiments.Shot (Hx_mm, Hy_mm, Tx_mm, Ty_mm) or None.
+        experiment: fepen.data.Shot (Hx_mm, Hy_mm, Tx_mm, Ty_mm) or None.
         outlines: how many output times to draw, evenly spread from the first to the last.
     """
     import matplotlib

@@ -8,7 +8,7 @@ from __future__ import annotations
 
 import numpy as np
 
-from fepen.experiments import shot as table1_shot
+from fepen.data.experiments import shot as table1_shot
 from fepen.io import files, results
 from fepen.post import analyses, signals, slices
 

@@ -11,6 +11,7 @@ from dataclasses import dataclass, replace
 import numpy as np
 from mpi4py import MPI
 
+from fepen.data import CONSTANTS, TARGETS
 from fepen.errors import InputError
 from fepen.geometry import gmsh_model, profile, tags, tetra
 from fepen.geometry import mesh as fmesh
@@ -18,7 +19,6 @@ from fepen.geometry.shape import Built, Shape, reach_mass
 from fepen.laws import layers as fl
 from fepen.laws import target as tg
 from fepen.scene import SCHEMA
-from fepen.targets import CONSTANTS, TARGETS
 
 
 # ---------------------------------------------------------------------------------------------------------

@@ -21,7 +21,7 @@ from pathlib import Path
 
 import numpy as np
 
-from fepen.experiments import SHOTS
+from fepen.data import SHOTS
 from fepen.laws import target as tg
 
 __all__ = ["Row", "read_set", "table1_set", "shipped_sets", "scene_sets", "rigid_depth", "closed_form_depth",

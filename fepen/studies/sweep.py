@@ -121,7 +121,7 @@ def _flat_leaves(tree: dict, is_leaf, prefix: str = "") -> dict:
 
 def _check_key(section: str, name: str) -> None:
     if name not in fscene.SCHEMA:
-        err = fscene._unknown(name)
+        err = fscene.unknown_key(name)
         raise InputError(f"{section}.{name}", f"not a scene key ({err.message})")
 
 
@@ -316,13 +316,13 @@ def _base_keys(path: Path, spec: dict, sets) -> dict:
     if "base" in spec:
         if not isinstance(spec["base"], dict):
             raise InputError("base", "a table of scene keys")
-        base.update(fscene._flatten(spec["base"]))
+        base.update(fscene.flatten(spec["base"]))
     for item in sets:
         k, v = fscene.parse_set(item)
         base[k] = v
     for k in base:
         if k not in fscene.SCHEMA:
-            raise fscene._unknown(k)
+            raise fscene.unknown_key(k)
     return base
 
 

@@ -15,7 +15,7 @@ import numpy as np
 from mpi4py import MPI
 
 from fepen import scene as fscene
-from fepen.experiments import SHOTS
+from fepen.data import SHOTS
 from fepen.io import files
 from fepen.post import figures
 from fepen.runs import run_scene, setup

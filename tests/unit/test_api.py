@@ -6,7 +6,7 @@ import sys
 import pytest
 
 import fepen
-from fepen.experiments import shot
+from fepen.data import shot
 from fepen.scene import to_toml
 
 ROOT_TOML = """

@@ -11,11 +11,10 @@ from pathlib import Path
 import pytest
 
 from fepen import cli
+from fepen.data import STEELS, TARGETS
 from fepen.errors import InputError
 from fepen.runs import setup
 from fepen.scene import Scene
-from fepen.steels import STEELS
-from fepen.targets import TARGETS
 
 ROOT = Path(__file__).resolve().parents[2]
 METAL = [name for name, t in TARGETS.items() if t["family"] == "metal"]
@@ -274,7 +273,7 @@ def test_every_shipped_scene_and_sweep_resolves(path):
 
 
 def test_the_default_scene_and_the_table1_shots_resolve():
-    from fepen.experiments import SHOTS
+    from fepen.data import SHOTS
 
     for name in [None, *SHOTS]:
         sc = Scene(None, [f'impact.shot="{name}"'] if name else [])

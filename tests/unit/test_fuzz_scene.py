@@ -23,10 +23,11 @@ from hypothesis import HealthCheck, assume, event, given, settings
 from hypothesis import strategies as st
 
 from fepen import cli
+from fepen.data import CONSTANTS, TARGETS
 from fepen.errors import InputError
 from fepen.runs import setup
-from fepen.scene import LAYER_KEYS, SCHEMA, SECTIONS, Scene, _name, parse_set, to_toml
-from fepen.targets import CONSTANTS, TARGETS
+from fepen.scene import LAYER_KEYS, SCHEMA, SECTIONS, Scene, parse_set, to_toml
+from fepen.scene import display_name as _name
 
 FUZZ = dict(deadline=None, database=None, derandomize=False, print_blob=True,
             suppress_health_check=[HealthCheck.too_slow, HealthCheck.filter_too_much, HealthCheck.data_too_large,

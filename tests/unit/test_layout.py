@@ -33,3 +33,63 @@ def test_no_import_circle():
 def test_no_function_over_80_lines():
     long = [f for f in layout.long_functions(80)]
     assert not long, "\n".join(f"{path}:{line} {name} ({n} lines)" for path, line, name, n in long)
+
+
+def test_no_class_over_300_lines():
+    big = layout.large_classes(300)
+    assert not big, "\n".join(f"{path}:{line} {name} ({n} lines)" for path, line, name, n in big)
+
+
+def test_no_import_up_a_floor():
+    """laws < geometry < solver < io < post, scene < runs < studies < api < cli (function-level imports too)."""
+    assert layout.upward_imports(GRAPH) == []
+
+
+def _declared_all(init: Path) -> set[str]:
+    import ast
+
+    for n in ast.parse(init.read_text()).body:
+        if isinstance(n, ast.Assign) and any(getattr(t, "id", None) == "__all__" for t in n.targets):
+            return {e.value for e in n.value.elts}
+    return set()
+
+
+PACKAGES = sorted(p.parent for p in layout.PACKAGE.rglob("__init__.py") if p.parent != layout.PACKAGE)
+
+
+@pytest.mark.parametrize("package", PACKAGES, ids=lambda p: p.name)
+def test_every_module_is_in_its_package_all(package):
+    names = {p.stem for p in package.glob("*.py") if p.stem != "__init__"}
+    names |= {p.name for p in package.iterdir() if (p / "__init__.py").is_file()}
+    missing = names - _declared_all(package / "__init__.py")
+    assert not missing, f"{package.name}/__init__.py's __all__ lacks {sorted(missing)}"
+
+
+def _readme_layout() -> dict[str, str]:
+    """The README's Layout block, by subpackage ("" for the top level)."""
+    text = (layout.ROOT / "README.md").read_text()
+    block = text.split("## Layout", 1)[1].split("```", 2)[1]
+    parts, current = {"": ""}, ""
+    for line in block.splitlines():
+        stripped = line.strip()
+        if line.startswith("  ") and not line.startswith("   ") and stripped.endswith("/") is False \
+                and stripped.split()[0].endswith("/"):
+            current = stripped.split()[0].rstrip("/")
+            parts.setdefault(current, "")
+        elif line.startswith("  ") and not line.startswith("   ") and stripped.split()[0].endswith(".py"):
+            current = ""
+        parts[current] = parts.get(current, "") + line + "\n"
+    return parts
+
+
+def test_every_module_is_in_the_readme_layout():
+    parts = _readme_layout()
+    missing = []
+    for p in sorted(layout.PACKAGE.rglob("*")):
+        if p.suffix not in (".py", ".c") or p.name in ("__init__.py", "__main__.py"):
+            continue
+        rel = p.relative_to(layout.PACKAGE)
+        section = rel.parts[0] if len(rel.parts) > 1 else ""
+        if p.name not in parts.get(section, ""):
+            missing.append(str(rel))
+    assert not missing, f"README's Layout does not name {missing}"

@@ -3,8 +3,8 @@
 import pytest
 
 from fepen import scene
+from fepen.data import SHOTS
 from fepen.errors import InputError
-from fepen.experiments import SHOTS
 
 
 def test_defaults_are_the_paper_and_shot_c3():
@@ -140,7 +140,7 @@ def test_sliding_friction_must_not_exceed_the_static_one():
 
 
 def test_named_steels_fill_the_material_and_explicit_keys_win():
-    from fepen.steels import STEELS
+    from fepen.data import STEELS
 
     default = scene.load(None, [])
     assert default.projectile.material.name == "45-steel"

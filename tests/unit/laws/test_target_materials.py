@@ -10,11 +10,11 @@ import pytest
 from scipy import integrate
 
 from fepen import scene
+from fepen.data import TARGETS
 from fepen.errors import InputError
 from fepen.laws import layers as fl
 from fepen.laws import target as tg
 from fepen.runs import setup
-from fepen.targets import TARGETS
 
 
 def test_metal_cavity_stress_is_hills_for_a_perfectly_plastic_metal():

@@ -10,6 +10,8 @@ import csv
 from dataclasses import dataclass
 from importlib import resources
 
+__all__ = ["Shot", "SHOTS", "shot"]
+
 
 @dataclass(frozen=True)
 class Shot:
@@ -26,7 +28,7 @@ class Shot:
 
 
 def _read() -> dict[str, Shot]:
-    text = resources.files("fepen").joinpath("data/table1.csv").read_text()
+    text = resources.files("fepen.data").joinpath("table1.csv").read_text()
     rows = csv.DictReader(text.splitlines())
     return {
         r["shot"]: Shot(r["shot"], float(r["v0_m_s"]), float(r["obliquity_deg"]), float(r["attack_deg"]),
@@ -39,5 +41,12 @@ SHOTS: dict[str, Shot] = _read()
 
 
 def shot(name: str) -> Shot:
-    """The Table 1 row of a shot ("C1" ... "C8")."""
+    """The Table 1 row of a shot.
+
+    Args:
+        name: "C1" ... "C8".
+
+    Returns:
+        The Shot (KeyError for another name).
+    """
     return SHOTS[name]

@@ -11,7 +11,7 @@ __all__ = ["TARGETS", "FAMILIES", "CONSTANTS"]
 
 
 def _read() -> dict[str, dict]:
-    return tomllib.loads(resources.files("fepen").joinpath("data/targets.toml").read_text())
+    return tomllib.loads(resources.files("fepen.data").joinpath("targets.toml").read_text())
 
 
 #: name -> {target key (without "target."): value, "family", "source", "crater"}

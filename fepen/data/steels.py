@@ -11,7 +11,7 @@ __all__ = ["STEELS", "names"]
 
 
 def _read() -> dict[str, dict]:
-    return tomllib.loads(resources.files("fepen").joinpath("data/steels.toml").read_text())
+    return tomllib.loads(resources.files("fepen.data").joinpath("steels.toml").read_text())
 
 
 #: name -> {material key (without "projectile.material."): value, "source": text}

@@ -1,0 +1,18 @@
+"""fepen's shipped data, one name for the tables and libraries in this folder (docs/theory.md §4, §16;
+docs/paper.md):
+
+- ``experiments``: the paper's Table 1 (table1.csv): ``SHOTS``, ``Shot``, ``shot``;
+- ``steels``: the named projectile steels (steels.toml), ``projectile.material.name``: ``STEELS``;
+- ``targets``: the named target materials (targets.toml), ``target.material``: ``TARGETS``, ``FAMILIES``,
+  ``CONSTANTS``.
+
+``depth/`` holds the depth data sets of ``fepen validate-depth`` (fepen.studies.depth). Plain Python and the
+standard library only: the scene and every layer above may import it.
+"""
+
+from fepen.data.experiments import SHOTS, Shot, shot
+from fepen.data.steels import STEELS
+from fepen.data.steels import names as steel_names
+from fepen.data.targets import CONSTANTS, FAMILIES, TARGETS
+
+__all__ = ["SHOTS", "Shot", "shot", "STEELS", "steel_names", "TARGETS", "FAMILIES", "CONSTANTS"]

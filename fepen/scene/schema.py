@@ -1,0 +1,203 @@
+"""``SCHEMA``: every scene key declared once, dotted name -> :class:`~fepen.scene.keys.Key` (type, default,
+unit, allowed range; docs/scenes.md). Nothing else is accepted.
+
+Defaults are the paper's projectile (45 steel, D = 23.6 mm, L = 144 mm, 367 g), its concrete target
+(Table 3) and the striking conditions of Table 1 shot C3. The choices the paper leaves open (nose CRH,
+cavity, tensile strength, ...) are explained in docs/theory.md.
+"""
+
+from __future__ import annotations
+
+from fepen.data import CONSTANTS, FAMILIES, SHOTS, STEELS, TARGETS, shot
+from fepen.scene.keys import ABSENT, Key, check_layers, check_sections, choice, flag, number, positive
+
+__all__ = ["SCHEMA", "SECTIONS", "LAYER_KEYS", "LAYER_FIELDS"]
+
+
+def _layers(key: Key, name: str, value) -> list:
+    """target.layers' rows: each table's keys checked as LAYER_FIELDS declares them."""
+    return check_layers(key, name, value, LAYER_FIELDS)
+
+
+_C3 = shot("C3")
+
+#: Every scene key, dotted name -> Key. Units are SI. ``ABSENT`` defaults are optional keys whose absence
+#: has a meaning given in their doc.
+SCHEMA: dict[str, Key] = {
+    # --- projectile geometry (docs/theory.md, "The projectile") ---
+    "projectile.nose": choice("ogive", "ogive", "secant", "cone", "hemisphere", "ellipsoid", "flat", "profile",
+                              doc="tangent or secant ogive, cone, hemisphere, ellipsoid, flat (a plain cylinder), "
+                                  "or a drawn profile (projectile.profile); docs/projectiles-and-targets.md"),
+    "projectile.nose_length": positive(ABSENT, "m", 10.0, doc="axial length of a secant ogive, cone or ellipsoid nose "
+                                                              "(before any meplat)"),
+    "projectile.meplat_diameter": number(0.0, "m", 0.0, 1.0, doc="flat blunt tip of an ogive, cone, hemisphere or "
+                                                                  "ellipsoid nose; 0: pointed"),
+    "projectile.boattail_length": number(0.0, "m", 0.0, 10.0, doc="tapered rear; 0: none"),
+    "projectile.boattail_diameter": positive(ABSENT, "m", 1.0, doc="rear-face diameter of the boat-tail"),
+    "projectile.profile": Key(str, ABSENT, doc="CSV of the outer profile, rows z_m, r_m[, arc_radius_m] from the "
+                                               "nose (projectile.nose = 'profile'; sets diameter and length)",
+                              form="a file path (CSV)"),
+    "projectile.inner_profile": Key(str, ABSENT, doc="CSV of the cavity profile, rows z_m, r_m[, arc_radius_m] "
+                                                     "(a fixed cavity: the mass follows from it)",
+                                    form="a file path (CSV)"),
+    "projectile.cavity_sections": Key(list, ABSENT, doc="cavity as [[length_m, diameter_m], ...] front to rear; "
+                                                        "the rear one's length is sized to projectile.mass",
+                                      form="a list of [length, diameter] pairs in metres, each > 0",
+                                      rows=check_sections),
+    "projectile.cad": Key(str, ABSENT, doc="STEP or BREP file of the projectile body (axis +y, nose toward -y); "
+                                           "meshed as is, mass from the mesh (docs/projectiles-and-targets.md)",
+                          form="a file path (STEP or BREP)"),
+    "projectile.cad_scale": positive(1.0, "m per file unit", 1.0e3, doc="lengths of projectile.cad times this are "
+                                                                         "metres (0.001 for a file in mm)"),
+    "projectile.diameter": number(0.0236, "m", 1.0e-3, 1.0, doc="calibre (fepen's laws are for 1 mm and more)"),
+    "projectile.length": number(0.144, "m", 1.0e-3, 10.0),
+    "projectile.crh": number(3.0, "", 0.5, 50.0, doc="ogive radius over diameter (0.5: hemisphere)"),
+    "projectile.mass": positive(0.367, "kg", 1.0e4,
+                                doc="total mass; the cavity is sized, reduced or dropped to reach it (theory §1.1)"),
+    "projectile.cavity_diameter": number(0.012, "m", 0.0, 1.0, doc="main (rear) cavity diameter; 0: solid"),
+    "projectile.cavity_length": positive(ABSENT, "m", 10.0,
+                                         doc="total cavity length; absent: sized from projectile.mass"),
+    "projectile.cavity_step_diameter": number(0.008, "m", 0.0, 1.0,
+                                              doc="diameter of the narrower forward cavity section (the step)"),
+    "projectile.cavity_step_length": number(0.020, "m", 0.0, 10.0,
+                                            doc="length of the narrower forward cavity section; 0: no step"),
+    "projectile.base_thickness": positive(0.015, "m", 10.0, doc="solid rear wall behind the cavity"),
+    # --- projectile material: 45 steel, Johnson-Cook (Table 2) ---
+    "projectile.material.name": choice("45-steel", *STEELS, doc="a named steel of fepen/data/steels.toml: sets "
+                                       "every projectile.material key not given explicitly (sources: "
+                                       "docs/theory.md §4)"),
+    "projectile.material.density": number(7850.0, "kg/m^3", 100.0, 30000.0),
+    "projectile.material.youngs_modulus": number(210.0e9, "Pa", 1.0e6, 1.0e13),
+    "projectile.material.poisson_ratio": number(0.3, "", 0.0, 0.5, hi_open=True),
+    "projectile.material.A": number(950.0e6, "Pa", 0.0, 1.0e11, lo_open=True),
+    "projectile.material.B": number(725.0e6, "Pa", 0.0, 1.0e11),
+    "projectile.material.n": number(0.375, "", 0.0, 2.0, lo_open=True),
+    "projectile.material.C": number(0.015, "", 0.0, 1.0),
+    "projectile.material.m": number(0.625, "", 0.0, 10.0, lo_open=True),
+    "projectile.material.melt_temperature": number(1765.0, "K", 0.0, 1.0e4, lo_open=True),
+    "projectile.material.room_temperature": number(294.0, "K", 0.0, 1.0e4, lo_open=True),
+    "projectile.material.reference_strain_rate": positive(1.0, "1/s", 1.0e9),
+    "projectile.material.specific_heat": positive(470.0, "J/(kg K)", 1.0e5),
+    "projectile.material.taylor_quinney": number(0.9, "", 0.0, 1.0),
+    "projectile.wear.efficiency": number(1.0, "", 0.0, 1.0,
+                                         doc="eta: the fraction of the interface heat that melts the surface off "
+                                             "(effects.wear; docs/theory.md §14)"),
+    "projectile.wear.friction": number(ABSENT, "", 0.0, 2.0,
+                                       doc="mu of the interface heat mu sigma_n |v_t|; absent: target.friction"),
+    "projectile.wear.latent_heat": number(2.7e5, "J/kg", 0.0, 1.0e7, doc="latent heat of fusion of the steel"),
+    "projectile.erosion.strain": number(1.0, "", 0.0, 100.0, lo_open=True,
+                                        doc="equivalent plastic strain at which a cell erodes (effects.erosion; "
+                                            "docs/theory.md §15)"),
+    "projectile.erosion.step_ratio": number(0.1, "", 0.0, 1.0, hi_open=True,
+                                            doc="a cell whose own stable step falls below this times the initial "
+                                                "step erodes (effects.erosion; 0: never)"),
+    "projectile.failure_strain": number(ABSENT, "", 0.0, 100.0, lo_open=True,
+                                        doc="PEEQ at which a concrete-target run stops, beyond the method "
+                                           "(docs/theory.md); absent: never (a mushrooming nose keeps running)"),
+    # --- explosive charge (Table 4) ---
+    "charge.material.density": number(1850.0, "kg/m^3", 100.0, 30000.0),
+    "charge.material.youngs_modulus": number(10.1e9, "Pa", 1.0e5, 1.0e13),
+    "charge.material.poisson_ratio": number(0.3, "", 0.0, 0.5, hi_open=True),
+    "charge.material.yield_stress": positive(45.0e6, "Pa", 1.0e11),
+    "charge.material.tangent_modulus": number(600.0e6, "Pa", 0.0, 1.0e12),
+    "charge.friction": number(0.1, "", 0.0, 2.0),
+    "charge.contact": choice("frictional", "frictional", "tied", doc="shell-charge interface"),
+    # --- target (Table 3; the law: docs/paper.md §4) ---
+    "target.kind": choice("concrete", "concrete", "rigid-wall",
+                          doc="'concrete': a cavity-expansion target of target.material (or target.layers); "
+                              "'rigid-wall': a Taylor test"),
+    "target.material": choice("concrete", *TARGETS, doc="a named target of fepen/data/targets.toml: its law's "
+                              "family and every target constant not given explicitly (docs/theory.md §16)"),
+    "target.layers": Key(list, ABSENT, doc="[[target.layers]] tables front to back: material, thickness (m; "
+                                           "absent on the last: semi-infinite), gap (m, the air gap after it), and "
+                                           "any target constant overriding the material's (docs/theory.md §17)",
+                         form="a list of tables {material, thickness, gap, ...}", rows=_layers),
+    "target.yield_stress": positive(ABSENT, "Pa", 1.0e11, doc="Y of a metal target (strength_model 'metal')"),
+    "target.hardening_exponent": number(ABSENT, "", 0.0, 1.0, hi_open=True,
+                                        doc="n of a metal target's power-law hardening Y (E eps / Y)^n"),
+    "target.compressive_strength": number(40.0e6, "Pa", 1.0e5, 1.0e10),
+    "target.density": number(2400.0, "kg/m^3", 100.0, 30000.0),
+    "target.youngs_modulus": positive(ABSENT, "Pa", 1.0e13, doc="absent: 4.7 sqrt(f_c / MPa) GPa (ACI 318)"),
+    "target.tensile_strength": positive(ABSENT, "Pa", 1.0e10, doc="absent: compressive_strength / 10"),
+    "target.pressure_hardening": number(0.67, "", 0.0, 3.0, hi_open=True, doc="lambda of Mohr-Coulomb"),
+    "target.crater_depth_factor": number(2.37, "", 0.0, 50.0, doc="crater depth k over diameter"),
+    "target.strength_model": choice("scaled-S", "scaled-S", "forrestal-S", "cavity-expansion", "metal",
+                                    doc="sigma_s = S fc with S = S_coefficient fc^-S_exponent / sqrt(1 + D/S_size) "
+                                        "(fc in MPa): fepen's calibrated scaled-S or Forrestal's S = 82.6 "
+                                        "fc^-0.544; or the paper's elastic-cracked-plastic cavity expansion; or "
+                                        "'metal': Forrestal-Warren's power-law metal (yield_stress, "
+                                        "hardening_exponent)"),
+    "target.S_coefficient": positive(ABSENT, "", 1.0e4, doc="absent: the strength model's"),
+    "target.S_exponent": number(ABSENT, "", 0.0, 2.0, doc="absent: the strength model's"),
+    "target.S_size": positive(ABSENT, "m", 1.0e6, doc="Bazant's D0 of the size effect; absent: the strength model's"),
+    "target.quasi_static_stress": positive(ABSENT, "Pa", 1.0e11,
+                                           doc="overrides the strength model's sigma_s; absent: computed"),
+    "target.inertial_factor": number(1.0, "", 0.0, 10.0, doc="B of sigma_n = sigma_s + B rho (v.n)^2"),
+    "target.friction": number(0.1, "", 0.0, 2.0, doc="Coulomb (static) coefficient, used when effects.friction"),
+    "target.friction_dynamic": number(ABSENT, "", 0.0, 2.0,
+                                      doc="mu_d of mu(v_t) = mu_d + (mu - mu_d) exp(-c v_t); absent: target.friction"),
+    "target.friction_decay": number(0.0, "s/m", 0.0, 1.0e3, doc="c of the sliding law; 0: constant Coulomb mu"),
+    "target.separation_angle_deg": number(0.0, "deg", 0.0, 90.0, hi_open=True),
+    "target.onset_angle_deg": number(2.0, "deg", 0.0, 30.0,
+                                     doc="sigma_s develops over this first surface angle (0: at once)"),
+    "target.thickness": positive(ABSENT, "m", 100.0, doc="absent: semi-infinite"),
+    "target.lock_density": number(2650.0, "kg/m^3", 100.0, 30000.0,
+                                  doc="Q1, density of fully compacted concrete (energy crater)"),
+    # --- striking conditions (Table 1; defaults are shot C3) ---
+    "impact.velocity": number(_C3.v0, "m/s", 0.0, 3000.0, lo_open=True),
+    "impact.obliquity_deg": number(_C3.obliquity_deg, "deg", 0.0, 90.0, hi_open=True),
+    "impact.attack_deg": number(_C3.attack_deg, "deg", -90.0, 90.0, lo_open=True, hi_open=True),
+    "impact.shot": Key(str, ABSENT, choices=tuple(SHOTS), doc="fills the three above from Table 1"),
+    # --- effects: what is off costs nothing ---
+    "effects.fidelity": choice("plastic", "rigid", "elastic", "plastic"),
+    "effects.crater": choice("energy", "none", "linear", "energy"),
+    "effects.separation": flag(True),
+    "effects.free_surface": flag(True),
+    "effects.friction": flag(False),
+    "effects.wear": flag(False, doc="nose wear: the interface heat melts mass off the surface (rigid fidelity: "
+                                    "the mass loss; deformable: the surface recedes; docs/theory.md §14)"),
+    "effects.erosion": flag(False, doc="element erosion of the meshed projectile: cells past projectile.erosion.* "
+                                       "are removed, the faces they expose loaded (docs/theory.md §15)"),
+    "effects.thermal": flag(True),
+    "effects.strain_rate": flag(True),
+    "effects.charge": flag(False),
+    # --- mesh ---
+    "mesh.size": number(0.0025, "m", 2.0e-4, 0.05, doc="nominal element size"),
+    "mesh.rigid_panel": number(ABSENT, "m", 2.0e-4, 0.5,
+                               doc="meridian panel of the rigid fidelity's load rings; absent: diameter / 6"),
+    "mesh.nose_size": number(ABSENT, "m", 2.0e-4, 0.05, doc="element size at the nose tip; absent: mesh.size"),
+    "mesh.optimize": choice("netgen", "none", "gmsh", "netgen",
+                            doc="tetrahedron optimiser; the stable step is set by the worst element"),
+    # --- run control ---
+    "run.end_time": positive(ABSENT, "s", 1.0, doc="absent: until stopped, perforated or ricocheted"),
+    "run.output_interval": positive(5.0e-5, "s", 1.0),
+    "run.safety_factor": number(0.8, "", 0.0, 1.0, lo_open=True,
+                                doc="stable step = factor * (the estimate of run.stable_step)"),
+    "run.stable_step": choice("eigenvalue", "altitude", "eigenvalue",
+                              doc="eigenvalue: 2/omega_max of the discrete body (power iteration), tracked "
+                                  "by h/c as it deforms; altitude: min h/c (conservative)"),
+    "run.fields": flag(True, doc="write fields.xdmf"),
+    "run.acceleration_filter_hz": number(1.0e4, "Hz", 0.0, 1.0e7,
+                                         doc="low-pass cut-off of the filtered accelerations (accelerations.csv); "
+                                             "0: none"),
+    "run.checkpoint_interval": number(1.0e-4, "s", 0.0, 1.0,
+                                      doc="simulated time between checkpoints (fepen run --resume DIR); 0: none"),
+    "run.rigid_step": positive(ABSENT, "s", 1e-3,
+                               doc="RK4 step of the rigid fidelity; absent: min(0.1 D/v0, t_stop/300)"),
+}
+
+#: the tables of the scene (the first part of every key)
+SECTIONS = sorted({name.split(".")[0] for name in SCHEMA})
+
+#: the keys of one [[target.layers]] table besides the target constants
+LAYER_KEYS = ("material", "thickness", "gap", "crater", "family")
+
+#: what one [[target.layers]] table may hold, each with its Key: LAYER_KEYS, then the target constants
+LAYER_FIELDS: dict[str, Key] = {
+    "material": SCHEMA["target.material"],
+    "thickness": SCHEMA["target.thickness"],
+    "gap": Key(float, 0.0, "m", 0.0, 1.0e3),
+    "crater": choice("none", "none", "energy"),
+    "family": choice("concrete", *FAMILIES),  # as a resolved scene writes it back: must be the material's
+    **{k: SCHEMA[f"target.{k}"] for k in CONSTANTS},
+}
