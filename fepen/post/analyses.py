@@ -17,6 +17,7 @@ from mpi4py import MPI
 
 from fepen.geometry import tags
 from fepen.geometry.frames import unit_axis
+from fepen.solver import probes
 
 GAUGE_NAMES = ["top", "bottom", "side+", "side-"]
 GAUGE_DIRECTIONS = np.array([[1.0, 0.0, 0.0], [-1.0, 0.0, 0.0], [0.0, 0.0, 1.0], [0.0, 0.0, -1.0]])
@@ -172,7 +173,7 @@ def nose_profile(solver, model, out: Path) -> dict | None:
     comm = solver.comm
     shape = model.pm.shape
     x = solver.positions()
-    tip, tail = solver.node_value(model.tip, x), solver.node_value(model.tail, x)
+    tip, tail = probes.node_value(solver, model.tip, x), probes.node_value(solver, model.tail, x)
     axis = unit_axis(tip, tail)  # tail to nose
     nodes = np.unique(model.surface.tri)
     nodes = nodes[~solver.orphans[nodes]]

@@ -20,7 +20,7 @@ from fepen.io.fields import FieldWriter
 from fepen.laws import layers as fl
 from fepen.post import analyses, paraview, signals, slices
 from fepen.runs import checkpoint, events, interrupts, model, outputs, rigid
-from fepen.solver import explicit
+from fepen.solver import diagnostics, explicit, probes
 
 #: steps between two checks of the stop rules in the target (each costs a few reductions)
 EVENT_EVERY = 20
@@ -200,26 +200,26 @@ class DeformableRun:
             return None
         if m.erosion is not None and s.total_mass < events.ERODED_FRACTION * s.initial_mass:
             return "eroded"
-        if events.beyond_method(s.max_peeq(), self.scene.get("projectile.failure_strain")):
+        if events.beyond_method(diagnostics.max_peeq(s), self.scene.get("projectile.failure_strain")):
             self._beyond_method()
         x = s.positions()
         pts = m.surface.kinematics(x, s.Vel)[0]
         y_min = self.comm.allreduce(float(pts[:, 1].min()) if len(pts) else np.inf, op=MPI.MIN)
         y_max = self.comm.allreduce(float(pts[:, 1].max()) if len(pts) else -np.inf, op=MPI.MAX)
         if self.crossings is not None:
-            self.crossings.update(s.t, -float(s.node_value(m.tip, x)[1]), -y_max,
-                                  float(np.linalg.norm(s.momentum_velocity())))
+            self.crossings.update(s.t, -float(probes.node_value(s, m.tip, x)[1]), -y_max,
+                                  float(np.linalg.norm(diagnostics.momentum_velocity(s))))
         if not (self.rules.entered or y_min < 0.0):
             return None  # not in the target yet
-        axis = unit_axis(s.node_value(m.tip, x), s.node_value(m.tail, x))
-        return self.rules.penetration(y_min, y_max, s.momentum_velocity(), axis, s.total_mass, s.ke0)
+        axis = unit_axis(probes.node_value(s, m.tip, x), probes.node_value(s, m.tail, x))
+        return self.rules.penetration(y_min, y_max, diagnostics.momentum_velocity(s), axis, s.total_mass, s.ke0)
 
     def _after_erosion(self) -> None:
         """If the nose-tip (tail) node lost its last cell, the foremost (rearmost) live node along the axis
         takes its place (collective)."""
         s, m = self.solver, self.model
         x = s.positions()
-        axis = unit_axis(s.node_value(m.tip, x), s.node_value(m.tail, x))
+        axis = unit_axis(probes.node_value(s, m.tip, x), probes.node_value(s, m.tail, x))
         for name, sign in (("tip", 1.0), ("tail", -1.0)):
             owner, local = getattr(m, name)
             dead = self.comm.bcast(bool(s.orphans[local]) if self.comm.rank == owner else None, root=owner)
@@ -235,7 +235,7 @@ class DeformableRun:
     def _beyond_method(self):
         """Stop: the equivalent plastic strain passed projectile.failure_strain (where, when)."""
         s = self.solver
-        peeq, where = s.max_peeq_where()
+        peeq, where = diagnostics.max_peeq_where(s)
         raise BeyondMethod(
             f"the equivalent plastic strain reached {peeq:.3g} > projectile.failure_strain = "
             f"{self.scene.get('projectile.failure_strain'):g}, {where[1] * 1e3:.1f} mm behind the nose tip "
@@ -248,14 +248,14 @@ class DeformableRun:
         """Append one history row (and the gauges' and sections' rows); return the row."""
         s, m = self.solver, self.model
         x = s.positions()
-        e = s.energies()
+        e = diagnostics.energies(s)
         en = dict(kinetic=e.kinetic, internal_work=e.internal_work, external_work=e.external_work,
                   elastic=e.elastic, plastic=e.plastic, heat=e.heat, energy_error=e.balance_error)
-        tip, tail = s.node_value(m.tip, x), s.node_value(m.tail, x)
-        row = results.history_row(s.t, tip, tail, s.momentum_velocity(), self.load.force, s.total_mass, en,
-                                  self.load.contact_nodes, s.dt, s.max_peeq(), self.load.area)
+        tip, tail = probes.node_value(s, m.tip, x), probes.node_value(s, m.tail, x)
+        row = results.history_row(s.t, tip, tail, diagnostics.momentum_velocity(s), self.load.force, s.total_mass,
+                                  en, self.load.contact_nodes, s.dt, diagnostics.max_peeq(s), self.load.area)
         if self.pm.charge:
-            row += list(s.body_accelerations(unit_axis(tip, tail)) / results.G0)
+            row += list(diagnostics.body_accelerations(s, unit_axis(tip, tail)) / results.G0)
             self.sections.record(tip, tail)
         if self.contact is not None:
             i = self.contact.summary()
@@ -290,9 +290,10 @@ class DeformableRun:
     def write_fields(self) -> None:
         s, m = self.solver, self.model
         x = s.positions()
-        axis = unit_axis(s.node_value(m.tip, x), s.node_value(m.tail, x))
-        values = {"displacement_m": x - s.X0, "velocity_m_s": s.velocity_at_step(), "von_mises_Pa": s.von_mises(),
-                  "axial_stress_Pa": s.axial_stress(axis), "peeq": s.live_peeq(), "temperature_K": s.temp,
+        axis = unit_axis(probes.node_value(s, m.tip, x), probes.node_value(s, m.tail, x))
+        values = {"displacement_m": x - s.X0, "velocity_m_s": s.velocity_at_step(),
+                  "von_mises_Pa": diagnostics.von_mises(s), "axial_stress_Pa": diagnostics.axial_stress(s, axis),
+                  "peeq": diagnostics.live_peeq(s), "temperature_K": s.temp,
                   "cell_tag": s.mat + 1.0}
         if self.contact is not None:
             values.update(self.contact.nodal_gap_and_slip())
@@ -321,7 +322,7 @@ class DeformableRun:
                 slices.trajectory_figure(self.out, self.out / "trajectory.png", shot(name) if name else None)
         else:
             analyses.deformed_picture(s, self.out / "deformed.png",
-                                      f"t = {s.t * 1e6:.0f} us, max PEEQ {s.max_peeq():.3g}")
+                                      f"t = {s.t * 1e6:.0f} us, max PEEQ {diagnostics.max_peeq(s):.3g}")
         if self.model.surface is not None:
             self.profile = analyses.nose_profile(s, self.model, self.out)
 
@@ -370,7 +371,7 @@ class DeformableRun:
         """Mass loss, length change, eroded cells, the wear heat and the removed energies (every deformable
         run; zero when wear and erosion are off)."""
         s, m = self.solver, self.model
-        e = s.energies()
+        e = diagnostics.energies(s)
         lost = s.initial_mass - s.total_mass
         length = self.rows[-1][results.COL["length_mm"]] if self.rows else self.pm.shape.length * 1e3
         heat = self.comm.allreduce(m.recession.heat_total, op=MPI.SUM) if m.recession is not None else 0.0
@@ -444,7 +445,7 @@ class DeformableRun:
         if m.erosion is not None:
             m.erosion.count = int(loop.get("eroded_cells", 0))
         if "tip" in loop:
-            m.tip = self.solver.node_at(loop["tip"])
+            m.tip = probes.node_at(self.solver, loop["tip"])
             self.load.tip = m.tip
         self.wall_before = float(state["wall_s"])
         return state["field_times_s"]

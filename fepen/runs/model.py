@@ -14,7 +14,7 @@ from fepen.geometry import tags
 from fepen.laws import target as tg
 from fepen.laws import wear
 from fepen.runs import setup
-from fepen.solver import erosion, explicit, recession, rigid_wall, shell_charge, surface, target_load
+from fepen.solver import erosion, explicit, probes, recession, rigid_wall, shell_charge, surface, target_load
 
 
 # ---------------------------------------------------------------------------------------------------------
@@ -26,7 +26,7 @@ class Model:
         pm: the projectile mesh. solver: the ExplicitSolver, at its initial state.
         load: the target (TargetLoad) or the rigid wall (RigidWall), hooked in as ``solver.external``.
         contact: the shell-charge contact (hooked in as ``solver.interface``), or None.
-        tip, tail: node handles of the nose tip and the tail centre (ExplicitSolver.node_at).
+        tip, tail: node handles of the nose tip and the tail centre (probes.node_at).
         v0: striking speed (m/s). surface: the target's load points (None on the rigid wall).
         law: the target law (None on the rigid wall). mesh_s, setup_s: wall seconds meshing and building.
         erosion: element erosion (effects.erosion) or None. recession: the surface recession of the nose
@@ -76,8 +76,8 @@ def build(scene, comm: MPI.Comm = MPI.COMM_WORLD) -> Model:
     if pm.split:
         contact = shell_charge.ShellChargeContact(s, pm.facet_tags, scene.charge.friction)
         s.interface = contact
-    tip = s.node_at(pm.shape.tip)
-    tail = s.node_at(pm.shape.tail)
+    tip = probes.node_at(s, pm.shape.tip)
+    tail = probes.node_at(s, pm.shape.tail)
     R, v = setup.placement(scene)
     v0 = float(np.linalg.norm(v))
     surf = law = None

@@ -16,6 +16,7 @@ from mpi4py import MPI
 
 from fepen.geometry.frames import unit_axis
 from fepen.laws import target as tg
+from fepen.solver import probes
 from fepen.solver.surface import Surface
 
 
@@ -26,7 +27,7 @@ class TargetLoad:
         solver: the ExplicitSolver.
         surf: its Surface (owned outer facets).
         law: the TargetLaw.
-        tip, tail: (owner, local) node handles of the nose tip and tail centre (ExplicitSolver.node_at).
+        tip, tail: (owner, local) node handles of the nose tip and tail centre (probes.node_at).
         crater: a ForrestalCrater for the linear crater, else None.
     """
 
@@ -41,7 +42,7 @@ class TargetLoad:
     def __call__(self, solver) -> None:
         x_all = solver.positions()  # not solver.x: a load may be evaluated on a state set by hand (wear playback)
         t0 = perf_counter()
-        tip, tail = solver.node_values((self.tip, self.tail), x_all)  # one reduction for both
+        tip, tail = probes.node_values(solver, (self.tip, self.tail), x_all)  # one reduction for both
         comm_s = perf_counter() - t0
         axis = unit_axis(tip, tail)
 
