@@ -47,8 +47,9 @@ class Load(Protocol):
     contact_nodes: int  #: loaded points (nodes on a rigid wall), all ranks
     area: float  #: loaded area (m^2), all ranks
 
-    def __call__(self, solver: ExplicitSolver) -> None:
-        """Add the external nodal forces of the current positions into ``solver.fext`` (owned nodes)."""
+    def __call__(self, solver: ExplicitSolver, dt: float) -> None:
+        """Add the external nodal forces of the current positions into ``solver.fext`` (owned nodes); ``dt``:
+        the step they act over (``solver.dt``; what a load accumulates in time, the wear heat, takes it)."""
 
 
 class Interface(Protocol):
@@ -238,7 +239,7 @@ class ExplicitSolver:
         """Internal and external forces at the current positions; returns the new stable-step estimate
         (h/c over the current mesh, before the safety factor) on this rank."""
         t0 = perf_counter()
-        x = np.add(self.X, self.U, out=self.x)
+        x = np.add(self.X, self.U, out=self._x)
         with_step = self.step_count % STEP_EVERY == 0
         jmin, worst, h_c, self._step_cell = kernels.volumes_and_step(
             x, self.dofs, self.orient, self.vol0, self.mat, self.speed, self.nodal_vol, with_step, self.cell_dt)
@@ -260,7 +261,7 @@ class ExplicitSolver:
         t3 = perf_counter()
         self.fext[:] = 0.0
         if self.external is not None:
-            self.external(self)
+            self.external(self, self.dt)
         t4 = perf_counter()
         tm = self.times
         tm.kinematics += t1 - t0
@@ -479,7 +480,7 @@ def _stress_kernel(s: ExplicitSolver, kernel: str | None) -> None:
     """The stress update: the C trial pass + numba radial return, or the numba kernel alone (the
     reference; also the plain element's)."""
     materials = s.materials
-    s.x = np.empty((s.n_nodes, 3))  # current positions X + U of the last force evaluation
+    s._x = np.empty((s.n_nodes, 3))  # current positions X + U of the last force evaluation (the kernels')
     s._flag = np.zeros(1)
     s._trial = None
     if kernel not in (None, "C", "numba"):
@@ -488,6 +489,6 @@ def _stress_kernel(s: ExplicitSolver, kernel: str | None) -> None:
         raise RuntimeError(f"the C kernel is not available: {ckernel.why_not() or 'plain element'}")
     if s.nodal and kernel != "numba" and ckernel.library() is not None:
         s.G_m = np.array([m.shear_modulus for m in materials])
-        s._trial = ckernel.TrialPass(s.x, s.Vel, s.X, s.dofs, s.mat, 6.0 * s.vol0 * s.orient, s.G_m,
+        s._trial = ckernel.TrialPass(s._x, s.Vel, s.X, s.dofs, s.mat, 6.0 * s.vol0 * s.orient, s.G_m,
                                      s.nodal_p, s._sT, s.sy0, s.P_packed)
     s.kernel = "C" if s._trial is not None else "numba"

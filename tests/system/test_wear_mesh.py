@@ -121,7 +121,7 @@ def test_recession_and_scalar_wear_agree_on_a_rigid_path(v0, tmp_path):
         s.Vel[:] = [0.0, -speed[k], 0.0]
         s.dt = t[k] - t[k - 1]
         s.fext[:] = 0.0
-        m.load(s)
+        m.load(s, s.dt)
         if k % 5 == 0:
             rec.apply()
     rec.apply()
