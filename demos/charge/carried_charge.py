@@ -25,7 +25,7 @@ from fepen.geometry import mesh as fmesh
 from fepen.geometry import tags
 from fepen.io.results import G0
 from fepen.runs import setup
-from fepen.solver import explicit
+from fepen.solver import diagnostics, explicit
 from fepen.solver.shell_charge import ShellChargeContact
 
 CASES = [("decelerating, mu = 0", 0.0, 1.0), ("decelerating, mu = 0.1", 0.1, 1.0), ("set-back, mu = 0.1", 0.1, -1.0)]
@@ -78,7 +78,7 @@ def carry(friction: float, sign: float, size: float = 0.004, accel_g: float = 50
             "transverse_over_axial": float(np.hypot(f[0], f[2]) / abs(f[1])),
             "lateral_share": float(np.mean(on_lateral) / (m_charge * a0)),
             "penetration_over_h": worst / size, "far_end_gap_mm": comm.bcast(far_gap, root=0) * 1e3,
-            "energy_error": s.energies().balance_error, "steps": s.step_count}
+            "energy_error": diagnostics.energies(s).balance_error, "steps": s.step_count}
 
 
 def main():

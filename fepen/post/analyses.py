@@ -17,6 +17,7 @@ from mpi4py import MPI
 
 from fepen.geometry import tags
 from fepen.geometry.frames import unit_axis
+from fepen.solver import probes
 
 GAUGE_NAMES = ["top", "bottom", "side+", "side-"]
 GAUGE_DIRECTIONS = np.array([[1.0, 0.0, 0.0], [-1.0, 0.0, 0.0], [0.0, 0.0, 1.0], [0.0, 0.0, -1.0]])
@@ -187,7 +188,7 @@ def nose_profile(solver, shape, tip_node, tail_node, tri: np.ndarray, out: Path)
 
     comm = solver.comm
     x = solver.positions()
-    tip, tail = solver.node_value(tip_node, x), solver.node_value(tail_node, x)
+    tip, tail = probes.node_value(solver, tip_node, x), probes.node_value(solver, tail_node, x)
     axis = unit_axis(tip, tail)  # tail to nose
     nodes = np.unique(tri)
     nodes = nodes[~solver.orphans[nodes]]

@@ -11,6 +11,7 @@ import numpy as np
 from fepen.data.experiments import shot as table1_shot
 from fepen.io import files, results
 from fepen.post import analyses, signals, slices
+from fepen.solver import diagnostics
 
 
 class Closing:
@@ -41,7 +42,7 @@ class Closing:
                 slices.trajectory_figure(run.out, run.out / "trajectory.png", table1_shot(name) if name else None)
         else:
             analyses.deformed_picture(s, run.out / "deformed.png",
-                                      f"t = {s.t * 1e6:.0f} us, max PEEQ {s.max_peeq():.3g}")
+                                      f"t = {s.t * 1e6:.0f} us, max PEEQ {diagnostics.max_peeq(s):.3g}")
         m = run.model
         if m.surface is not None:
             self.profile = analyses.nose_profile(s, run.pm.shape, m.tip, m.tail, m.surface.tri, run.out)

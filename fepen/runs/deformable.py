@@ -18,7 +18,7 @@ from fepen.io.fields import FieldWriter
 from fepen.post import analyses, paraview
 from fepen.runs import checkpoint, closing, events, model, outputs, shot
 from fepen.runs.run import Removal, Run, Snapshot
-from fepen.solver import explicit
+from fepen.solver import diagnostics, explicit, probes
 
 #: steps between two checks of the stop rules in the target (each costs a few reductions)
 EVENT_EVERY = 20
@@ -93,7 +93,7 @@ class DeformableRun(Run):
             return None
         if m.erosion is not None and s.total_mass < events.ERODED_FRACTION * s.initial_mass:
             return "eroded"
-        if events.beyond_method(s.max_peeq(), self.shot.failure_strain):
+        if events.beyond_method(diagnostics.max_peeq(s), self.shot.failure_strain):
             self._beyond_method()
         return super().stop_rules()
 
@@ -110,15 +110,15 @@ class DeformableRun(Run):
         y_min, y_max = self._y_extent(x)
         if not (self.rules.entered or y_min < 0.0):
             return y_min, y_max, None, None, 0.0, 0.0  # not in the target yet: Run looks no further
-        axis = unit_axis(s.node_value(m.tip, x), s.node_value(m.tail, x))
-        return y_min, y_max, s.momentum_velocity(), axis, s.total_mass, s.ke0
+        axis = unit_axis(probes.node_value(s, m.tip, x), probes.node_value(s, m.tail, x))
+        return y_min, y_max, diagnostics.momentum_velocity(s), axis, s.total_mass, s.ke0
 
     def _after_erosion(self) -> None:
         """If the nose-tip (tail) node lost its last cell, the foremost (rearmost) live node along the axis
         takes its place (collective)."""
         s, m = self.solver, self.model
         x = s.positions()
-        axis = unit_axis(s.node_value(m.tip, x), s.node_value(m.tail, x))
+        axis = unit_axis(probes.node_value(s, m.tip, x), probes.node_value(s, m.tail, x))
         for name, sign in (("tip", 1.0), ("tail", -1.0)):
             owner, local = getattr(m, name)
             dead = self.comm.bcast(bool(s.orphans[local]) if self.comm.rank == owner else None, root=owner)
@@ -134,7 +134,7 @@ class DeformableRun(Run):
     def _beyond_method(self):
         """Stop: the equivalent plastic strain passed projectile.failure_strain (where, when)."""
         s = self.solver
-        peeq, where = s.max_peeq_where()
+        peeq, where = diagnostics.max_peeq_where(s)
         raise BeyondMethod(
             f"the equivalent plastic strain reached {peeq:.3g} > projectile.failure_strain = "
             f"{self.shot.failure_strain:g}, {where[1] * 1e3:.1f} mm behind the nose tip "
@@ -154,13 +154,13 @@ class DeformableRun(Run):
     def snapshot(self) -> Snapshot:
         s, m = self.solver, self.model
         x = s.positions()
-        e = s.energies()
+        e = diagnostics.energies(s)
         en = dict(kinetic=e.kinetic, internal_work=e.internal_work, external_work=e.external_work,
                   elastic=e.elastic, plastic=e.plastic, heat=e.heat, energy_error=e.balance_error)
-        tip, tail = s.node_value(m.tip, x), s.node_value(m.tail, x)
+        tip, tail = probes.node_value(s, m.tip, x), probes.node_value(s, m.tail, x)
         extra = []
         if self.pm.charge:
-            extra += list(s.body_accelerations(unit_axis(tip, tail)) / results.G0)
+            extra += list(diagnostics.body_accelerations(s, unit_axis(tip, tail)) / results.G0)
             self.sections.record(tip, tail)
         if self.contact is not None:
             i = self.contact.summary()
@@ -168,12 +168,12 @@ class DeformableRun(Run):
                       i["sliding_fraction"]]
         self.gauges.record()
         rear = -self._y_extent(x)[1] if self.crossings is not None else np.nan
-        return Snapshot(tip, tail, s.momentum_velocity(), self.load.force, s.total_mass, en,
-                        self.load.contact_nodes, s.dt, s.max_peeq(), self.load.area, rear, extra)
+        return Snapshot(tip, tail, diagnostics.momentum_velocity(s), self.load.force, s.total_mass, en,
+                        self.load.contact_nodes, s.dt, diagnostics.max_peeq(s), self.load.area, rear, extra)
 
     def removal(self) -> Removal:
         s, m = self.solver, self.model
-        e = s.energies()
+        e = diagnostics.energies(s)
         heat = self.comm.allreduce(m.recession.heat_total, op=MPI.SUM) if m.recession is not None else 0.0
         return Removal(s.initial_mass - s.total_mass, heat, m.erosion.count if m.erosion is not None else 0,
                        e.removed_kinetic, e.removed_internal)
@@ -196,10 +196,10 @@ class DeformableRun(Run):
     def write_fields(self) -> None:
         s, m = self.solver, self.model
         x = s.positions()
-        axis = unit_axis(s.node_value(m.tip, x), s.node_value(m.tail, x))
-        values = {"displacement_m": x - s.X0, "velocity_m_s": s.velocity_at_step(), "von_mises_Pa": s.von_mises(),
-                  "axial_stress_Pa": s.axial_stress(axis), "peeq": s.live_peeq(), "temperature_K": s.temp,
-                  "cell_tag": s.mat + 1.0}
+        axis = unit_axis(probes.node_value(s, m.tip, x), probes.node_value(s, m.tail, x))
+        values = {"displacement_m": x - s.X0, "velocity_m_s": s.velocity_at_step(),
+                  "von_mises_Pa": diagnostics.von_mises(s), "axial_stress_Pa": diagnostics.axial_stress(s, axis),
+                  "peeq": diagnostics.live_peeq(s), "temperature_K": s.temp, "cell_tag": s.mat + 1.0}
         if self.contact is not None:
             values.update(self.contact.nodal_gap_and_slip())
         if m.recession is not None:
@@ -255,7 +255,7 @@ class DeformableRun(Run):
         for name, c in small.items():
             c.restore(state["components"][name])
         self.rows = [list(r) for r in z["rows"]]
-        self.model.tip = self.load.tip = self.solver.node_at(state["tip"])
+        self.model.tip = self.load.tip = probes.node_at(self.solver, state["tip"])
         self.wall_before = float(state["wall_s"])
         return state["field_times_s"]
 

@@ -13,7 +13,7 @@ from fepen.geometry import mesh as fmesh
 from fepen.geometry import tags
 from fepen.laws import target as tg
 from fepen.runs import setup, shot
-from fepen.solver import erosion, explicit, recession, rigid_wall, shell_charge, surface, target_load
+from fepen.solver import erosion, explicit, probes, recession, rigid_wall, shell_charge, surface, target_load
 
 
 # ---------------------------------------------------------------------------------------------------------
@@ -82,8 +82,8 @@ def build(sh, comm: MPI.Comm = MPI.COMM_WORLD) -> Model:
     if pm.split:
         contact = shell_charge.ShellChargeContact(s, pm.facet_tags, sh.charge_friction)
         s.interface = contact
-    tip = s.node_at(pm.shape.tip)
-    tail = s.node_at(pm.shape.tail)
+    tip = probes.node_at(s, pm.shape.tip)
+    tail = probes.node_at(s, pm.shape.tail)
     surf = None
     if sh.law is not None:
         surf = surface.outer_surface(s.V, pm.facet_tags, pm.shape)

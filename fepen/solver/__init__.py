@@ -1,3 +1,5 @@
-"""The explicit solver on a dolfinx mesh: cell kernels, central differences, target load, contact."""
+"""The explicit solver on a dolfinx mesh: cell kernels, central differences, what is read off it and
+changes its reference body, target load, contact."""
 
-__all__ = ["kernels", "ckernel", "explicit", "surface", "target_load", "rigid_wall", "shell_charge"]
+__all__ = ["kernels", "ckernel", "explicit", "probes", "diagnostics", "reference", "failures", "surface",
+           "target_load", "rigid_wall", "shell_charge"]

@@ -1,5 +1,5 @@
 """Element erosion on the explicit solver (docs/theory.md §15): cells past the criteria of
-fepen.laws.erosion are removed (fepen.solver.explicit.ExplicitSolver.remove_cells: their mass and kinetic
+fepen.laws.erosion are removed (fepen.solver.reference.remove_cells: their mass and kinetic
 energy accounted), and the faces they expose become loaded surface with their own flat normals and areas.
 
 Faces are matched across ranks by the global numbers of their three nodes, so an erosion on one rank
@@ -12,7 +12,7 @@ import numpy as np
 from mpi4py import MPI
 
 from fepen.laws import erosion as law
-from fepen.solver import kernels
+from fepen.solver import kernels, reference
 
 __all__ = ["Erosion"]
 
@@ -99,7 +99,7 @@ class Erosion:
         if n == 0:
             return 0
         dead = np.concatenate(s.comm.allgather(self._face_codes(cells)))
-        s.remove_cells(cells)
+        reference.remove_cells(s, cells)
         if self.surface is not None:
             self._expose(cells, dead)
         self.count += n

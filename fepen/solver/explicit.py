@@ -17,37 +17,9 @@ from mpi4py import MPI
 
 from fepen.errors import SimulationError
 from fepen.laws import materials as M
-from fepen.solver import ckernel, kernels
+from fepen.solver import ckernel, failures, kernels, reference
 
 _log.set_log_level(_log.LogLevel.WARNING)  # quiet dolfinx wherever the solver is used
-
-
-@dataclass
-class Energies:
-    """Global energies (J) at the current step."""
-
-    kinetic: float
-    internal_work: float
-    external_work: float
-    elastic: float
-    plastic: float
-    heat: float
-    initial_kinetic: float
-    interface_normal_work: float = 0.0
-    friction: float = 0.0
-    removed_kinetic: float = 0.0
-    removed_internal: float = 0.0
-
-    @property
-    def balance_error(self) -> float:
-        """Relative energy-balance error: KE + KE_removed + W_int − KE_0 − W_ext − W_interface, with
-        W_interface the work of the shell–charge contact forces (normal work − friction dissipation;
-        fepen.solver.shell_charge) and KE_removed the kinetic energy the removed material carried away when
-        it was removed (erosion, surface recession; W_int keeps the work done on it)."""
-        scale = max(self.initial_kinetic, abs(self.external_work), self.kinetic, 1e-300)
-        w_if = self.interface_normal_work - self.friction
-        return abs(self.kinetic + self.removed_kinetic + self.internal_work - self.initial_kinetic
-                   - self.external_work - w_if) / scale
 
 
 @dataclass
@@ -75,8 +47,9 @@ class Load(Protocol):
     contact_nodes: int  #: loaded points (nodes on a rigid wall), all ranks
     area: float  #: loaded area (m^2), all ranks
 
-    def __call__(self, solver: ExplicitSolver) -> None:
-        """Add the external nodal forces of the current positions into ``solver.fext`` (owned nodes)."""
+    def __call__(self, solver: ExplicitSolver, dt: float) -> None:
+        """Add the external nodal forces of the current positions into ``solver.fext`` (owned nodes); ``dt``:
+        the step they act over (``solver.dt``; what a load accumulates in time, the wear heat, takes it)."""
 
 
 class Interface(Protocol):
@@ -124,97 +97,17 @@ class ExplicitSolver:
         self.safety = safety
         self.nodal = nodal_pressure
         self.external = external
-        V = fem.VectorFunctionSpace(mesh, ("CG", 1))
-        Q = fem.TensorFunctionSpace(mesh, ("DG", 0))
-        self.V, self.Q = V, Q
-        imap = V.dofmap.index_map
-        self.n_owned = imap.size_local
-        self.n_nodes = imap.size_local + imap.num_ghosts
-        n_cells = mesh.topology.index_map(mesh.topology.dim).size_local
-        self.n_cells = n_cells
-        self.dofs = np.ascontiguousarray(V.dofmap.list.array.reshape(-1, 4)[:n_cells]).astype(np.int64)
-        self.X = V.tabulate_dof_coordinates()[: self.n_nodes].copy()
-        self.X0 = self.X.copy()  # X moves only where a surface recedes (fepen.solver.recession)
-        # the mesh geometry's node of each dof, so that a moved reference reaches the assembled form
-        gdofs = mesh.geometry.dofmap.array.reshape(-1, 4)
-        self._geometry_node = np.zeros(self.n_nodes, dtype=np.int64)
-        self._geometry_node[V.dofmap.list.array.reshape(-1, 4).ravel()] = gdofs.ravel()
-        self.geometry_x = mesh.geometry.x
-        assert np.allclose(self.geometry_x[self._geometry_node, :3], self.X)
-        self.X[:] = self.geometry_x[self._geometry_node, :3]  # the mesh's own numbers (tabulated ones may
-        self.X0[:] = self.X  # differ in the last bit), so that writing X back into the geometry changes nothing
-        self.grad0, self.vol0, self.orient = kernels.reference_gradients(self.X, self.dofs)
-        self.materials = materials
-        self.params = np.stack([m.params for m in materials])
-        self.mat = np.ascontiguousarray(cell_material, dtype=np.int64)  # −1: an eroded cell
-        assert len(self.mat) == n_cells
-        self.cell_dt = np.full(n_cells, np.inf)  # each cell's altitude / wave speed, every STEP_EVERY steps
-        #: this rank's removed mass (owned nodes), kinetic energy carried away, stored elastic energy of
-        #: the removed cells (J); see remove_cells and change_reference
-        self._removed = np.zeros(3)
-        self.speed = np.array([float(np.sqrt((m.bulk_modulus + 4.0 * m.shear_modulus / 3.0) / m.density))
-                               for m in materials])
-        self.bulk = np.array([m.bulk_modulus for m in materials])
+        _reference_body(self, mesh)
+        _material_tables(self, materials, cell_material)
         nm = len(materials)
-
-        self._nodal_arrays(V, imap, nm)
+        imap = self.V.dofmap.index_map
+        _nodal_arrays(self, self.V, imap, nm)
         self._lumped_mass(imap, nm)
         self.initial_mass = self.total_mass
-
-        # cell state
-        self._sT = np.zeros((6, n_cells))  # component-major for the C trial pass
-        self.s = self._sT.T  # (n_cells, 6) view: xx, yy, zz, xy, yz, xz
-        self.eps_p = np.zeros(n_cells)
-        self.temp = np.array([m.params[M.TROOM] for m in materials])[self.mat].astype(float)
-        self._totals = np.zeros(4)
-        self.sy0 = np.empty(n_cells)
-        kernels.static_flow_stress(self.mat, self.params, self.eps_p, self.temp, self.sy0)
-
-        self._internal_force_form(V, Q)
-
-        self._stress_kernel(kernel)
-
-        # time and energy
-        self.step_gain = 1.0  # stable step = safety * step_gain * min(h/c); see calibrate_step
-        self.t = 0.0
-        self.step_count = 0
-        self.dt_prev = 0.0
-        self.dt = self.stable_step()
-        self.dt0 = self.dt
-        self.dt_min = self.dt
-        self._w_int = 0.0
-        self._w_ext = 0.0
-        self._plastic = 0.0
-        self._heat = 0.0
-        self._w_if_n = 0.0  # work of the interface's normal and tangential forces (fepen.solver.shell_charge)
-        self._w_if_t = 0.0
-        self.interface = None
-        # called with the current positions when a live cell inverts (collective): True if it eroded the
-        # inverted cells (fepen.solver.erosion), False or None to stop the run
-        self.on_inverted = None
-        self.ke0 = None
-        self.times = StepTimes()
-
-    def _nodal_arrays(self, V, imap, nm: int) -> None:
-        """Nodal vectors (ghosted, block size 3) and nodal scalars per material; the reference nodal volumes."""
-        self.u = fem.Function(V, name="displacement")
-        self.v = fem.Function(V, name="velocity")
-        self.fint_fn = fem.Function(V)
-        self.U, self.Vel = self.u.x.array.reshape(-1, 3), self.v.x.array.reshape(-1, 3)
-        self.a_fn = fem.Function(V, name="acceleration")
-        self.acc = self.a_fn.x.array.reshape(-1, 3)
-        self.fint = self.fint_fn.x.array.reshape(-1, 3)
-        self.fint_old = np.zeros_like(self.fint)
-        self.fixed = None  # (n_nodes, 3) bool: velocity components held at zero (symmetry planes)
-        self.fext = np.zeros((self.n_nodes, 3))
-        self.fext_old = np.zeros_like(self.fext)
-        self._nvol = la.vector(imap, bs=nm)
-        self._nvol0 = la.vector(imap, bs=nm)
-        self.nodal_vol = self._nvol.array.reshape(-1, nm)
-        self.nodal_vol0 = self._nvol0.array.reshape(-1, nm)
-        self.nodal_p = np.zeros_like(self.nodal_vol0)
-        kernels.volumes_and_step(self.X, self.dofs, self.orient, self.vol0, self.mat, self.speed, self.nodal_vol0)
-        self._ghost_sum(self._nvol0)
+        _cell_state(self)
+        _internal_force_form(self, self.V, self.Q)
+        _stress_kernel(self, kernel)
+        _clock(self)
 
     def _lumped_mass(self, imap, nm: int, orphans_allowed: bool = False) -> None:
         """Lumped mass: ρ_e V0_e / 4 to each node, per material (the bodies' masses, for their mass-averaged
@@ -240,36 +133,6 @@ class ExplicitSolver:
         if np.any(self.orphans):
             self._mass_div = np.where(self.orphans, 1.0, self.mass)
         self.total_mass = self.comm.allreduce(float(self.mass[: self.n_owned].sum()), op=MPI.SUM)
-
-    def _internal_force_form(self, V, Q) -> None:
-        """The internal-force form, with P packed once and rewritten in place each step."""
-        n_cells = self.n_cells
-        self.P = fem.Function(Q, name="P")
-        w = ufl.TestFunction(V)
-        self.form = fem.form(ufl.inner(self.P, ufl.grad(w)) * ufl.dx)
-        self._consts = _cpp.fem.pack_constants(self.form)
-        self._coeffs = _cpp.fem.pack_coefficients(self.form)
-        key = next(iter(self._coeffs))
-        self.P_packed = self._coeffs[key]
-        assert self.P_packed.shape[1] == 9 and self.P_packed.shape[0] >= n_cells
-
-    def _stress_kernel(self, kernel: str | None) -> None:
-        """The stress update: the C trial pass + numba radial return, or the numba kernel alone (the
-        reference; also the plain element's)."""
-        materials = self.materials
-        self.x = np.empty((self.n_nodes, 3))  # current positions X + U of the last force evaluation
-        self._flag = np.zeros(1)
-        self._trial = None
-        if kernel not in (None, "C", "numba"):
-            raise ValueError(f"kernel must be 'C', 'numba' or None, not {kernel!r}")
-        if kernel == "C" and (not self.nodal or ckernel.library() is None):
-            raise RuntimeError(f"the C kernel is not available: {ckernel.why_not() or 'plain element'}")
-        if self.nodal and kernel != "numba" and ckernel.library() is not None:
-            self.G_m = np.array([m.shear_modulus for m in materials])
-            self._trial = ckernel.TrialPass(self.x, self.Vel, self.X, self.dofs, self.mat,
-                                            6.0 * self.vol0 * self.orient, self.G_m, self.nodal_p, self._sT,
-                                            self.sy0, self.P_packed)
-        self.kernel = "C" if self._trial is not None else "numba"
 
     # ------------------------------------------------------------------------------------------------
     def _ghost_sum(self, vec) -> None:
@@ -376,17 +239,17 @@ class ExplicitSolver:
         """Internal and external forces at the current positions; returns the new stable-step estimate
         (h/c over the current mesh, before the safety factor) on this rank."""
         t0 = perf_counter()
-        x = np.add(self.X, self.U, out=self.x)
+        x = np.add(self.X, self.U, out=self._x)
         with_step = self.step_count % STEP_EVERY == 0
         jmin, worst, h_c, self._step_cell = kernels.volumes_and_step(
             x, self.dofs, self.orient, self.vol0, self.mat, self.speed, self.nodal_vol, with_step, self.cell_dt)
         if self._any_inverted(jmin):
             if self.on_inverted is None or not self.on_inverted(x):
-                self._raise_inverted(x, jmin, worst)
+                failures.inverted(self, x, jmin, worst)
             jmin, worst, h_c, self._step_cell = kernels.volumes_and_step(  # the inverted cells eroded
                 x, self.dofs, self.orient, self.vol0, self.mat, self.speed, self.nodal_vol, with_step, self.cell_dt)
             if self._any_inverted(jmin):
-                self._raise_inverted(x, jmin, worst)
+                failures.inverted(self, x, jmin, worst)
         if self.nodal:
             self._ghost_sum(self._nvol)
         t1 = perf_counter()
@@ -398,7 +261,7 @@ class ExplicitSolver:
         t3 = perf_counter()
         self.fext[:] = 0.0
         if self.external is not None:
-            self.external(self)
+            self.external(self, self.dt)
         t4 = perf_counter()
         tm = self.times
         tm.kinematics += t1 - t0
@@ -428,11 +291,6 @@ class ExplicitSolver:
         kernels.internal_force(self.P_packed, self.dofs, self.grad0, self.vol0, self.fint)
         self.fint_fn.x.scatter_reverse(la.ScatterMode.add)
 
-    def assemble_form(self, out: np.ndarray) -> None:
-        """The same internal force through dolfinx: the compiled form assembled into ``out`` (the flat array
-        of a V function, zeroed by the caller), no ghost sum (the reference, and the benchmarks' floor)."""
-        _cpp.fem.assemble_vector(out, self.form, self._consts, self._coeffs)
-
     def _any_inverted(self, jmin: float) -> bool:
         """Whether a live cell on any rank is inverted (or NaN); every rank gets the same answer."""
         bad = not (jmin > 0.0)
@@ -441,21 +299,6 @@ class ExplicitSolver:
             self.comm.Allreduce(MPI.IN_PLACE, self._flag, op=MPI.MAX)
             bad = self._flag[0] > 0.0
         return bad
-
-    def _raise_inverted(self, x: np.ndarray, jmin: float, worst: int) -> None:
-        """SimulationError naming the inverted element, where and when (collective)."""
-        local = (0 if not (jmin > 0.0) else 1, self.comm.rank)
-        _, owner = self.comm.allreduce(local, op=MPI.MIN)
-        info = None
-        if self.comm.rank == owner:
-            c = x[self.dofs[worst]].mean(axis=0)
-            c0 = self.X[self.dofs[worst]].mean(axis=0)
-            info = (self.mesh.topology.index_map(3).local_range[0] + worst, jmin, c, c0)
-        gidx, jw, c, c0 = self.comm.bcast(info, root=owner)
-        raise SimulationError(
-            f"element {gidx} inverted (J = {jw:.3g}) at step {self.step_count}, t = {self.t * 1e6:.3f} us, "
-            f"centre ({c[0] * 1e3:.2f}, {c[1] * 1e3:.2f}, {c[2] * 1e3:.2f}) mm; in the undeformed projectile "
-            f"{c0[1] * 1e3:.1f} mm behind the nose tip, radius {np.hypot(c0[0], c0[2]) * 1e3:.1f} mm")
 
     def step(self) -> None:
         """Advance one central-difference step."""
@@ -492,75 +335,9 @@ class ExplicitSolver:
         """The next Δt from this rank's h/c (all ranks agree), or SimulationError if it collapsed."""
         new = self.safety * self.step_gain * self.comm.allreduce(h_c, op=MPI.MIN)
         if not (new > 1e-3 * self.dt0):
-            _, owner = self.comm.allreduce((h_c, self.comm.rank), op=MPI.MIN)
-            c = self.X[self.dofs[self._step_cell]].mean(axis=0) if self.comm.rank == owner else None
-            c = self.comm.bcast(c, root=owner)
-            raise SimulationError(
-                f"stable step collapsed to {new:.3g} s (initial {self.dt0:.3g} s) at step {self.step_count}, "
-                f"t = {self.t * 1e6:.3f} us: an element is nearly flat, {c[1] * 1e3:.1f} mm behind the nose "
-                f"tip (radius {np.hypot(c[0], c[2]) * 1e3:.1f} mm) in the undeformed projectile")
+            failures.step_collapsed(self, h_c, new)
         self.dt = new
         self.dt_min = min(self.dt_min, new)
-
-    # ------------------------------------------------------------------------------------------------
-    def remove_cells(self, cells: np.ndarray) -> None:
-        """Erode owned cells (collective; ``cells`` may be empty on some ranks): their stress and force go,
-        their mass leaves their nodes, and a node left without a live cell stops (docs/theory.md §15).
-
-        The removed mass, the kinetic energy it carried (½ Δm_a |v_a|² at the integer step) and the elastic
-        energy stored in the removed cells are added to this rank's ``_removed`` sums.
-        """
-        cells = np.asarray(cells, dtype=np.int64)
-        if len(cells):
-            J = np.empty(self.n_cells)
-            kernels.cell_jacobians(self.positions(), self.dofs, self.orient, self.vol0, self.mat, J)
-            G = np.array([m.shear_modulus for m in self.materials])[self.mat[cells]]
-            self._removed[2] += kernels.deviatoric_energy(self.s[cells], J[cells], self.vol0[cells], G)
-            self.mat[cells] = -1
-            self.s[cells] = 0.0
-            self.P_packed[cells] = 0.0
-            self.sy0[cells] = np.inf
-            self.cell_dt[cells] = np.inf
-        self._new_reference(np.zeros(0, dtype=np.int64))
-
-    def change_reference(self, dX: np.ndarray) -> None:
-        """Move the reference positions of nodes by dX (n_nodes, 3), ghosts included and equal on every rank
-        that holds a node: material removed from a receding surface (fepen.solver.recession). The
-        displacement is kept, so the current positions move with the reference ones; the cells touched get
-        their new reference gradients and volumes, the nodes their new masses (collective)."""
-        moved = np.any(dX != 0.0, axis=1)
-        cells = np.flatnonzero(moved[self.dofs].any(axis=1))
-        self.X += dX
-        self._new_reference(cells)
-
-    def _new_reference(self, cells: np.ndarray) -> None:
-        """Recompute the reference data of ``cells`` and every nodal mass and volume (collective)."""
-        if len(cells):
-            g, v, o = kernels.reference_gradients(self.X, self.dofs[cells])
-            self.grad0[cells], self.vol0[cells], self.orient[cells] = g, v, o
-            if self.geometry_x is not None:
-                self.geometry_x[self._geometry_node, :3] = self.X
-        if self._trial is not None:
-            self._trial.refresh(self.mat, 6.0 * self.vol0 * self.orient)
-        old = self.mass.copy()
-        v = self.velocity_at_step()
-        kernels.volumes_and_step(self.X, self.dofs, self.orient, self.vol0, self.mat, self.speed,
-                                 self.nodal_vol0, False)
-        self._ghost_sum(self._nvol0)
-        nm = len(self.materials)
-        self._lumped_mass(self.V.dofmap.index_map, nm, orphans_allowed=True)
-        n = self.n_owned
-        dm = old[:n] - self.mass[:n]
-        self._removed[0] += float(dm.sum())
-        self._removed[1] += 0.5 * float(np.sum(dm[:, None] * v[:n] ** 2))
-        if np.any(self.orphans):
-            for a in (self.Vel, self.acc):
-                a[self.orphans] = 0.0
-
-    @property
-    def removed_mass(self) -> float:
-        """Mass removed so far (kg), all ranks."""
-        return self.comm.allreduce(float(self._removed[0]), op=MPI.SUM)
 
     def state(self) -> dict[str, np.ndarray]:
         """This rank's state between two steps: STATE_ARRAYS, the reference positions ``X`` and the
@@ -584,7 +361,7 @@ class ExplicitSolver:
         changed = bool(np.any(self.mat < 0)) or not np.array_equal(self.X, self.X0)  # eroded or receded
         if self.comm.allreduce(changed, op=MPI.LOR):  # rebuild (collective)
             removed = self._removed.copy()
-            self._new_reference(np.arange(self.n_cells))
+            reference.rebuild(self, np.arange(self.n_cells))
             self.P_packed[: self.n_cells][self.mat < 0] = 0.0
             self._removed[:] = removed
 
@@ -593,103 +370,125 @@ class ExplicitSolver:
         self._w_if_n += normal
         self._w_if_t += tangential
 
-    def momentum_velocity(self) -> np.ndarray:
-        """Velocity of the centre of mass (m/s), all ranks."""
-        n = self.n_owned
-        p = np.sum(self.mass[:n, None] * self.velocity_at_step()[:n], axis=0)
-        return self.comm.allreduce(p, op=MPI.SUM) / self.total_mass
 
-    def body_accelerations(self, axis: np.ndarray) -> np.ndarray:
-        """Mass-averaged acceleration of each material's body along the axis (m/s^2), all ranks:
-        Σ_a m_a^(body) a_a · axis / m_body, with m_a^(body) the lumped mass node a takes from that body's
-        cells (interface nodes share theirs)."""
-        n = self.n_owned
-        along = self.acc[:n] @ axis
-        local = np.array([float(self.mass_by_material[:n, k] @ along) for k in range(len(self.materials))])
-        return self.comm.allreduce(local, op=MPI.SUM) / self.body_mass
+# ------------------------------------------------------------------------------------------------
+# the solver's set-up, in the order ExplicitSolver.__init__ calls them
 
-    def max_peeq(self) -> float:
-        """The largest equivalent plastic strain, all ranks."""
-        return self.comm.allreduce(float(self.live_peeq().max()) if self.n_cells else 0.0, op=MPI.MAX)
+def _reference_body(s: ExplicitSolver, mesh) -> None:
+    """The function spaces, the node and cell numbering, the reference positions and gradients."""
+    V = fem.VectorFunctionSpace(mesh, ("CG", 1))
+    Q = fem.TensorFunctionSpace(mesh, ("DG", 0))
+    s.V, s.Q = V, Q
+    imap = V.dofmap.index_map
+    s.n_owned = imap.size_local
+    s.n_nodes = imap.size_local + imap.num_ghosts
+    n_cells = mesh.topology.index_map(mesh.topology.dim).size_local
+    s.n_cells = n_cells
+    s.dofs = np.ascontiguousarray(V.dofmap.list.array.reshape(-1, 4)[:n_cells]).astype(np.int64)
+    s.X = V.tabulate_dof_coordinates()[: s.n_nodes].copy()
+    s.X0 = s.X.copy()  # X moves only where a surface recedes (fepen.solver.recession)
+    # the mesh geometry's node of each dof, so that a moved reference reaches the assembled form
+    gdofs = mesh.geometry.dofmap.array.reshape(-1, 4)
+    s._geometry_node = np.zeros(s.n_nodes, dtype=np.int64)
+    s._geometry_node[V.dofmap.list.array.reshape(-1, 4).ravel()] = gdofs.ravel()
+    s.geometry_x = mesh.geometry.x
+    assert np.allclose(s.geometry_x[s._geometry_node, :3], s.X)
+    s.X[:] = s.geometry_x[s._geometry_node, :3]  # the mesh's own numbers (tabulated ones may differ in
+    s.X0[:] = s.X  # the last bit), so that writing X back into the geometry changes nothing
+    s.grad0, s.vol0, s.orient = kernels.reference_gradients(s.X, s.dofs)
 
-    def live_peeq(self) -> np.ndarray:
-        """The owned cells' equivalent plastic strain, 0 on eroded cells."""
-        return self.eps_p if self.mat.min(initial=0) >= 0 else np.where(self.mat >= 0, self.eps_p, 0.0)
 
-    def max_peeq_where(self) -> tuple[float, np.ndarray]:
-        """The largest equivalent plastic strain and its cell's centre in the reference body, all ranks."""
-        ep = self.live_peeq()
-        local = (float(ep.max()), self.comm.rank, int(np.argmax(ep))) if self.n_cells else (-1.0, 0, -1)
-        peeq, owner, cell = self.comm.allreduce(local, op=MPI.MAX)
-        where = self.X[self.dofs[cell]].mean(axis=0) if self.comm.rank == owner else None
-        return peeq, self.comm.bcast(where, root=owner)
+def _material_tables(s: ExplicitSolver, materials: list[M.Material], cell_material: np.ndarray) -> None:
+    """Each cell's material (−1: eroded) and the materials' parameters, wave speeds and bulk moduli."""
+    s.materials = materials
+    s.params = np.stack([m.params for m in materials])
+    s.mat = np.ascontiguousarray(cell_material, dtype=np.int64)  # −1: an eroded cell
+    assert len(s.mat) == s.n_cells
+    s.cell_dt = np.full(s.n_cells, np.inf)  # each cell's altitude / wave speed, every STEP_EVERY steps
+    #: this rank's removed mass (owned nodes), kinetic energy carried away, stored elastic energy of
+    #: the removed cells (J); see fepen.solver.reference
+    s._removed = np.zeros(3)
+    s.speed = np.array([float(np.sqrt((m.bulk_modulus + 4.0 * m.shear_modulus / 3.0) / m.density))
+                        for m in materials])
+    s.bulk = np.array([m.bulk_modulus for m in materials])
 
-    def von_mises(self) -> np.ndarray:
-        """Equivalent (von Mises) stress of the owned cells (Pa)."""
-        sd = self.s
-        return np.sqrt(1.5 * (sd[:, 0] ** 2 + sd[:, 1] ** 2 + sd[:, 2] ** 2
-                              + 2 * (sd[:, 3] ** 2 + sd[:, 4] ** 2 + sd[:, 5] ** 2)))
 
-    def axial_stress(self, axis: np.ndarray) -> np.ndarray:
-        """Normal Cauchy stress along the axis of the owned cells (Pa): a·s·a plus the cells' mean stress."""
-        sd = self.s
-        pm = self.nodal_p[self.dofs, np.maximum(self.mat, 0)[:, None]].mean(axis=1) * (self.mat >= 0) \
-            if self.nodal else 0.0
-        ax, ay, az = axis
-        return (sd[:, 0] * ax * ax + sd[:, 1] * ay * ay + sd[:, 2] * az * az
-                + 2 * (sd[:, 3] * ax * ay + sd[:, 4] * ay * az + sd[:, 5] * ax * az)) + pm
+def _cell_state(s: ExplicitSolver) -> None:
+    """Stress, plastic strain, temperature and static flow stress of each cell, at rest."""
+    n_cells = s.n_cells
+    s._sT = np.zeros((6, n_cells))  # component-major for the C trial pass
+    s.s = s._sT.T  # (n_cells, 6) view: xx, yy, zz, xy, yz, xz
+    s.eps_p = np.zeros(n_cells)
+    s.temp = np.array([m.params[M.TROOM] for m in s.materials])[s.mat].astype(float)
+    s._totals = np.zeros(4)
+    s.sy0 = np.empty(n_cells)
+    kernels.static_flow_stress(s.mat, s.params, s.eps_p, s.temp, s.sy0)
 
-    # ------------------------------------------------------------------------------------------------
-    def energies(self) -> Energies:
-        """Global energies at the current step."""
-        c = self.comm
-        ke = self.kinetic_energy(self.velocity_at_step())
-        vol = kernels.volumetric_energy(self.nodal_vol, self.nodal_vol0, self.bulk, self.n_owned)
-        if not self.nodal:
-            vol = self._element_volumetric_energy()
-        dev = self._deviatoric_energy()
-        sums = c.allreduce(np.array([self._w_int, self._w_ext, vol + dev, self._plastic, self._heat,
-                                     self._w_if_n, self._w_if_t, self._removed[1], self._removed[2]]), op=MPI.SUM)
-        return Energies(ke, sums[0], sums[1], sums[2], sums[3], sums[4], self.ke0 or 0.0, sums[5], -sums[6],
-                        sums[7], sums[8])
 
-    def _cell_J(self) -> np.ndarray:
-        J = np.empty(self.n_cells)
-        kernels.cell_jacobians(self.positions(), self.dofs, self.orient, self.vol0, self.mat, J)
-        return J
+def _clock(s: ExplicitSolver) -> None:
+    """Time, the first stable step, the work sums, no hooks yet."""
+    s.step_gain = 1.0  # stable step = safety * step_gain * min(h/c); see calibrate_step
+    s.t = s.dt_prev = 0.0
+    s.step_count = 0
+    s.dt = s.dt0 = s.dt_min = s.stable_step()
+    # the work sums: internal, external, plastic, heat, and the interface's normal and tangential forces
+    s._w_int = s._w_ext = s._plastic = s._heat = s._w_if_n = s._w_if_t = 0.0
+    s.interface = None
+    # called with the current positions when a live cell inverts (collective): True if it eroded the
+    # inverted cells (fepen.solver.erosion), False or None to stop the run
+    s.on_inverted = None
+    s.ke0 = None
+    s.times = StepTimes()
 
-    def _deviatoric_energy(self) -> float:
-        G = np.array([m.shear_modulus for m in self.materials])[self.mat]
-        return kernels.deviatoric_energy(self.s, self._cell_J(), self.vol0, G)
 
-    def _element_volumetric_energy(self) -> float:
-        lj = np.log(self._cell_J())
-        return float(np.sum(self.vol0 * 0.5 * self.bulk[self.mat] * lj * lj))
+def _nodal_arrays(s: ExplicitSolver, V, imap, nm: int) -> None:
+    """Nodal vectors (ghosted, block size 3) and nodal scalars per material; the reference nodal volumes."""
+    s.u = fem.Function(V, name="displacement")
+    s.v = fem.Function(V, name="velocity")
+    s.fint_fn = fem.Function(V)
+    s.U, s.Vel = s.u.x.array.reshape(-1, 3), s.v.x.array.reshape(-1, 3)
+    s.a_fn = fem.Function(V, name="acceleration")
+    s.acc = s.a_fn.x.array.reshape(-1, 3)
+    s.fint = s.fint_fn.x.array.reshape(-1, 3)
+    s.fint_old = np.zeros_like(s.fint)
+    s.fixed = None  # (n_nodes, 3) bool: velocity components held at zero (symmetry planes)
+    s.fext = np.zeros((s.n_nodes, 3))
+    s.fext_old = np.zeros_like(s.fext)
+    s._nvol = la.vector(imap, bs=nm)
+    s._nvol0 = la.vector(imap, bs=nm)
+    s.nodal_vol = s._nvol.array.reshape(-1, nm)
+    s.nodal_vol0 = s._nvol0.array.reshape(-1, nm)
+    s.nodal_p = np.zeros_like(s.nodal_vol0)
+    kernels.volumes_and_step(s.X, s.dofs, s.orient, s.vol0, s.mat, s.speed, s.nodal_vol0)
+    s._ghost_sum(s._nvol0)
 
-    # ------------------------------------------------------------------------------------------------
-    def node_at(self, point) -> tuple[int, int]:
-        """(owner rank, local index) of the owned node at a point of the initial reference body (exact match),
-        or (-1, -1)."""
-        d = np.linalg.norm(self.X0[: self.n_owned] - np.asarray(point), axis=1)
-        local = int(np.argmin(d)) if len(d) else -1
-        mine = local >= 0 and d[local] < 1e-12
-        ranks = self.comm.allgather(self.comm.rank if mine else -1)
-        owner = max(ranks)
-        return owner, (local if self.comm.rank == owner else -1)
 
-    def node_values(self, handles, array: np.ndarray) -> np.ndarray:
-        """The (3,) values of a nodal array at several nodes located with node_at, as (k, 3) on every rank, in
-        one reduction (each owner's value against −inf elsewhere: bit for bit the owner's)."""
-        buf = np.full((len(handles), 3), -np.inf)
-        for k, (owner, local) in enumerate(handles):
-            if self.comm.rank == owner:
-                buf[k] = array[local]
-        if self.comm.size > 1:
-            self.comm.Allreduce(MPI.IN_PLACE, buf, op=MPI.MAX)
-        return buf
+def _internal_force_form(s: ExplicitSolver, V, Q) -> None:
+    """The internal-force form, with P packed once and rewritten in place each step."""
+    n_cells = s.n_cells
+    s.P = fem.Function(Q, name="P")
+    w = ufl.TestFunction(V)
+    s.form = fem.form(ufl.inner(s.P, ufl.grad(w)) * ufl.dx)
+    s._consts = _cpp.fem.pack_constants(s.form)
+    s._coeffs = _cpp.fem.pack_coefficients(s.form)
+    key = next(iter(s._coeffs))
+    s.P_packed = s._coeffs[key]
+    assert s.P_packed.shape[1] == 9 and s.P_packed.shape[0] >= n_cells
 
-    def node_value(self, owner_local: tuple[int, int], array: np.ndarray) -> np.ndarray:
-        """The (3,) value of a nodal array at a node located with node_at, on every rank."""
-        owner, local = owner_local
-        val = array[local].copy() if self.comm.rank == owner else None
-        return self.comm.bcast(val, root=owner)
+
+def _stress_kernel(s: ExplicitSolver, kernel: str | None) -> None:
+    """The stress update: the C trial pass + numba radial return, or the numba kernel alone (the
+    reference; also the plain element's)."""
+    materials = s.materials
+    s._x = np.empty((s.n_nodes, 3))  # current positions X + U of the last force evaluation (the kernels')
+    s._flag = np.zeros(1)
+    s._trial = None
+    if kernel not in (None, "C", "numba"):
+        raise ValueError(f"kernel must be 'C', 'numba' or None, not {kernel!r}")
+    if kernel == "C" and (not s.nodal or ckernel.library() is None):
+        raise RuntimeError(f"the C kernel is not available: {ckernel.why_not() or 'plain element'}")
+    if s.nodal and kernel != "numba" and ckernel.library() is not None:
+        s.G_m = np.array([m.shear_modulus for m in materials])
+        s._trial = ckernel.TrialPass(s._x, s.Vel, s.X, s.dofs, s.mat, 6.0 * s.vol0 * s.orient, s.G_m,
+                                     s.nodal_p, s._sT, s.sy0, s.P_packed)
+    s.kernel = "C" if s._trial is not None else "numba"

@@ -8,7 +8,7 @@ its facets' exact reference areas), moves the node's reference position inward b
 reference normal, and spreads the move over the ``layers`` node layers behind the surface by Jacobi
 sweeps of the graph Laplacian (the move fixed on the surface, zero beyond the band and on every other
 boundary, such as a cavity wall), so cells shrink gradually rather than the surface cells alone.
-ExplicitSolver.change_reference then takes the melted mass off the nodes (mass and carried kinetic
+fepen.solver.reference.change_reference then takes the melted mass off the nodes (mass and carried kinetic
 energy accounted), and the load points follow the new reference facets: the worn nose's own normals and
 areas feed back into σ_n.
 """
@@ -23,6 +23,7 @@ from dolfinx import mesh as dmesh
 from mpi4py import MPI
 
 from fepen.laws import wear
+from fepen.solver import reference
 
 __all__ = ["Recession"]
 
@@ -139,7 +140,7 @@ class Recession:
         dX = -d[:, None] * unit
         dX = self._relax(dX, on_surface)
         X_old = s.X.copy()
-        s.change_reference(dX)
+        reference.change_reference(s, dX)
         surf.follow_reference(X_old, s.X)
         self.depth += d
         return largest

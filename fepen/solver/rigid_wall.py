@@ -29,7 +29,7 @@ class RigidWall:
         self.contact_nodes = 0
         self.area = 0.0  # a wall of nodes: no loaded area
 
-    def __call__(self, solver) -> None:
+    def __call__(self, solver, dt: float) -> None:
         n = solver.n_owned
         y = solver.X[:n, 1] + solver.U[:n, 1]
         inside = np.flatnonzero(y < 0.0)

@@ -89,7 +89,7 @@ class ShellChargeContact:
         """Add the contact forces of the coming step to solver.acc (owned nodes), then refresh the ghosts."""
         s = solver
         dt, dt_avg = s.dt, 0.5 * (s.dt_prev + s.dt)
-        x = s.x  # X + U, as the solver's last force evaluation left it
+        x = s.positions()  # X + U: the positions of the solver's last force evaluation
         self.normal = self.normals(x)
         pair_forces(x, s.Vel, s.acc, s.mass, self.pa, self.pb, self.normal, dt, dt_avg, self.mu,
                     self.force, self.fn, self.state)

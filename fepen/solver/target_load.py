@@ -16,6 +16,7 @@ from mpi4py import MPI
 
 from fepen.geometry.frames import unit_axis
 from fepen.laws import target as tg
+from fepen.solver import probes
 from fepen.solver.surface import Surface
 
 
@@ -26,7 +27,7 @@ class TargetLoad:
         solver: the ExplicitSolver.
         surf: its Surface (owned outer facets).
         law: the TargetLaw.
-        tip, tail: (owner, local) node handles of the nose tip and tail centre (ExplicitSolver.node_at).
+        tip, tail: (owner, local) node handles of the nose tip and tail centre (probes.node_at).
         crater: a ForrestalCrater for the linear crater, else None.
     """
 
@@ -38,10 +39,10 @@ class TargetLoad:
         self.area = 0.0
         self.wear = None  # a fepen.solver.recession.Recession fed each step's point loads, or None
 
-    def __call__(self, solver) -> None:
-        x_all = solver.positions()  # not solver.x: a load may be evaluated on a state set by hand (wear playback)
+    def __call__(self, solver, dt: float) -> None:
+        x_all = solver.positions()  # from X and U: a load may be evaluated on a state set by hand (wear playback)
         t0 = perf_counter()
-        tip, tail = solver.node_values((self.tip, self.tail), x_all)  # one reduction for both
+        tip, tail = probes.node_values(solver, (self.tip, self.tail), x_all)  # one reduction for both
         comm_s = perf_counter() - t0
         axis = unit_axis(tip, tail)
 
@@ -62,7 +63,7 @@ class TargetLoad:
         arr[:] = 0.0
         self.surf.to_nodes(load.force, arr)
         if self.wear is not None:
-            self.wear.add(load.force, n, v, solver.dt)
+            self.wear.add(load.force, n, v, dt)
         t1 = perf_counter()
         self.buf.scatter_reverse(la.ScatterMode.add)
         comm_s += perf_counter() - t1
