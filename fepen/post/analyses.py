@@ -16,6 +16,7 @@ import numpy as np
 from mpi4py import MPI
 
 from fepen.geometry import tags
+from fepen.geometry.cad import CadBody
 from fepen.geometry.frames import unit_axis
 
 GAUGE_NAMES = ["top", "bottom", "side+", "side-"]
@@ -165,7 +166,8 @@ def nose_profile(solver, model, out: Path) -> dict | None:
     """nose_profile.csv and nose_profile.png: the nose's outer radius against the distance behind the
     original tip, before (the exact shape) and after (the largest radius of the final surface's nodes in
     each PROFILE_BIN, in the frame of the deformed axis: tail node to tip node), over the nose and one
-    calibre behind it (collective; rank 0 writes). Returns {"tip_recession_mm", "max_radius_mm"} on every rank.
+    calibre behind it (collective; rank 0 writes). A CAD body, without an exact outside: the calibre over
+    one calibre before. Returns {"tip_recession_mm", "max_radius_mm"} on every rank.
     """
     from fepen.io import files
 
@@ -185,9 +187,10 @@ def nose_profile(solver, model, out: Path) -> dict | None:
     if comm.rank == 0:
         behind = np.concatenate([p[0] for p in parts])
         radius = np.concatenate([p[1] for p in parts])
-        reach = shape.nose_length + shape.diameter
+        cad = isinstance(shape, CadBody)
+        reach = (0.0 if cad else shape.nose_length) + shape.diameter
         z0 = np.arange(0.0, reach + 1e-12, 0.25e-3)
-        r0 = shape.outer_radius(z0)
+        r0 = np.full(z0.shape, shape.radius) if cad else shape.outer_radius(z0)
         sel = behind <= reach
         k = np.floor(np.maximum(behind[sel], 0.0) / PROFILE_BIN).astype(int)
         r_after = np.zeros(k.max(initial=-1) + 1)

@@ -16,6 +16,7 @@ from mpi4py import MPI
 from fepen.errors import Interrupted, SimulationError
 from fepen.geometry import mesh as fmesh
 from fepen.geometry import revolution, tags
+from fepen.geometry.cad import CadBody
 from fepen.io import files, results, rundir
 from fepen.laws import layers as fl
 from fepen.laws import target as tg
@@ -129,7 +130,7 @@ class RigidRun:
             built, points, mass_properties = default_body(scene)
         else:
             built = setup.projectile(scene)
-        if points == "mesh" or (points is None and built.shape.is_cad):  # a CAD body has only its mesh
+        if points == "mesh" or (points is None and isinstance(built.shape, CadBody)):  # a CAD body: only its mesh
             points, mass_properties, self.cells = mesh_points(scene, comm)
         if points is None:
             points = ring_points(scene, built.shape)
