@@ -1,17 +1,61 @@
 """Projectile bodies from CAD files (STEP or BREP), read and meshed with gmsh's OpenCASCADE kernel
 (docs/projectiles-and-targets.md). The body is taken as drawn: axis along +y, nose toward −y; fepen moves it
 so that its foremost point is at y = 0 and scales it to metres. No exact surface: the target loads the
-mesh's own facets; mass properties come from the mesh.
+mesh's own facets; mass properties come from the mesh. CadBody is such a body where a Shape (the exact
+solid of revolution) would be.
 """
 
 from __future__ import annotations
 
 import hashlib
+from dataclasses import dataclass
 from pathlib import Path
 
 import numpy as np
 
 from fepen.errors import InputError
+
+
+@dataclass(frozen=True)
+class CadBody:
+    """A projectile body read from a CAD file: no meridian, no exact surface or volume (those come from its
+    mesh). Body frame as fepen.geometry.shape: foremost point at y = 0, axis along +y.
+
+    Attributes:
+        diameter, length: calibre (twice the largest distance from the y axis) and length along y (m), as
+            probe measures them.
+        file: the STEP or BREP file (absolute path). scale: metres per file unit.
+        digest: digest(file), so that a changed file is meshed again (mesh-cache key).
+        tip_point, tail_point: the mesh nodes tracked as nose tip and tail centre (end_nodes), set once the
+            body is meshed; () before.
+    """
+
+    diameter: float
+    length: float
+    file: str
+    scale: float = 1.0
+    digest: str = ""
+    tip_point: tuple = ()
+    tail_point: tuple = ()
+
+    def __post_init__(self):
+        for name in ("tip_point", "tail_point"):  # lists from JSON back to tuples
+            object.__setattr__(self, name, tuple(float(v) for v in getattr(self, name)))
+
+    @property
+    def radius(self) -> float:
+        """Half the calibre (m)."""
+        return 0.5 * self.diameter
+
+    @property
+    def tip(self) -> tuple:
+        """The tracked nose-tip point (a mesh node; the origin before meshing)."""
+        return self.tip_point or (0.0, 0.0, 0.0)
+
+    @property
+    def tail(self) -> tuple:
+        """The tracked tail-centre point (a mesh node; (0, length, 0) before meshing)."""
+        return self.tail_point or (0.0, self.length, 0.0)
 
 
 def digest(path: str) -> str:

@@ -16,7 +16,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from fepen.geometry import tetra
+from fepen.geometry import cad, tetra
 from fepen.geometry.shape import Shape
 
 SHELL, CHARGE = 1, 2
@@ -94,7 +94,7 @@ ALTITUDE_GOAL = 0.27
 MAX_SEEDS = 6
 
 
-def build_best(shape: Shape, opts: MeshOptions, charge: bool) -> float:
+def build_best(shape: Shape | cad.CadBody, opts: MeshOptions, charge: bool) -> float:
     """Mesh with :func:`build`, retrying new seeds until the shortest altitude reaches ALTITUDE_GOAL x size.
 
     Returns:
@@ -117,21 +117,19 @@ def build_best(shape: Shape, opts: MeshOptions, charge: bool) -> float:
     return best
 
 
-def build(shape: Shape, opts: MeshOptions, charge: bool, seed: int = 1) -> None:
+def build(shape: Shape | cad.CadBody, opts: MeshOptions, charge: bool, seed: int = 1) -> None:
     """Create and mesh the projectile in the current gmsh model (gmsh must be initialised).
 
     Args:
-        shape: the exact projectile geometry.
+        shape: the exact projectile geometry, or a CadBody (meshed as its file draws it).
         opts: element sizes and optimiser.
         charge: mesh the cavity as a second volume (the explosive) when True; else it is a void.
         seed: gmsh's random seed (different seeds give different, equally valid meshes).
     """
     import gmsh
 
-    if shape.is_cad:
-        from fepen.geometry import cad
-
-        cad.build(shape.cad_file, shape.cad_scale)
+    if isinstance(shape, cad.CadBody):
+        cad.build(shape.file, shape.scale)
         _size_and_mesh(opts, 0.0, seed)
         return
     gmsh.model.add("projectile")

@@ -12,7 +12,7 @@ import logging
 import math
 import os
 import time
-from dataclasses import asdict, dataclass, replace
+from dataclasses import asdict, dataclass, fields, replace
 from pathlib import Path
 
 import numpy as np
@@ -20,6 +20,8 @@ from mpi4py import MPI
 
 from fepen.atomic import replacing, sha256_file
 from fepen.geometry import gmsh_model, tags, tetra
+from fepen.geometry.cad import CadBody
+from fepen.geometry.checks import check
 from fepen.geometry.shape import Shape
 from fepen.version import __version__
 
@@ -45,7 +47,8 @@ class ProjectileMesh:
         mesh: the dolfinx mesh (tetrahedra, SI units, body frame of fepen.geometry.shape).
         cell_tags: SHELL / CHARGE cell markers.
         facet_tags: OUTER / CAVITY facet markers (and CHARGE_FACE, the charge's side of a split wall).
-        shape: the exact geometry meshed (cavity length as corrected on the mesh).
+        shape: the exact geometry meshed (cavity length as corrected on the mesh), or the CadBody (its
+            tracked ends the mesh's nodes).
         charge: whether the cavity is meshed as the charge.
         split: whether the charge has nodes of its own on the cavity wall (frictional contact).
         mesh_s: wall time spent meshing on rank 0 (0 when read from the cache).
@@ -55,7 +58,7 @@ class ProjectileMesh:
     mesh: object
     cell_tags: object
     facet_tags: object
-    shape: Shape
+    shape: Shape | CadBody
     charge: bool
     mesh_s: float
     cached: bool
@@ -74,10 +77,50 @@ def cache_dir() -> Path:
     return Path.home() / ".cache" / "fepen" / "meshes"
 
 
-def _key(shape: Shape, opts: gmsh_model.MeshOptions, charge: bool, mass, rho_s, rho_c) -> str:
+#: the fields of CAD bodies when one Shape type held them too (nose "cad"), at a parametric shape's values:
+#: every cache key and sidecar still holds them (_record), so that a body keeps its key but for the code hash
+_CAD_FIELDS = {"cad_file": "", "cad_scale": 1.0, "cad_digest": "", "tip_point": (), "tail_point": ()}
+
+
+def _record(body: Shape | CadBody) -> dict:
+    """The body as the mesh-cache key and sidecar hold it, in the layout of the one Shape type that held
+    CAD bodies too.
+
+    Args:
+        body: a Shape or a CadBody.
+
+    Returns:
+        A Shape's fields and _CAD_FIELDS; for a CadBody, nose "cad", its calibre, length and CAD fields and
+        every other Shape field at its default.
+    """
+    if isinstance(body, CadBody):
+        rec = {f.name: f.default for f in fields(Shape)}
+        rec.update(diameter=body.diameter, length=body.length, nose="cad", cad_file=body.file,
+                   cad_scale=body.scale, cad_digest=body.digest, tip_point=body.tip_point,
+                   tail_point=body.tail_point)
+        return rec
+    return {**asdict(body), **_CAD_FIELDS}
+
+
+def _from_record(rec: dict) -> Shape | CadBody:
+    """The body of a sidecar's record (_record).
+
+    Args:
+        rec: the record, as read from JSON.
+
+    Returns:
+        A CadBody when its nose is "cad", else a Shape.
+    """
+    if rec.get("nose") == "cad":
+        return CadBody(rec["diameter"], rec["length"], rec["cad_file"], rec["cad_scale"], rec["cad_digest"],
+                       rec["tip_point"], rec["tail_point"])
+    return Shape(**{k: v for k, v in rec.items() if k not in _CAD_FIELDS})
+
+
+def _key(shape: Shape | CadBody, opts: gmsh_model.MeshOptions, charge: bool, mass, rho_s, rho_c) -> str:
     import gmsh
 
-    blob = json.dumps([asdict(shape), asdict(opts), charge, mass, rho_s, rho_c, gmsh.__version__,
+    blob = json.dumps([_record(shape), asdict(opts), charge, mass, rho_s, rho_c, gmsh.__version__,
                        _code_hash()], sort_keys=True)
     return hashlib.sha256(blob.encode()).hexdigest()[:20]
 
@@ -93,7 +136,7 @@ def _entry_stamp() -> dict:
     return {"fepen": __version__, "gmsh": gmsh.__version__, "code": _code_hash()}
 
 
-def _check_entry(msh: Path, side: Path) -> Shape:
+def _check_entry(msh: Path, side: Path) -> Shape | CadBody:
     """The shape a cache entry holds after checking its sidecar, versions and checksum; raises _BadEntry."""
     try:
         meta = json.loads(side.read_text())
@@ -111,10 +154,10 @@ def _check_entry(msh: Path, side: Path) -> Shape:
         raise _BadEntry(f"{msh.name} is missing")
     if sha256_file(msh) != meta["sha256"]:
         raise _BadEntry(f"{msh.name} does not match its SHA-256 (damaged or truncated)")
-    return Shape(**meta["shape"])
+    return _from_record(meta["shape"])
 
 
-def _read_entry(key: str, msh: Path, side: Path) -> Shape | None:
+def _read_entry(key: str, msh: Path, side: Path) -> Shape | CadBody | None:
     """Rank 0: open a checked cache entry in gmsh and return its shape; or, for an entry that fails a check
     or cannot be read, log one warning, delete the entry and return None (the caller meshes afresh)."""
     import gmsh
@@ -143,7 +186,7 @@ def _read_entry(key: str, msh: Path, side: Path) -> Shape | None:
         return None
 
 
-def _write_entry(msh: Path, side: Path, shape: Shape, seconds: float) -> None:
+def _write_entry(msh: Path, side: Path, shape: Shape | CadBody, seconds: float) -> None:
     """Rank 0: write the model in gmsh as a cache entry, the .msh first and its sidecar (shape, SHA-256 of the
     .msh, the versions that wrote it) last, each replaced whole: a sidecar only exists for a complete .msh."""
     import gmsh
@@ -153,7 +196,7 @@ def _write_entry(msh: Path, side: Path, shape: Shape, seconds: float) -> None:
     with replacing(msh, ".msh") as tmp:
         gmsh.write(str(tmp))
         digest = sha256_file(tmp)
-    meta = {"shape": asdict(shape), "mesh_s": seconds, "sha256": digest, **_entry_stamp()}
+    meta = {"shape": _record(shape), "mesh_s": seconds, "sha256": digest, **_entry_stamp()}
     with replacing(side) as tmp:
         tmp.write_text(json.dumps(meta))
 
@@ -165,7 +208,7 @@ def _gmsh_mass(rho_s: float, rho_c: float | None) -> float:
     return m
 
 
-def _mesh_on_root(shape: Shape, opts, charge: bool, mass, rho_s, rho_c, use_cache: bool):
+def _mesh_on_root(shape: Shape | CadBody, opts, charge: bool, mass, rho_s, rho_c, use_cache: bool):
     """Rank 0: leave the meshed model in gmsh. Returns (final shape, meshing seconds, from cache)."""
     import gmsh
 
@@ -186,7 +229,7 @@ def _mesh_on_root(shape: Shape, opts, charge: bool, mass, rho_s, rho_c, use_cach
     for _ in range(5):
         gmsh.clear()
         gmsh_model.build_best(current, opts, charge)
-        if mass is None or not current.has_cavity:
+        if mass is None or isinstance(current, CadBody) or not current.has_cavity:
             break
         error = _gmsh_mass(rho_s, rho_c) - mass
         if abs(error) <= MASS_TOLERANCE:
@@ -194,8 +237,8 @@ def _mesh_on_root(shape: Shape, opts, charge: bool, mass, rho_s, rho_c, use_cach
         r = 0.5 * current.cavity_diameter
         step = error / ((rho_s - (rho_c or 0.0)) * math.pi * r * r)
         current = replace(current, cavity_length=current.cavity_length + step)
-        current.check()
-    if current.is_cad:  # the tracked ends: mesh nodes
+        check(current)
+    if isinstance(current, CadBody):  # the tracked ends: mesh nodes
         from fepen.geometry import cad
 
         tip, tail = cad.end_nodes()
@@ -216,13 +259,14 @@ def _mesh_on_root(shape: Shape, opts, charge: bool, mass, rho_s, rho_c, use_cach
     return current, seconds, False
 
 
-def create(shape: Shape, opts: gmsh_model.MeshOptions, comm: MPI.Comm = MPI.COMM_WORLD, charge: bool = False,
+def create(shape: Shape | CadBody, opts: gmsh_model.MeshOptions, comm: MPI.Comm = MPI.COMM_WORLD, charge: bool = False,
            mass: float | None = None, shell_density: float = 7850.0, charge_density: float | None = None,
            split: bool = False, use_cache: bool = True) -> ProjectileMesh:
     """Build (or read from the cache) and distribute a projectile mesh.
 
     Args:
-        shape: the checked exact geometry (its cavity length a first guess when ``mass`` is given).
+        shape: the checked exact geometry (its cavity length a first guess when ``mass`` is given), or a
+            CadBody.
         opts: element sizes and optimiser.
         comm: the communicator to distribute over; gmsh runs on its rank 0.
         charge: mesh the cavity as the charge (volume tag CHARGE).
@@ -450,10 +494,8 @@ def metrics(pm: ProjectileMesh, density: dict, speed: dict, safety: float, nomin
 
     shell_v = total(vol[tag == tags.SHELL])
     charge_v = total(vol[tag == tags.CHARGE])
-    exact_shell = pm.shape.shell_volume()
-    exact_total = pm.shape.outer_volume() if pm.charge else exact_shell
-    if not math.isfinite(exact_total):  # a CAD body: no exact volume
-        exact_total = None
+    cad = isinstance(pm.shape, CadBody)  # no exact volume, no cavity sized
+    exact_total = None if cad else pm.shape.outer_volume() if pm.charge else pm.shape.shell_volume()
     volume = shell_v + charge_v
     h = nominal_size
     shortest = smallest(alt)
@@ -471,7 +513,7 @@ def metrics(pm: ProjectileMesh, density: dict, speed: dict, safety: float, nomin
         "nominal_size_m": h,
         "altitude_over_size": shortest / h,
         "stable_dt_s": safety * smallest(alt / c),
-        "cavity_length_m": pm.shape.cavity_length,
+        "cavity_length_m": 0.0 if cad else pm.shape.cavity_length,
         "mesh_s": pm.mesh_s,
         "from_cache": pm.cached,
         "ranks": comm.size,

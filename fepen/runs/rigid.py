@@ -16,6 +16,7 @@ from mpi4py import MPI
 from fepen.errors import Interrupted
 from fepen.geometry import mesh as fmesh
 from fepen.geometry import revolution, tags
+from fepen.geometry.cad import CadBody
 from fepen.laws import energy, wear
 from fepen.laws import target as tg
 from fepen.laws.rigid_body import (
@@ -115,9 +116,9 @@ class RigidRun(Run):
         sh = shot.of(shot_)
         super().__init__(sh, out, comm)
         self.cells = 0  # no volume mesh unless asked for
-        if points is None and mass_properties is None and not sh.built.shape.is_cad:
+        if points is None and mass_properties is None and not isinstance(sh.built.shape, CadBody):
             points, mass_properties = default_body(sh)
-        if points == "mesh" or (points is None and sh.built.shape.is_cad):  # a CAD body has only its mesh
+        if points == "mesh" or (points is None and isinstance(sh.built.shape, CadBody)):  # a CAD body: only its mesh
             points, mass_properties, self.cells = mesh_points(sh, comm)
         if points is None:
             points = ring_points(sh.built.shape, sh.mesh.rigid_panel)

@@ -15,7 +15,10 @@ from fepen.data import CONSTANTS, TARGETS
 from fepen.errors import InputError
 from fepen.geometry import gmsh_model, profile, tags, tetra
 from fepen.geometry import mesh as fmesh
-from fepen.geometry.shape import Built, Shape, reach_mass
+from fepen.geometry.cad import CadBody
+from fepen.geometry.checks import check
+from fepen.geometry.mass_rule import Built, reach_mass
+from fepen.geometry.shape import Shape
 from fepen.laws import layers as fl
 from fepen.laws import target as tg
 from fepen.scene import SCHEMA
@@ -141,15 +144,15 @@ def _cad_projectile(scene) -> Built:
     if not (0.0 < D <= 1.0 and 0.0 < L <= 10.0):
         raise InputError("projectile.cad_scale", f"the body is {D:g} m wide and {L:g} m long after scaling by "
                                                  f"{scale:g}: give the scale that makes its lengths metres")
-    shape = Shape(D, L, "cad", cad_file=path, cad_scale=scale, cad_digest=cad.digest(path))
-    return Built(shape, scene.projectile.material.density)
+    body = CadBody(D, L, path, scale, cad.digest(path))
+    return Built(body, scene.projectile.material.density)
 
 
 def _projectile(scene) -> Built:
     if scene.get("projectile.cad"):
         return _cad_projectile(scene)
     """The checked exact projectile built to projectile.mass by the mass-reaching rule
-    (fepen.geometry.shape.reach_mass): the given cavity sized, else reduced or dropped, with one line in
+    (fepen.geometry.mass_rule.reach_mass): the given cavity sized, else reduced or dropped, with one line in
     Built.note saying what was chosen. A cavity the user gave explicitly is only sized (InputError if the
     mass is out of its reach). InputError on impossible geometry, in well under a second."""
     p = scene.projectile
@@ -186,9 +189,9 @@ def _projectile(scene) -> Built:
         cavity_table=() if solid else table, **geometry,
     )
     if mass is None or explicit or inner:
-        shape.check()
+        check(shape)
     else:  # the outside only: a default cavity that does not fit is left to the mass rule
-        replace(shape, cavity_diameter=0.0, cavity_table=()).check()
+        check(replace(shape, cavity_diameter=0.0, cavity_table=()))
         _check_base(scene, shape)
     if mass is None or (solid and explicit) or inner:
         return Built(shape, p.material.density)
@@ -208,7 +211,7 @@ def _check_base(scene, shape: Shape) -> None:
 def thin_target_note(scene, built: Built) -> str | None:
     """A line when the target, or one of its layers, is thinner than the nose is long: the nose is through
     before its shoulder enters, and the cavity-expansion law is a law of thick targets (docs/theory.md §16)."""
-    nose = built.shape.nose_length
+    nose = 0.0 if isinstance(built.shape, CadBody) else built.shape.nose_length  # a CAD body's is unknown
     layers = scene.get("target.layers")
     if scene.target.kind != "concrete" or not nose:
         return None
@@ -249,8 +252,8 @@ def announce(scene, comm, built: Built | None = None) -> Built:
     return built
 
 
-def projectile_shape(scene) -> Shape:
-    """The exact geometry of projectile(scene)."""
+def projectile_shape(scene) -> Shape | CadBody:
+    """The exact geometry of projectile(scene) (a CadBody for projectile.cad)."""
     return projectile(scene).shape
 
 

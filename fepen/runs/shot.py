@@ -12,7 +12,8 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
-from fepen.geometry.shape import Built
+from fepen.geometry.cad import CadBody
+from fepen.geometry.mass_rule import Built
 from fepen.laws import target as tg
 from fepen.laws import wear
 from fepen.runs import setup
@@ -125,7 +126,10 @@ class Shot:
         if self.law is None or self.law.crater != "linear":
             return None
         shape = self.built.shape
-        factor = None if shape.nose == "ogive" and not shape.meplat_diameter else shape.nose_factor()
+        if isinstance(shape, CadBody):  # N* = 0, as fepen always took it: the N* of a CAD body's (empty) meridian
+            factor = 0.0
+        else:
+            factor = None if shape.nose == "ogive" and not shape.meplat_diameter else shape.nose_factor()
         return tg.ForrestalCrater(self.law, mass, self.speed, self.crh, factor)
 
     def densities(self) -> dict[int, float]:

@@ -11,7 +11,8 @@ import numba
 import numpy as np
 from mpi4py import MPI
 
-from fepen.geometry import tags
+from fepen.geometry import projection, tags
+from fepen.geometry.cad import CadBody
 
 SUBDIVISION = 4  # facet patch areas: 4 x 4 sub-triangles projected on the exact surface
 
@@ -75,7 +76,7 @@ def _patch_areas(shape, p: np.ndarray, patch: np.ndarray, m: int = SUBDIVISION) 
     lam = np.array([[1 - u - v, u, v] for u, v in pts])
     q = np.einsum("sk,fkd->fsd", lam, p)  # (f, s, 3)
     nf, ns = q.shape[:2]
-    qp = shape.project(q.reshape(-1, 3), np.repeat(patch, ns)).reshape(nf, ns, 3)
+    qp = projection.project(shape, q.reshape(-1, 3), np.repeat(patch, ns)).reshape(nf, ns, 3)
     t = np.array(tris)
     a = qp[:, t[:, 0]]
     return 0.5 * np.linalg.norm(np.cross(qp[:, t[:, 1]] - a, qp[:, t[:, 2]] - a), axis=2).sum(axis=1)
@@ -288,12 +289,13 @@ def outer_surface(V, facet_tags, shape, tag: int = tags.OUTER) -> Surface:
     Args:
         V: the P1 vector function space of the solver (its block indices are the nodes).
         facet_tags: the mesh's facet MeshTags.
-        shape: the exact fepen.shape.Shape the mesh was built from (body frame = reference frame).
+        shape: the exact fepen.geometry.shape.Shape the mesh was built from (body frame = reference frame),
+            or its CadBody.
     """
     imap = V.dofmap.index_map
     X = V.tabulate_dof_coordinates()[: imap.size_local + imap.num_ghosts]
     tri, cells = oriented_facets(V, facet_tags, tag, with_cells=True)
-    if shape.is_cad:  # no exact surface: the facets' areas, their normals smoothed across smooth edges
+    if isinstance(shape, CadBody):  # no exact surface: the facets' areas, their normals smoothed across smooth edges
         empty = np.zeros(0, dtype=np.int64)
         surf = Surface(np.zeros((0, 3), dtype=np.int64), np.zeros((0, 3)), np.zeros(0), np.zeros(0),
                        np.zeros((0, 3)), np.zeros((0, 3)), np.zeros(0), np.zeros(0), np.zeros(0), empty)
@@ -305,9 +307,9 @@ def outer_surface(V, facet_tags, shape, tag: int = tags.OUTER) -> Surface:
     flat = np.linalg.norm(av, axis=1)
     nflat = av / np.maximum(flat, 1e-300)[:, None]
     centroid = X[tri].mean(axis=1)
-    patch = shape.classify(X[tri], nflat) if len(tri) else np.zeros(0, dtype=np.int64)  # meridian segments
-    P = shape.project(centroid, patch)
-    N, radius, Rm, sphi = shape.surface_info(P, patch)
+    patch = projection.classify(shape, X[tri], nflat) if len(tri) else np.zeros(0, dtype=np.int64)  # meridian segments
+    P = projection.project(shape, centroid, patch)
+    N, radius, Rm, sphi = projection.surface_info(shape, P, patch)
     bad = np.isnan(N[:, 0])  # should not happen for centroids; fall back to the flat normal
     N[bad] = nflat[bad]
     area = _patch_areas(shape, X[tri], patch) if len(tri) else np.zeros(0)

@@ -11,6 +11,7 @@ from scipy import integrate
 from fepen import scene
 from fepen.errors import InputError
 from fepen.geometry import revolution
+from fepen.geometry.checks import check
 from fepen.geometry.shape import Shape
 from fepen.laws import target as tg
 from fepen.runs import rigid, setup
@@ -76,7 +77,7 @@ def quad_props(r, breaks, rho=7850.0):
 @pytest.mark.parametrize("name", list(families()))
 def test_mass_centre_and_inertia_of_each_family_against_quadrature(name):
     shape, r, ln = families()[name]
-    shape.check()
+    check(shape)
     breaks = sorted({0.0, ln, L, L - shape.boattail_length, L})
     m, yc, i_ax, i_tr = quad_props(r, breaks)
     mm, c, inertia = revolution.mass_properties(shape, 7850.0)

@@ -6,7 +6,9 @@ import pytest
 
 from fepen import scene
 from fepen.errors import InputError
-from fepen.geometry.shape import Shape, reach_mass
+from fepen.geometry.checks import check, front_limit, max_cavity_length
+from fepen.geometry.mass_rule import reach_mass
+from fepen.geometry.shape import Shape
 from fepen.runs import setup
 
 
@@ -44,7 +46,7 @@ def test_default_projectile_reaches_the_papers_mass():
     (z0, z1, r0), (z2, z3, r1) = sh.cavity_sections()
     assert z1 == pytest.approx(z2) and r0 < r1  # the wall-thickness step
     assert z3 == pytest.approx(0.144 - 0.015)
-    assert z0 > sh.front_limit(r0) - 1e-12  # the cavity keeps the minimum wall
+    assert z0 > front_limit(sh, r0) - 1e-12  # the cavity keeps the minimum wall
 
 
 def test_charge_filled_cavity_is_sized_on_total_mass():
@@ -91,7 +93,7 @@ def test_mass_rule_builds_any_projectile_to_its_mass(D, L, crh, frac):
     sc = scene.load(None, [f"projectile.diameter={D}", f"projectile.length={L}", f"projectile.crh={crh}",
                            f"projectile.mass={mass}"])
     built = setup.projectile(sc)
-    built.shape.check()
+    check(built.shape)
     got = built.shape.mass(built.shell_density)
     assert got == pytest.approx(mass, rel=5e-3)
     default = Shape(D, L, "ogive", crh, 0.012, 0.0, 0.008, 0.020, 0.015)
@@ -101,7 +103,7 @@ def test_mass_rule_builds_any_projectile_to_its_mass(D, L, crh, frac):
         assert not built.shape.has_cavity and "density adjusted" in built.note
         assert abs(built.shell_density / rho - 1.0) <= 0.03  # only near-solid masses come here
     if built.shape.has_cavity:  # the thinnest wall is kept everywhere
-        assert built.shape.cavity_length <= built.shape.max_cavity_length() * (1 + 1e-9)
+        assert built.shape.cavity_length <= max_cavity_length(built.shape) * (1 + 1e-9)
 
 
 def test_mass_rule_prefers_the_given_cavity():
