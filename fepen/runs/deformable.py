@@ -176,7 +176,7 @@ class DeformableRun(Run):
         e = diagnostics.energies(s)
         heat = self.comm.allreduce(m.recession.heat_total, op=MPI.SUM) if m.recession is not None else 0.0
         return Removal(s.initial_mass - s.total_mass, heat, m.erosion.count if m.erosion is not None else 0,
-                       e.removed_kinetic, e.removed_internal)
+                       e.removed_kinetic, e.removed_internal, remaining_kg=s.total_mass)
 
     def finish_loop(self) -> None:
         self.record()

@@ -212,8 +212,10 @@ class RigidRun(Run):
         return Snapshot(tip, tail, s.V, self.F, body.mass, en, self.loaded, self.dt, 0.0, self.area, rear)
 
     def removal(self) -> Removal:
-        w = self.wear
-        return Removal() if w is None else Removal(w.mass_lost, w.heat, 0, w.kinetic_removed)
+        w, length = self.wear, self.shape.length * 1e3  # a rigid body keeps its length
+        if w is None:
+            return Removal(remaining_kg=self.body.mass, length_mm=length)
+        return Removal(w.mass_lost, w.heat, 0, w.kinetic_removed, remaining_kg=self.body.mass, length_mm=length)
 
     def interrupt(self, name: str) -> None:
         raise Interrupted(f"{name} at step {self.step_count}, t = {self.t * 1e6:.3f} us: a rigid run keeps no "

@@ -64,6 +64,8 @@ class Removal:
     eroded_cells: int = 0
     kinetic_J: float = 0.0
     elastic_J: float = 0.0
+    remaining_kg: float | None = None  #: the mass now, as the body tracks it (None: initial minus mass_kg)
+    length_mm: float | None = None  #: the length now (None: the last history row's)
 
 
 class Run:
@@ -240,9 +242,11 @@ class Run:
         r = self.removal()
         mass0 = self.initial_mass
         length0 = self.shot.built.shape.length * 1e3
-        length = self.rows[-1][results.COL["length_mm"]] if self.rows else length0
+        length = r.length_mm if r.length_mm is not None else (
+            self.rows[-1][results.COL["length_mm"]] if self.rows else length0)
         return {"mass_loss_kg": r.mass_kg, "mass_loss_percent": 100.0 * r.mass_kg / mass0,
-                "remaining_mass_kg": mass0 - r.mass_kg, "length_change_mm": length - length0,
+                "remaining_mass_kg": r.remaining_kg if r.remaining_kg is not None else mass0 - r.mass_kg,
+                "length_change_mm": length - length0,
                 "eroded_cells": r.eroded_cells,
                 "crossings": self.crossings.state() if self.crossings is not None else None,
                 "wear_heat_J": r.heat_J, "removed_kinetic_J": r.kinetic_J, "removed_elastic_J": r.elastic_J}
