@@ -121,9 +121,7 @@ def run(scene, out=None, comm=None, progress: bool = False, force: bool = False)
         SimulationError: the simulation could not go on (what, where, when); what it wrote is kept.
         MachineFault: disk full, permission, a signal (fepen.errors); what it wrote is kept and resumable.
     """
-    from fepen import scene as fscene
-    from fepen.io import files, rundir
-    from fepen.runs import run_scene, setup
+    from fepen.runs import run_in_directory, setup
 
     comm = _comm(comm)
     sc = scene if isinstance(scene, Scene) else Scene(scene)
@@ -132,32 +130,14 @@ def run(scene, out=None, comm=None, progress: bool = False, force: bool = False)
     if out is None:
         out = comm.bcast(tempfile.mkdtemp(prefix="fepen-") if comm.rank == 0 else None, root=0)
     out = Path(out)
-    with rundir.RunDirectory(out, comm, "force" if force else "new"):
-        files.agree(comm, "scene.toml", lambda: files.write_text(out / "scene.toml", fscene.to_toml(sc), comm))
-        try:
-            run_scene(sc, out, comm, progress=progress)
-        finally:
-            _figure(out, sc, comm)
+    run_in_directory(sc, out, comm, "force" if force else "new", progress=progress)
     return load(out)
-
-
-def _figure(out: Path, sc, comm) -> None:
-    """history.png of whatever history.csv holds (a full disk leaves the last one)."""
-    from fepen.post import figures
-
-    if (out / "history.csv").exists():
-        try:
-            figures.history_figure(out, sc, comm)
-        except OSError:
-            pass
-    comm.barrier()
 
 
 def resume(results_dir, comm=None, progress: bool = False) -> Result:
     """Continue a killed or interrupted deformable run from its last checkpoint (same number of ranks), or run
     a stopped rigid run again; its Result."""
-    from fepen.io import rundir
-    from fepen.runs import checkpoint, run_scene
+    from fepen.runs import checkpoint, run_in_directory
 
     comm = _comm(comm)
     out = Path(results_dir)
@@ -166,9 +146,6 @@ def resume(results_dir, comm=None, progress: bool = False) -> Result:
     sc = Scene(out / "scene.toml")
     rigid = sc.effects.fidelity == "rigid"  # seconds to run: a stopped rigid run runs again from the start
     state = None if rigid else checkpoint.read_state(out, comm)
-    with rundir.RunDirectory(out, comm, "resume"):
-        try:
-            run_scene(sc, out, comm, progress=progress, resume=state)
-        finally:
-            _figure(out, sc, comm)
+    run_in_directory(sc, out, comm, "resume", progress=progress, resume=state)
     return load(out)
+
