@@ -4,8 +4,8 @@ Only the projectile is meshed (FEniCSx/dolfinx 0.5); the concrete acts through a
 resistance law applied node by node on the deformed projectile surface.
 
 The API (docs/api.md): ``fepen.Scene``, ``fepen.run(scene, out=None, comm=None) -> Result``,
-``fepen.load(results_dir) -> Result``, ``fepen.resume(results_dir)``. The layers, bottom up: ``laws``
-(plain arrays), ``geometry``, ``solver`` (dolfinx), ``io``, ``post``, ``runs``, ``studies``.
+``fepen.load(results_dir) -> Result``, ``fepen.resume(results_dir)``, ``fepen.mesh(scene, out) -> dict``. The
+layers, bottom up: ``laws`` (plain arrays), ``geometry``, ``solver`` (dolfinx), ``io``, ``post``, ``runs``, ``studies``.
 """
 
 import os
@@ -14,8 +14,8 @@ from pathlib import Path
 
 from fepen.version import __version__
 
-__all__ = ["Scene", "Result", "run", "load", "resume", "InputError", "SimulationError", "MachineFault", "Interrupted",
-           "__version__"]
+__all__ = ["Scene", "Result", "run", "load", "resume", "mesh", "InputError", "SimulationError", "MachineFault",
+           "Interrupted", "__version__"]
 
 # numba highlights its error messages with colorama when colorama is installed (Debian's paraview brings
 # it): colorama then writes an ANSI reset to a terminal's stdout at exit, which under mpirun (whose ranks'
@@ -47,7 +47,7 @@ _numba_cache_per_rank()
 
 def __getattr__(name):
     """The API, imported on first use: ``import fepen`` stays cheap (no dolfinx, no MPI)."""
-    if name in ("Scene", "Result", "run", "load", "resume"):
+    if name in ("Scene", "Result", "run", "load", "resume", "mesh"):
         from fepen import api
 
         return getattr(api, name)

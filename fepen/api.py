@@ -4,6 +4,7 @@
     result = fepen.run(scene, out="results/C3-rigid")
     result.summary["Hy_mm"], result.history["nose_y_mm"][-1]
     again = fepen.load("results/C3-rigid")
+    info = fepen.mesh(scene, "results/C3-mesh")      # the mesh only, as ``fepen mesh``: info["cells"]
 
 Under ``mpirun -n N python script.py`` every rank calls ``fepen.run`` with the same arguments (or a
 communicator), as the command does.
@@ -21,7 +22,7 @@ import numpy as np
 from fepen.errors import InputError
 from fepen.scene import Scene
 
-__all__ = ["Scene", "Result", "run", "load", "resume"]
+__all__ = ["Scene", "Result", "run", "load", "resume", "mesh"]
 
 
 @dataclass
@@ -121,9 +122,7 @@ def run(scene, out=None, comm=None, progress: bool = False, force: bool = False)
         SimulationError: the simulation could not go on (what, where, when); what it wrote is kept.
         MachineFault: disk full, permission, a signal (fepen.errors); what it wrote is kept and resumable.
     """
-    from fepen import scene as fscene
-    from fepen.io import files, rundir
-    from fepen.runs import resolve, run_scene, setup
+    from fepen.runs import resolve, run_in_directory, setup
 
     comm = _comm(comm)
     sc = scene if isinstance(scene, Scene) else Scene(scene)
@@ -132,32 +131,14 @@ def run(scene, out=None, comm=None, progress: bool = False, force: bool = False)
     if out is None:
         out = comm.bcast(tempfile.mkdtemp(prefix="fepen-") if comm.rank == 0 else None, root=0)
     out = Path(out)
-    with rundir.RunDirectory(out, comm, "force" if force else "new"):
-        files.agree(comm, "scene.toml", lambda: files.write_text(out / "scene.toml", fscene.to_toml(sc), comm))
-        try:
-            run_scene(sc, out, comm, progress=progress, sh=sh)
-        finally:
-            _figure(out, sc, comm)
+    run_in_directory(sc, out, comm, "force" if force else "new", progress=progress, sh=sh)
     return load(out)
-
-
-def _figure(out: Path, sc, comm) -> None:
-    """history.png of whatever history.csv holds (a full disk leaves the last one)."""
-    from fepen.post import figures
-
-    if (out / "history.csv").exists():
-        try:
-            figures.history_figure(out, sc, comm)
-        except OSError:
-            pass
-    comm.barrier()
 
 
 def resume(results_dir, comm=None, progress: bool = False) -> Result:
     """Continue a killed or interrupted deformable run from its last checkpoint (same number of ranks), or run
     a stopped rigid run again; its Result."""
-    from fepen.io import rundir
-    from fepen.runs import checkpoint, run_scene
+    from fepen.runs import checkpoint, run_in_directory
 
     comm = _comm(comm)
     out = Path(results_dir)
@@ -166,9 +147,73 @@ def resume(results_dir, comm=None, progress: bool = False) -> Result:
     sc = Scene(out / "scene.toml")
     rigid = sc.effects.fidelity == "rigid"  # seconds to run: a stopped rigid run runs again from the start
     state = None if rigid else checkpoint.read_state(out, comm)
-    with rundir.RunDirectory(out, comm, "resume"):
-        try:
-            run_scene(sc, out, comm, progress=progress, resume=state)
-        finally:
-            _figure(out, sc, comm)
+    run_in_directory(sc, out, comm, "resume", progress=progress, resume=state)
     return load(out)
+
+
+def mesh(scene, out, comm=None, force: bool = False) -> dict:
+    """Mesh a scene's projectile without running it, as ``fepen mesh`` does; the mesh's metrics.
+
+    Writes into ``out``: mesh.json (the metrics and the versions), scene.toml, mesh.xdmf with mesh.h5 (the
+    mesh, its cell tags and facet tags), mesh_facets.xdmf (fepen.io.fields.mesh_index: one dataset per file,
+    as every reader wants it) and mesh.png (a half-section).
+
+    Args:
+        scene: a Scene, or anything Scene() takes.
+        out: the results directory (created).
+        comm: the MPI communicator; None: COMM_WORLD.
+        force: write into a directory that holds a run's results (its scene.toml becomes the mesh's); without
+            it, InputError before anything is meshed or written.
+
+    Returns:
+        The content of mesh.json: cells, nodes, mass_kg, volume_m3, min_quality, shortest_altitude_m,
+        stable_dt_s, altitude_over_size, ..., versions.
+    """
+    from fepen import scene as fscene
+    from fepen.io import files
+    from fepen.post import figures
+    from fepen.runs import setup
+
+    comm = _comm(comm)
+    sc = scene if isinstance(scene, Scene) else Scene(scene)
+    out = Path(out)
+    if not force:
+        _refuse_run_directory(out, comm)
+    setup.announce(sc, comm)  # geometry errors before anything is written
+    pm = setup.mesh(sc, comm)
+    info = setup.mesh_metrics(pm, sc)
+    files.prepare(out, comm)
+    info["versions"] = files.versions()
+    files.write_json(out / "mesh.json", info, comm)
+    files.write_text(out / "scene.toml", fscene.to_toml(sc), comm)
+    _write_mesh(pm, out, comm)
+    figures.mesh_picture(pm, out / "mesh.png",
+                         f"{info['cells']} tets, h = {1e3 * sc.mesh.size:g} mm, {1e3 * info['mass_kg']:.2f} g")
+    return info
+
+
+def _refuse_run_directory(out: Path, comm) -> None:
+    """InputError on every rank when ``out`` holds a run's results (fepen.io.rundir.MARKERS)."""
+    from fepen.io import rundir
+
+    found = [m for m in rundir.MARKERS if (out / m).exists()] if comm.rank == 0 else None
+    found = comm.bcast(found, root=0) if comm.size > 1 else found
+    if found:
+        raise InputError("out", f"{out} holds a run's results ({', '.join(found)}): the mesh's scene.toml would "
+                                "replace the run's; name another directory, or give force=True")
+
+
+def _write_mesh(pm, out: Path, comm) -> None:
+    """mesh.xdmf (with mesh.h5): the mesh, its cell tags and facet tags; mesh_facets.xdmf beside it."""
+    from dolfinx.io import XDMFFile
+
+    from fepen.io.fields import mesh_index
+
+    with XDMFFile(comm, str(out / "mesh.xdmf"), "w") as xdmf:
+        xdmf.write_mesh(pm.mesh)
+        pm.mesh.topology.create_connectivity(2, 3)
+        xdmf.write_meshtags(pm.cell_tags)
+        xdmf.write_meshtags(pm.facet_tags)
+    if comm.rank == 0:  # one dataset per file, as every reader wants it
+        mesh_index(out / "mesh.h5", out / "mesh.xdmf", out / "mesh_facets.xdmf")
+    comm.barrier()

@@ -43,12 +43,21 @@ OUTPUT_NAMES = ("summary.json", "run.json", "fepen.log", "scene.toml", "history.
 
 _log_path: Path | None = None
 _transcript: list[str] = []
-#: the command line being run (fepen.cli.main sets it; else this process's)
-command_line: list[str] | None = None
+#: the command line being run, recorded in run.json and fepen.log (set by begin_command; None: this process's)
+_command_line: list[str] | None = None
+
+
+def begin_command(command: list[str] | None) -> None:
+    """A new command (fepen.cli.main calls it first): the command line the run directories it claims record
+    (None: this process's ``sys.argv``), no log yet, nothing kept. The one way to set the recorded command
+    line besides RunDirectory's own ``command`` argument."""
+    global _command_line
+    _command_line = None if command is None else list(command)
+    forget()
 
 
 def forget() -> None:
-    """A new command: no log yet, nothing kept."""
+    """No log yet, nothing kept."""
     global _log_path
     _log_path = None
     _transcript.clear()
@@ -138,13 +147,13 @@ class RunDirectory:
         out: the results directory.
         comm: the run's communicator.
         mode: "new" (refuse a directory holding results), "force" (remove them first) or "resume".
-        command: the command line to record (default: this process's).
+        command: the command line to record (default: the one begin_command set, else this process's).
     """
 
     def __init__(self, out, comm=MPI.COMM_WORLD, mode: str = "new", command: list[str] | None = None):
         self.out, self.comm, self.mode = Path(out), comm, mode
         if command is None:
-            command = command_line or [Path(sys.argv[0]).name, *sys.argv[1:]]
+            command = _command_line or [Path(sys.argv[0]).name, *sys.argv[1:]]
         self.command = list(command)
         self.record: dict = {}
 

@@ -63,7 +63,7 @@ def mesh_picture(pm: fmesh.ProjectileMesh, path: Path, title: str = "") -> None:
     plotter.close()
 
 
-def history_figure(out: Path, scene=None, comm=MPI.COMM_WORLD) -> None:
+def history_figure(out: Path, experiment: str | None = None, comm=MPI.COMM_WORLD) -> None:
     """history.png: force, trajectory (with the experiment's end points when a shot is named), energies."""
     if comm.rank != 0:
         return
@@ -80,7 +80,7 @@ def history_figure(out: Path, scene=None, comm=MPI.COMM_WORLD) -> None:
     ax[0].set(xlabel="t (us)", ylabel="deceleration (1000 g)")
     ax[1].plot(data["nose_x_mm"], data["nose_y_mm"], label="nose tip")
     ax[1].plot(data["tail_x_mm"], data["tail_y_mm"], label="tail centre")
-    name = scene.get("impact.shot") if scene is not None else None
+    name = experiment
     if name:
         s = shot(name)
         ax[1].plot([s.Hx_mm], [s.Hy_mm], "o", color="C0", label=f"{name} nose, test")

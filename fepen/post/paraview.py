@@ -11,7 +11,7 @@ from __future__ import annotations
 
 from pathlib import Path
 
-__all__ = ["VIEW_SCRIPT", "write_view_script", "plot"]
+__all__ = ["VIEW_SCRIPT", "write_view_script", "plot", "show", "render_png"]
 
 VIEW_SCRIPT = '''"""This run in ParaView: the projectile warped by its displacement, coloured by von Mises stress, the
 target face (y = 0) drawn, the time controls on the output times (written by fepen).
@@ -100,6 +100,53 @@ def write_view_script(out: Path) -> Path:
     with replacing(path) as tmp:
         tmp.write_text(VIEW_SCRIPT.replace("{here!r}", repr(str(Path(out).resolve()))))
     return path
+
+
+def show(out: Path, field: str = "von_mises_Pa", time: float | None = None, png: str | Path | None = None) -> None:
+    """``fepen view``: the run in ``out`` in ParaView on its view.py (written first for a run from before
+    view.py), or by pyvista (plot) where ParaView is not installed.
+
+    Args:
+        out: results directory with fields.xdmf. field: the field to colour by. time: output time (s); None:
+            the last. png: render one picture there, offscreen (pvpython, render_png), instead of opening the
+            GUI.
+    """
+    import shutil
+    import subprocess
+
+    out = Path(out)
+    script = out / "view.py"
+    if not script.is_file():  # a run from before view.py was written
+        write_view_script(out)
+    if png and shutil.which("pvpython"):
+        render_png(script, png, [*(["--time", repr(time)] if time is not None else []), "--field", field])
+    elif not png and shutil.which("paraview"):
+        subprocess.run(["paraview", f"--script={script}"], check=False)
+    else:
+        plot(out, field, time, png)
+
+
+def render_png(script: Path, png: str | Path, options=(), tries: int = 3) -> None:
+    """pvpython on a run's view.py, offscreen, into ``png``; under xvfb-run (a virtual screen of 24-bit colour
+    on a free display number) where it is installed. Two xvfb-run started at once may race for one display:
+    up to ``tries`` attempts.
+
+    Raises:
+        SimulationError: when ParaView wrote no picture (the end of its stderr).
+    """
+    import shutil
+    import subprocess
+
+    from fepen.errors import SimulationError
+
+    cmd = ["pvpython", "--force-offscreen-rendering", str(script), "--png", str(Path(png).resolve()), *options]
+    if shutil.which("xvfb-run"):
+        cmd = ["xvfb-run", "-a", "-s", "-screen 0 1280x1024x24", *cmd]
+    for _ in range(tries):
+        r = subprocess.run(cmd, capture_output=True, text=True)
+        if r.returncode == 0 and Path(png).is_file():
+            return
+    raise SimulationError(f"ParaView could not render {png}: {r.stderr.strip()[-400:]}")
 
 
 def plot(out: Path, field: str = "von_mises_Pa", time: float | None = None, png: str | Path | None = None):

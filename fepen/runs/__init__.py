@@ -59,3 +59,41 @@ def run_scene(scene, out, comm=MPI.COMM_WORLD, progress: bool = False, resume: d
 
     end = expected_end(scene, sh) if progress and comm.rank == 0 else None
     return DeformableRun(sh, out, comm, end, resume).run()
+
+
+
+def run_in_directory(scene, out, comm=MPI.COMM_WORLD, mode: str = "new", progress: bool = False,
+                     resume: dict | None = None, sh: Shot | None = None) -> dict:
+    """Run a scene into its results directory as ``fepen run`` does (fepen.api.run and resume, the studies'
+    shots): claim OUT (fepen.io.rundir.RunDirectory: lock, run.json, fepen.log), write scene.toml unless
+    resuming, run_scene, and draw history.png of whatever history.csv holds, even after a stop.
+
+    Args:
+        scene: a resolved Scene, checked by the caller (setup.check_supported, setup.announce) before OUT is
+            claimed. out: the results directory. comm: the communicator of the run.
+        mode: "new" (refuse a directory holding another run's results), "force" (clear them first) or "resume".
+        progress, resume, sh: as for run_scene.
+
+    Returns:
+        The summary (the content of summary.json).
+    """
+    from pathlib import Path
+
+    from fepen import scene as fscene
+    from fepen.io import files, rundir
+    from fepen.post import figures
+
+    out = Path(out)
+    sh = sh or resolve(scene)
+    with rundir.RunDirectory(out, comm, mode):
+        if mode != "resume":
+            files.agree(comm, "scene.toml", lambda: files.write_text(out / "scene.toml", fscene.to_toml(scene), comm))
+        try:
+            return run_scene(scene, out, comm, progress=progress, resume=resume, sh=sh)
+        finally:
+            if (out / "history.csv").exists():  # a full disk leaves the last one
+                try:
+                    figures.history_figure(out, sh.experiment, comm)
+                except OSError:
+                    pass
+            comm.barrier()

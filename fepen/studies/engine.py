@@ -25,7 +25,7 @@ from mpi4py import MPI
 
 from fepen.errors import InputError, SimulationError
 
-__all__ = ["execute", "run_shot", "read_records", "check_directory", "RECORDS"]
+__all__ = ["execute", "run_shot", "read_records", "check_directory", "check_ranks_per_shot", "RECORDS"]
 
 RECORDS = "shots.jsonl"
 _REQUEST, _REPLY = 7101, 7102
@@ -33,6 +33,19 @@ _REQUEST, _REPLY = 7101, 7102
 POLL = 5e-4
 #: the records are synced to the disk at most this often (s)
 SYNC = 1.0
+
+
+def check_ranks_per_shot(ranks_per_shot: int, ranks: int) -> None:
+    """The one check of ``--ranks-per-shot`` (fepen sweep, fepen study ballistic-limit and ricochet, execute):
+    at least 1 and a divisor of ``ranks``, the number of ranks the shots share.
+
+    Raises:
+        InputError: (--ranks-per-shot) else.
+    """
+    if ranks_per_shot < 1:
+        raise InputError("--ranks-per-shot", f"must be at least 1, got {ranks_per_shot}")
+    if ranks % ranks_per_shot:
+        raise InputError("--ranks-per-shot", f"must divide the number of ranks ({ranks}), got {ranks_per_shot}")
 
 
 def check_directory(out: Path, digest: str, fresh: bool) -> tuple | None:
@@ -117,7 +130,7 @@ def run_shot(i: int, scene, out, comm) -> dict:
         i: the shot's index. scene: its resolved Scene. out: its results directory, or None (a rigid shot
             then writes nothing). comm: the group's communicator.
     """
-    from fepen import api
+    from fepen.runs import run_in_directory, setup
     from fepen.runs.rigid import RigidRun
 
     t0 = time.perf_counter()
@@ -126,7 +139,10 @@ def run_shot(i: int, scene, out, comm) -> dict:
         if out is None and scene.effects.fidelity == "rigid":
             summary = RigidRun(scene, None, comm).run()
         else:
-            summary = api.run(scene, out=out, comm=comm, force=True).summary  # the study owns its shots' folders
+            setup.check_supported(scene)  # bad input before the shot's folder is claimed, as fepen.api.run
+            setup.announce(scene, comm)
+            summary = run_in_directory(scene, out, comm, "force")  # the study owns its shots' folders
+            summary = json.loads(json.dumps(summary))  # as summary.json holds it (and shots.jsonl gives it back)
     except SimulationError as err:
         status, message = "stopped", str(err)
     except InputError as err:
@@ -152,8 +168,7 @@ def execute(n: int, scene_of, out, comm=None, ranks_per_shot: int = 1, keep=None
     """
     comm = MPI.COMM_WORLD if comm is None else comm
     k = ranks_per_shot
-    if k < 1 or comm.size % k:
-        raise InputError("--ranks-per-shot", f"must divide the number of ranks ({comm.size}), got {k}")
+    check_ranks_per_shot(k, comm.size)
     keep = keep or (lambda sc: sc.effects.fidelity != "rigid")
     out = Path(out)
     records = read_records(out) if comm.rank == 0 else {}

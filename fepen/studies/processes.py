@@ -49,3 +49,12 @@ def run_fepen_process(args: list[str], ranks: int = 1) -> tuple[int, float, str]
     wall = time.perf_counter() - t0
     lines = [ln for ln in r.stderr.strip().splitlines() if ln.startswith("fepen:")]
     return r.returncode, wall, (lines[-1] if lines else r.stderr.strip()[-400:])
+
+
+def relaunch_sweep(sweep_file, out, ranks_per_shot: int, workers: int, sets=(), fresh: bool = False) -> int:
+    """``fepen sweep`` started without mpirun on a machine that has it: the same sweep again as ``mpirun -n
+    WORKERS python -m fepen sweep ... --workers 1``, whose ranks share the shots in groups of
+    ``ranks_per_shot`` (the caller checked its input first). Returns that process's exit code."""
+    argv = ["sweep", sweep_file, "--out", out, "--ranks-per-shot", str(ranks_per_shot), "--workers", "1",
+            *(["--fresh"] if fresh else []), *[f"--set={s}" for s in sets]]
+    return subprocess.run(command(argv, workers), env=mpi_env()).returncode

@@ -47,7 +47,7 @@ def validate(scene_path, sets, out, comm=MPI.COMM_WORLD) -> list[dict]:
             s = summaries[name]
         else:
             s = run_scene(sc, out / name, comm)
-            figures.history_figure(out / name, sc, comm)
+            figures.history_figure(out / name, sc.get("impact.shot"), comm)
         e = SHOTS[name]
         rows.append({"shot": name, "v0_m_s": e.v0, "obliquity_deg": e.obliquity_deg, "attack_deg": e.attack_deg,
                      "Hx_mm": s["Hx_mm"], "Hy_mm": s["Hy_mm"], "Tx_mm": s["Tx_mm"], "Ty_mm": s["Ty_mm"],

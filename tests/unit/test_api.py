@@ -75,3 +75,21 @@ def test_load_gives_the_summary_the_history_by_column_and_a_dataframe(tmp_path):
     assert list(frame.columns) == ["t_s", "nose_x_mm", "nose_y_mm"] and frame["nose_x_mm"].iloc[-1] == 1.5
     with pytest.raises(fepen.InputError):
         fepen.load(tmp_path / "nothing")
+
+
+def test_mesh_refuses_a_run_directory_before_meshing(tmp_path, monkeypatch):
+    """fepen.mesh into a run's results: InputError, nothing meshed or written (the run's scene.toml kept)."""
+    from fepen.runs import setup
+
+    def meshed(*args, **kwargs):
+        raise AssertionError("meshed")
+
+    monkeypatch.setattr(setup, "mesh", meshed)
+    (tmp_path / "summary.json").write_text("{}")
+    (tmp_path / "scene.toml").write_text("# the run's")
+    with pytest.raises(fepen.InputError) as err:
+        fepen.mesh(fepen.Scene(), tmp_path)
+    assert err.value.key == "out" and "summary.json" in err.value.message
+    assert sorted(p.name for p in tmp_path.iterdir()) == ["scene.toml", "summary.json"]
+    assert (tmp_path / "scene.toml").read_text() == "# the run's"
+    assert "mesh" in fepen.__all__ and fepen.mesh is fepen.api.mesh

@@ -198,6 +198,16 @@ CASES = [
         r"comma-separated positive numbers, got 'fast,slow'"),
     row("study-ranks-zero", ["study", "accuracy-cost", "--ranks", "0"], None, "--ranks", r"must be at least 1"),
     row("unknown-study", ["study", "penetration"], None, "command line", r"invalid choice: 'penetration'"),
+    # each study has only its own options (issue 28), and one --ranks-per-shot rule with fepen sweep
+    row("accuracy-cost-speeds", ["study", "accuracy-cost", "--speeds", "100,900"], None, "command line",
+        r"unrecognized arguments: --speeds 100,900$"),
+    row("ballistic-limit-obliquity", ["study", "ballistic-limit", "--obliquity-max=80"], None, "command line",
+        r"unrecognized arguments: --obliquity-max=80$"),
+    row("ricochet-quick", ["study", "ricochet", "--quick"], None, "command line", r"unrecognized arguments: --quick$"),
+    row("limit-ranks-per-shot-zero", ["study", "ballistic-limit", "--ranks-per-shot", "0"], None, "--ranks-per-shot",
+        r"must be at least 1, got 0"),
+    row("limit-ranks-per-shot-not-dividing", ["study", "ricochet", "--ranks-per-shot", "2"], None,
+        "--ranks-per-shot", r"must divide the number of ranks \(1\), got 2"),
 ]
 
 

@@ -1,0 +1,153 @@
+"""The ``fepen`` command (docs/scenes.md, docs/results.md, docs/studies.md).
+
+    fepen run [SCENE.toml] [--out DIR] [--set KEY=VALUE ...] [--force]
+    fepen run --resume DIR
+    fepen mesh [SCENE.toml] [--out DIR] [--set KEY=VALUE ...]
+    fepen validate [SCENE.toml] [--out DIR] [--set KEY=VALUE ...]
+    fepen validate-depth [--data PATH ...] [--only] [--set KEY=VALUE ...] [--out DIR] [--workers W]
+    fepen study accuracy-cost [--out DIR] [--ranks N] [--quick] [--fresh]
+    fepen study ballistic-limit [SCENE.toml] [--out DIR] [--speeds LOW,HIGH] [--tol M/S] [--ranks-per-shot K]
+                                [--set KEY=VALUE ...] [--fresh]
+    fepen study ricochet [SCENE.toml] [--out DIR] [--speeds V,...] [--tol DEG] [--obliquity-max DEG]
+                         [--ranks-per-shot K] [--set KEY=VALUE ...] [--fresh]
+    fepen sweep SWEEP.toml [--out DIR] [--ranks-per-shot K] [--workers W] [--set KEY=VALUE ...] [--fresh]
+    fepen view DIR [--png FILE] [--time T] [--field NAME]
+    fepen keys
+    fepen --version
+    fepen --debug COMMAND ...    (a traceback with every error, for developers)
+
+One module per command (``fepen.cli.run``, ``mesh``, ``validate``, ``validate_depth``, ``study``, ``sweep``,
+``view``, ``keys``), each with a docstring, ``HELP`` (its line in ``fepen --help``), ``add_arguments(parser)``
+and ``run(args) -> int``; ``COMMANDS`` below is the registry the parser is built from. A new command is a new
+module and one line there.
+
+Exit codes (fepen.errors, docs/results.md): 0 success; 2 bad input (one line naming the key or argument and
+what is allowed, before anything is written); 3 the simulation cannot go on (what, where, when); 4 a fault of
+the machine (disk full, permission, a signal that stopped the run after a checkpoint); 1 a bug in fepen. Every
+error is one line on stderr; --debug adds the traceback.
+"""
+
+from __future__ import annotations
+
+import argparse
+import sys
+
+from fepen.cli import keys, mesh, run, study, sweep, validate, validate_depth, view
+from fepen.cli.common import say
+from fepen.errors import InputError, Interrupted, MachineFault, SimulationError, describe_os_error, stop_outcome
+
+__all__ = ["main", "COMMANDS", "version_line"]
+
+#: the command modules by name, in the order of "name a command: ..."
+_MODULES = {"run": run, "mesh": mesh, "validate": validate, "validate-depth": validate_depth, "study": study,
+            "sweep": sweep, "keys": keys, "view": view}
+#: what main calls: command name -> its module's run(args) -> exit code
+COMMANDS = {name: module.run for name, module in _MODULES.items()}
+#: the order of the commands in ``fepen --help`` and in argparse's "invalid choice" line
+_HELP_ORDER = ("run", "validate", "mesh", "validate-depth", "study", "sweep", "keys", "view")
+
+
+class _Parser(argparse.ArgumentParser):
+    def error(self, message):  # one line, exit 2, as for every other bad input
+        raise InputError("command line", message)
+
+
+def _parser() -> argparse.ArgumentParser:
+    """The parser: the global options and one sub-parser per command, from its module's add_arguments."""
+    ap = _Parser(prog="fepen", description="Projectile penetrating concrete, projectile-target separation.",
+                 epilog="Exit codes: 0 success, 2 bad input, 3 the simulation cannot go on, 4 a fault of the "
+                        "machine (disk full, permission, SIGTERM/SIGINT after a checkpoint), 1 a bug. "
+                        "--debug (anywhere): tracebacks.")
+    ap.add_argument("--version", action="store_true", help="print fepen's version and code revision and exit")
+    sub = ap.add_subparsers(dest="command", parser_class=_Parser)
+    for name in _HELP_ORDER:
+        _MODULES[name].add_arguments(sub.add_parser(name, help=_MODULES[name].HELP))
+    return ap
+
+
+def version_line() -> str:
+    """``fepen 0.1.0 (revision abc123…)``: the version and the code revision of this source tree."""
+    from fepen.io.rundir import revision
+    from fepen.version import __version__
+
+    rev = revision()
+    return f"fepen {__version__}" + (f" (revision {rev})" if rev else "")
+
+
+def main(argv: list[str] | None = None) -> int:
+    """Entry point of the ``fepen`` console script and of ``python -m fepen``. Returns the exit code
+    (fepen.errors): every error is one line on stderr, with its traceback only under --debug."""
+    from fepen.io import rundir
+
+    argv = list(sys.argv[1:] if argv is None else argv)
+    rundir.begin_command(["fepen", *map(str, argv)])  # run.json's "command"
+    debug = "--debug" in argv
+    argv = [a for a in argv if a != "--debug"]
+    try:
+        args = _parser().parse_args(argv)
+        if args.version:
+            say(version_line())
+            return 0
+        if args.command is None:
+            raise InputError("command line", "name a command: " + ", ".join(COMMANDS) + " (fepen --help)")
+        _quiet()
+        return COMMANDS[args.command](args)
+    except BaseException as err:  # noqa: B036 - every way out is one line and a documented code
+        if isinstance(err, SystemExit):
+            return err.code if isinstance(err.code, int) else 0  # --help
+        code, line = _verdict(err)
+        if debug:
+            import traceback
+
+            traceback.print_exc()
+        _error(line)
+        return code
+
+
+def _verdict(err: BaseException) -> tuple[int, str]:
+    """The exit code and the one line of an error (whitespace, newlines in a path included, collapsed)."""
+    code, line = _verdict_line(err)
+    return code, " ".join(line.split())
+
+
+def _verdict_line(err: BaseException) -> tuple[int, str]:
+    """The exit code (fepen.errors.stop_outcome, the one classification) and the line before its whitespace is
+    collapsed."""
+    code = stop_outcome(err).exit_code
+    if isinstance(err, ValueError) and "null byte" in str(err):  # a path holding NUL, from a script
+        return code, "fepen: bad input: a file name holds a NUL byte"
+    if isinstance(err, InputError):
+        return code, f"fepen: bad input: {err}"
+    if isinstance(err, SimulationError):
+        return code, f"fepen: simulation stopped: {err}"
+    if isinstance(err, Interrupted):
+        return code, f"fepen: interrupted: {err}"
+    if isinstance(err, MachineFault):
+        return code, f"fepen: stopped by a fault of the machine: {err}"
+    if isinstance(err, OSError):
+        return code, f"fepen: stopped by a fault of the machine: {describe_os_error(err)}"
+    if isinstance(err, KeyboardInterrupt):
+        return code, "fepen: interrupted (SIGINT) before the run had anything to keep"
+    if isinstance(err, MemoryError):
+        return code, "fepen: stopped by a fault of the machine: out of memory"
+    text = " ".join(str(err).split())[:300]
+    return code, (f"fepen: internal error (a bug in fepen; run again with --debug for the traceback and report "
+                  f"it): {type(err).__name__}: {text}")
+
+
+def _quiet() -> None:
+    import logging
+
+    logging.getLogger("dolfinx").setLevel(logging.WARNING)
+    logging.basicConfig(format="fepen: %(message)s", level=logging.INFO)
+
+
+def _error(line: str) -> None:
+    """The one line of an error, on stderr (rank 0), kept for fepen.log."""
+    from mpi4py import MPI
+
+    from fepen.io import rundir
+
+    if MPI.COMM_WORLD.rank == 0:
+        print(line, file=sys.stderr, flush=True)
+        rundir.log_line(line)

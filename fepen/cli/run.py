@@ -1,0 +1,39 @@
+"""``fepen run SCENE.toml [--out DIR] [--set KEY=VALUE ...] [--force]`` and ``fepen run --resume DIR``: one
+simulation (fepen.api.run, fepen.api.resume), its summary printed."""
+
+from __future__ import annotations
+
+from fepen.cli.common import say, scene_arguments
+from fepen.errors import InputError
+
+HELP = "one simulation: summary.json, history.csv, fields.xdmf, figures"
+
+
+def add_arguments(parser) -> None:
+    scene_arguments(parser, "results/run")
+    parser.add_argument("--resume", metavar="DIR",
+                        help="continue the killed or interrupted run in DIR from its last checkpoint (same scene, "
+                             "same ranks)")
+    parser.add_argument("--force", action="store_true",
+                        help="when --out holds another run's results, remove them first (only what fepen writes)")
+
+
+def run(args) -> int:
+    """Run one scene, or continue a run; print its summary."""
+    from fepen import api
+
+    if args.resume is not None:
+        if args.scene is not None or args.sets or args.force:
+            raise InputError("--resume", "takes the scene of the run it continues (DIR/scene.toml): give no "
+                                         "scene file, no --set and no --force")
+        result = api.resume(args.resume, progress=True)
+    else:
+        result = api.run(api.Scene(args.scene, sets=args.sets), out=args.out, progress=True, force=args.force)
+    summary, out = result.summary, result.out
+    keys = ("outcome", "Hx_mm", "Hy_mm", "Tx_mm", "Ty_mm", "length_mm", "residual_speed_m_s", "max_peeq",
+            "energy_error", "steps", "dt_s", "wall_s")
+    keys += tuple(k for k in ("mass_loss_kg", "mass_loss_percent") if k in summary)
+    say(*(f"{k} = {summary[k]:.6g}" if isinstance(summary[k], float) else f"{k} = {summary[k]}"
+          for k in keys), f"written: {out}/summary.json, history.csv, history.png"
+        + (", fields.xdmf" if result.fields is not None else ""))
+    return 0

@@ -1,0 +1,30 @@
+"""``fepen view DIR [--png FILE] [--time T] [--field NAME]``: a run in ParaView (its view.py), or pyvista where
+ParaView is absent (fepen.post.paraview.show)."""
+
+from __future__ import annotations
+
+from fepen.cli.common import say
+from fepen.errors import InputError
+
+HELP = "a run in ParaView (its view.py), or pyvista where ParaView is absent"
+
+
+def add_arguments(parser) -> None:
+    parser.add_argument("dir", help="results directory of a run with fields (finished, running or killed)")
+    parser.add_argument("--png", help="render one picture to this file, offscreen, and exit")
+    parser.add_argument("--time", type=float, help="output time (s); default the last")
+    parser.add_argument("--field", default="von_mises_Pa", help="the field to colour by (default von_mises_Pa)")
+
+
+def run(args) -> int:
+    """Show the run DIR, or render it to --png."""
+    from pathlib import Path
+
+    from fepen.post import paraview
+
+    out = Path(args.dir)
+    if not (out / "fields.xdmf").is_file():
+        raise InputError("dir", f"{out} holds no fields.xdmf (a run with run.fields = true writes it)")
+    paraview.show(out, args.field, args.time, args.png)
+    say(f"written: {args.png}" if args.png else f"shown: {out}")
+    return 0
