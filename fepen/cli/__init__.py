@@ -36,7 +36,8 @@ from fepen.cli import keys, mesh, run, study, sweep, validate, validate_depth, v
 from fepen.cli.common import say
 from fepen.errors import InputError, Interrupted, MachineFault, SimulationError, describe_os_error, stop_outcome
 
-__all__ = ["main", "COMMANDS", "version_line"]
+__all__ = ["main", "COMMANDS", "version_line", "common", "run", "mesh", "validate", "validate_depth", "study", "sweep",
+           "keys", "view"]
 
 #: the command modules by name, in the order of "name a command: ..."
 _MODULES = {"run": run, "mesh": mesh, "validate": validate, "validate-depth": validate_depth, "study": study,

@@ -15,4 +15,5 @@ from fepen.data.steels import STEELS
 from fepen.data.steels import names as steel_names
 from fepen.data.targets import CONSTANTS, FAMILIES, TARGETS
 
-__all__ = ["SHOTS", "Shot", "shot", "STEELS", "steel_names", "TARGETS", "FAMILIES", "CONSTANTS"]
+__all__ = ["experiments", "steels", "targets", "SHOTS", "Shot", "shot", "STEELS", "steel_names", "TARGETS", "FAMILIES",
+           "CONSTANTS"]

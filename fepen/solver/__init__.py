@@ -2,4 +2,4 @@
 changes its reference body, target load, contact."""
 
 __all__ = ["kernels", "ckernel", "explicit", "probes", "diagnostics", "reference", "failures", "surface",
-           "target_load", "rigid_wall", "shell_charge"]
+           "target_load", "rigid_wall", "shell_charge", "erosion", "recession"]
