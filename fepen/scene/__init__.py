@@ -29,5 +29,6 @@ from fepen.scene.schema import LAYER_FIELDS, LAYER_KEYS, SCHEMA, SECTIONS
 from fepen.scene.writing import describe, to_toml
 
 __all__ = ["keys", "schema", "writing", "Scene", "Section", "load", "resolve", "read_toml", "parse_set", "flatten",
-           "unknown_key", "to_toml", "describe", "SCHEMA", "SECTIONS", "LAYER_KEYS", "LAYER_FIELDS", "Key", "ABSENT", "display_name",
+           "unknown_key", "to_toml", "describe", "SCHEMA", "SECTIONS", "LAYER_KEYS", "LAYER_FIELDS", "Key",
+           "ABSENT", "display_name",
            "CROSS_CHECKS", "CHECKS_AFTER_RESOLUTION", "CAD_EXCLUDES", "cross_check", "registered_checks"]
