@@ -79,7 +79,6 @@ def run_in_directory(scene, out, comm=MPI.COMM_WORLD, mode: str = "new", progres
     """
     from pathlib import Path
 
-    from fepen import scene as fscene
     from fepen.io import files, rundir
     from fepen.post import figures
 
@@ -87,7 +86,7 @@ def run_in_directory(scene, out, comm=MPI.COMM_WORLD, mode: str = "new", progres
     sh = sh or resolve(scene)
     with rundir.RunDirectory(out, comm, mode):
         if mode != "resume":
-            files.agree(comm, "scene.toml", lambda: files.write_text(out / "scene.toml", fscene.to_toml(scene), comm))
+            files.agree(comm, "scene.toml", lambda: files.write_text(out / "scene.toml", sh.scene_toml, comm))
         try:
             return run_scene(scene, out, comm, progress=progress, resume=resume, sh=sh)
         finally:

@@ -17,6 +17,7 @@ from fepen.geometry.mass_rule import Built
 from fepen.laws import target as tg
 from fepen.laws import wear
 from fepen.runs import setup
+from fepen.scene import to_toml
 
 #: the longest a run without run.end_time may last (s): deformable, rigid
 MAX_TIME = {"deformable": 5e-3, "rigid": 5e-2}
@@ -77,7 +78,7 @@ class Shot:
         charge_friction: the shell-charge friction coefficient.
         rigid_step: run.rigid_step or None.
         experiment: the Table 1 shot's name (impact.shot) or None.
-        scene: the resolved scene as a dict (summary.json's "scene").
+        scene: the resolved scene as a dict (summary.json's "scene"); scene_toml: as scene.toml (the given keys).
         body_key: what identifies the projectile (a sweep's shots share a body).
     """
 
@@ -102,6 +103,7 @@ class Shot:
     experiment: str | None
     scene: dict = field(repr=False)
     body_key: tuple = field(repr=False, default=())
+    scene_toml: str = field(repr=False, default="")
 
     @property
     def rigid(self) -> bool:
@@ -193,7 +195,8 @@ def resolve(scene) -> Shot:
         failure_strain=scene.get("projectile.failure_strain"), outputs=_outputs(scene), mesh=setup.mesh_request(scene),
         materials=materials, safety_factor=scene.run.safety_factor, stable_step=scene.run.stable_step,
         charge_friction=scene.charge.friction, rigid_step=scene.get("run.rigid_step"),
-        experiment=scene.get("impact.shot"), scene=scene.as_dict(), body_key=setup.body_key(scene))
+        experiment=scene.get("impact.shot"), scene=scene.as_dict(), body_key=setup.body_key(scene),
+        scene_toml=to_toml(scene))
 
 
 def of(shot_or_scene) -> Shot:
