@@ -50,7 +50,7 @@ def carry(friction: float, sign: float, size: float = 0.004, accel_g: float = 50
     def level(t):
         return a0 * (np.sin(0.5 * np.pi * t / ramp) ** 2 if t < ramp else 1.0)
 
-    def body_force(solver):
+    def body_force(solver, dt):
         solver.fext[:n, 1] += share * level(solver.t)
 
     s.external = body_force

@@ -22,7 +22,7 @@ from fepen.runs.rigid import RigidRun
 from fepen.runs.shot import Shot, resolve
 
 __all__ = ["shot", "setup", "run", "rigid", "model", "deformable", "closing", "events", "outputs", "checkpoint",
-           "interrupts", "run_scene", "expected_end", "resolve", "Shot", "RigidRun"]
+           "interrupts", "run_scene", "run_in_directory", "expected_end", "resolve", "Shot", "RigidRun"]
 
 
 def expected_end(scene, sh: Shot) -> float:

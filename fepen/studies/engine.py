@@ -130,7 +130,7 @@ def run_shot(i: int, scene, out, comm) -> dict:
         i: the shot's index. scene: its resolved Scene. out: its results directory, or None (a rigid shot
             then writes nothing). comm: the group's communicator.
     """
-    from fepen.runs import run_in_directory, setup
+    from fepen.runs import resolve, run_in_directory, setup
     from fepen.runs.rigid import RigidRun
 
     t0 = time.perf_counter()
@@ -139,9 +139,9 @@ def run_shot(i: int, scene, out, comm) -> dict:
         if out is None and scene.effects.fidelity == "rigid":
             summary = RigidRun(scene, None, comm).run()
         else:
-            setup.check_supported(scene)  # bad input before the shot's folder is claimed, as fepen.api.run
-            setup.announce(scene, comm)
-            summary = run_in_directory(scene, out, comm, "force")  # the study owns its shots' folders
+            sh = resolve(scene)  # bad input before the shot's folder is claimed, as fepen.api.run
+            setup.announce(scene, comm, sh.built)
+            summary = run_in_directory(scene, out, comm, "force", sh=sh)  # the study owns its shots' folders
             summary = json.loads(json.dumps(summary))  # as summary.json holds it (and shots.jsonl gives it back)
     except SimulationError as err:
         status, message = "stopped", str(err)
