@@ -38,10 +38,13 @@ STOP_STEPS = 150
 RING_SECTORS = 12
 
 
-def mesh_points(sh: shot.Shot, comm) -> tuple[dict, tuple, int]:
+def mesh_points(sh, comm) -> tuple[dict, tuple, int]:
     """Load points and mass properties from the shot's volume mesh: its outer facets on the exact surface
     (fepen.solver.surface) and the exact integrals over its cells, summed in the cells' original (gmsh)
     order, so that the whole rigid trajectory is bitwise the same on any number of ranks.
+
+    Args:
+        sh: the Shot (a Scene is resolved). comm: the communicator.
 
     Returns:
         (points as fepen.geometry.revolution.load_points returns them, (mass, centre, inertia), cells).
@@ -49,6 +52,8 @@ def mesh_points(sh: shot.Shot, comm) -> tuple[dict, tuple, int]:
     from dolfinx import fem
 
     from fepen.solver import surface
+
+    sh = shot.of(sh)
 
     pm = setup.build_mesh(sh.built, sh.mesh, comm)
     p = fmesh.cell_points(pm.mesh)
