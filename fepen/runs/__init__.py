@@ -61,7 +61,6 @@ def run_scene(scene, out, comm=MPI.COMM_WORLD, progress: bool = False, resume: d
     return DeformableRun(sh, out, comm, end, resume).run()
 
 
-
 def run_in_directory(scene, out, comm=MPI.COMM_WORLD, mode: str = "new", progress: bool = False,
                      resume: dict | None = None, sh: Shot | None = None) -> dict:
     """Run a scene into its results directory as ``fepen run`` does (fepen.api.run and resume, the studies'
@@ -69,8 +68,8 @@ def run_in_directory(scene, out, comm=MPI.COMM_WORLD, mode: str = "new", progres
     resuming, run_scene, and draw history.png of whatever history.csv holds, even after a stop.
 
     Args:
-        scene: a resolved Scene, checked by the caller (setup.check_supported, setup.announce) before OUT is
-            claimed. out: the results directory. comm: the communicator of the run.
+        scene: a resolved Scene, resolved to its Shot by the caller (``sh``) before OUT is claimed, so that
+            bad input writes nothing. out: the results directory. comm: the communicator of the run.
         mode: "new" (refuse a directory holding another run's results), "force" (clear them first) or "resume".
         progress, resume, sh: as for run_scene.
 

@@ -89,7 +89,7 @@ class DeformableRun(Run):
         s, m = self.solver, self.model
         if m.law is None:
             return self.rules.rebound(s.t, self.load.contact_nodes)
-        if s.step_count % EVENT_EVERY:
+        if s.step_count % self.check_every:
             return None
         if m.erosion is not None and s.total_mass < events.ERODED_FRACTION * s.initial_mass:
             return "eroded"
@@ -109,7 +109,7 @@ class DeformableRun(Run):
         x = s.positions()
         y_min, y_max = self._y_extent(x)
         if not (self.rules.entered or y_min < 0.0):
-            return y_min, y_max, None, None, 0.0, 0.0  # not in the target yet: Run looks no further
+            return None  # not in the target yet
         axis = unit_axis(probes.node_value(s, m.tip, x), probes.node_value(s, m.tail, x))
         return y_min, y_max, diagnostics.momentum_velocity(s), axis, s.total_mass, s.ke0
 
@@ -152,6 +152,8 @@ class DeformableRun(Run):
 
     # ---- rows, fields, summary ----------------------------------------------------------------------------
     def snapshot(self) -> Snapshot:
+        """The state of a history row (collective); the strain gauges' and charge sections' rows are recorded
+        with it."""
         s, m = self.solver, self.model
         x = s.positions()
         e = diagnostics.energies(s)
@@ -169,11 +171,15 @@ class DeformableRun(Run):
         self.gauges.record()
         rear = -self._y_extent(x)[1] if self.crossings is not None else np.nan
         return Snapshot(tip, tail, diagnostics.momentum_velocity(s), self.load.force, s.total_mass, en,
-                        self.load.contact_nodes, s.dt, diagnostics.max_peeq(s), self.load.area, rear, extra)
+                        self.load.contact_nodes, s.dt, diagnostics.max_peeq(s), self.load.area, rear, extra,
+                        self._removal(e) if self.removing else None)
 
     def removal(self) -> Removal:
+        return self._removal(diagnostics.energies(self.solver))
+
+    def _removal(self, e) -> Removal:
+        """Removal from the step's energies ``e`` (collective: the wear heat's sum)."""
         s, m = self.solver, self.model
-        e = diagnostics.energies(s)
         heat = self.comm.allreduce(m.recession.heat_total, op=MPI.SUM) if m.recession is not None else 0.0
         return Removal(s.initial_mass - s.total_mass, heat, m.erosion.count if m.erosion is not None else 0,
                        e.removed_kinetic, e.removed_internal, remaining_kg=s.total_mass)

@@ -140,9 +140,9 @@ class RigidRun(Run):
         self.v0 = sh.speed
         self.state = RigidState(R @ c0, matrix_to_quat(R), v.copy(), np.zeros(3))
         self.crater = sh.crater(self.mass)
-        a = 0.5 * sh.diameter
+        a = 0.5 * sh.nominal_diameter
         t_stop = self.mass * self.v0 / (self.law.sigma_s * np.pi * a * a)
-        self.dt = sh.rigid_step or min(STEP_FRACTION * sh.diameter / self.v0, t_stop / STOP_STEPS)
+        self.dt = sh.rigid_step or min(STEP_FRACTION * sh.nominal_diameter / self.v0, t_stop / STOP_STEPS)
         self.tip_ref = np.zeros(3)
         self.tail_ref = np.array([0.0, self.shape.length, 0.0])
         self.w_ext = 0.0

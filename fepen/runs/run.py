@@ -30,6 +30,19 @@ SIGNAL_EVERY = 20
 
 
 @dataclass
+class Removal:
+    """What wear and erosion took off so far (every rank the same numbers)."""
+
+    mass_kg: float = 0.0
+    heat_J: float = 0.0
+    eroded_cells: int = 0
+    kinetic_J: float = 0.0
+    elastic_J: float = 0.0
+    remaining_kg: float | None = None  #: the mass now, as the body tracks it (None: initial minus mass_kg)
+    length_mm: float | None = None  #: the length now (None: the last history row's)
+
+
+@dataclass
 class Snapshot:
     """The state a history row is made of (world frame, SI).
 
@@ -39,6 +52,7 @@ class Snapshot:
         history_row's energies. contact: loaded points. dt: the step (s). peeq: the largest plastic strain.
         area: the loaded area (m^2). rear_depth: the shallowest load point's depth (m; the crossings).
         extra: the body's own columns (charge, interface), in Run.columns' order.
+        removal: what wear and erosion took off, when the body has it at hand (else Run.record asks removal()).
     """
 
     tip: np.ndarray
@@ -53,19 +67,7 @@ class Snapshot:
     area: float
     rear_depth: float
     extra: list = field(default_factory=list)
-
-
-@dataclass
-class Removal:
-    """What wear and erosion took off so far (every rank the same numbers)."""
-
-    mass_kg: float = 0.0
-    heat_J: float = 0.0
-    eroded_cells: int = 0
-    kinetic_J: float = 0.0
-    elastic_J: float = 0.0
-    remaining_kg: float | None = None  #: the mass now, as the body tracks it (None: initial minus mass_kg)
-    length_mm: float | None = None  #: the length now (None: the last history row's)
+    removal: Removal | None = None
 
 
 class Run:
@@ -106,7 +108,7 @@ class Run:
 
     def extent(self) -> tuple[float, float, np.ndarray, np.ndarray, float, float] | None:
         """(lowest and highest load-point y, centre-of-mass velocity, axis tail to nose, mass, striking
-        kinetic energy) for the stop rules, or None when the rules need not look (collective)."""
+        kinetic energy) for the stop rules, or None while the projectile has not reached the target (collective)."""
         raise NotImplementedError
 
     def snapshot(self) -> Snapshot:
@@ -197,12 +199,7 @@ class Run:
         if self.step_count % self.check_every:
             return None
         sample = self.extent()
-        if sample is None:
-            return None
-        y_min, y_max, v_cm, axis, mass, ke0 = sample
-        if not (self.rules.entered or y_min < 0.0):
-            return None  # not in the target yet
-        return self.rules.penetration(y_min, y_max, v_cm, axis, mass, ke0)
+        return None if sample is None else self.rules.penetration(*sample)
 
     def record(self) -> list[float]:
         """Append one history row from the body's snapshot (and sample the layer crossings there)."""
@@ -210,7 +207,7 @@ class Run:
         row = results.history_row(self.t, s.tip, s.tail, s.velocity, s.force, s.mass, s.energies, s.contact,
                                   s.dt, s.peeq, s.area) + list(s.extra)
         if self.removing:
-            r = self.removal()
+            r = s.removal or self.removal()
             row += [s.mass, r.heat_J, r.eroded_cells, r.kinetic_J]
         results.finite_row(row, self.step_count, self.t)
         self.rows.append(row)

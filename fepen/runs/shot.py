@@ -77,6 +77,8 @@ class Shot:
         safety_factor, stable_step: the explicit step's safety factor and estimate ("eigenvalue", "altitude").
         charge_friction: the shell-charge friction coefficient.
         rigid_step: run.rigid_step or None.
+        nominal_diameter: projectile.diameter (m), which the rigid step has always been sized on (a drawn profile's
+            or a CAD body's own calibre may differ from it).
         experiment: the Table 1 shot's name (impact.shot) or None.
         scene: the resolved scene as a dict (summary.json's "scene"); scene_toml: as scene.toml (the given keys).
         body_key: what identifies the projectile (a sweep's shots share a body).
@@ -100,6 +102,7 @@ class Shot:
     stable_step: str
     charge_friction: float
     rigid_step: float | None
+    nominal_diameter: float
     experiment: str | None
     scene: dict = field(repr=False)
     body_key: tuple = field(repr=False, default=())
@@ -118,10 +121,6 @@ class Shot:
     def layered(self) -> bool:
         return getattr(self.law, "layered", False)
 
-    @property
-    def diameter(self) -> float:
-        return self.built.shape.diameter
-
     def crater(self, mass: float) -> tg.ForrestalCrater | None:
         """Forrestal's linear crater for a projectile of ``mass`` (kg) when effects.crater = "linear", else None
         (the energy crater is in the law)."""
@@ -134,11 +133,6 @@ class Shot:
             factor = None if shape.nose == "ogive" and not shape.meplat_diameter else shape.nose_factor()
         return tg.ForrestalCrater(self.law, mass, self.speed, self.crh, factor)
 
-    def densities(self) -> dict[int, float]:
-        """Density (kg/m^3) per volume tag."""
-        from fepen.geometry import tags
-
-        return {tags.SHELL: self.built.shell_density, tags.CHARGE: self.mesh.charge_density}
 
 
 def _hard_end(law, end_time: float | None, speed: float, kind: str) -> float:
@@ -195,6 +189,7 @@ def resolve(scene) -> Shot:
         failure_strain=scene.get("projectile.failure_strain"), outputs=_outputs(scene), mesh=setup.mesh_request(scene),
         materials=materials, safety_factor=scene.run.safety_factor, stable_step=scene.run.stable_step,
         charge_friction=scene.charge.friction, rigid_step=scene.get("run.rigid_step"),
+        nominal_diameter=scene.projectile.diameter,
         experiment=scene.get("impact.shot"), scene=scene.as_dict(), body_key=setup.body_key(scene),
         scene_toml=to_toml(scene))
 
