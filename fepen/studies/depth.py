@@ -7,8 +7,10 @@ A data set is one CSV file, one shot a row, with the columns (units in the names
 
     shot, d_mm, m_kg, crh, L_mm, v_ms, fc_mpa, rho_kgm3, depth_m
 
-and optionally ``obliquity_deg``, ``attack_deg`` (absent: 0), ``source`` and ``notes`` (kept, not read).
-The shipped sets are in ``fepen/data/depth/``; ``table1`` is the paper's eight shots (docs/paper.md).
+and optionally ``obliquity_deg``, ``attack_deg`` (absent: 0), ``strength_basis`` (``cylinder`` or ``cube``:
+what f_c was measured on; absent or empty: cylinder), and ``source``, ``compilation_row`` and ``notes`` (kept,
+not read). The shipped sets are in ``fepen/data/depth/`` (their provenance: SOURCES.md there); ``table1`` is
+the paper's eight shots (docs/paper.md).
 """
 
 from __future__ import annotations
@@ -26,9 +28,11 @@ from fepen.laws import target as tg
 
 __all__ = ["Row", "read_set", "table1_set", "shipped_sets", "scene_sets", "rigid_depth", "closed_form_depth",
            "errors", "predict_sets", "gather_sets", "summary_table", "markdown", "figure", "validate_depth",
-           "COLUMNS", "METHODS"]
+           "COLUMNS", "STRENGTH_BASES", "METHODS"]
 
 COLUMNS = ("shot", "d_mm", "m_kg", "crh", "L_mm", "v_ms", "fc_mpa", "rho_kgm3", "depth_m")
+#: what a set's f_c can have been measured on (column ``strength_basis``; absent or empty: the first)
+STRENGTH_BASES = ("cylinder", "cube")
 
 
 @dataclass(frozen=True)
@@ -38,7 +42,8 @@ class Row:
     Attributes:
         name: the shot's label. D, L, mass, crh: projectile diameter, length (m), mass (kg), ogive CRH.
         V: striking speed (m/s). fc, rho: target strength (Pa) and density (kg/m^3). depth: measured
-        depth of the nose (m). obliquity_deg, attack_deg: striking angles (degrees).
+        depth of the nose (m). obliquity_deg, attack_deg: striking angles (degrees). strength_basis: what fc
+        was measured on, "cylinder" or "cube" (STRENGTH_BASES); fc is kept as published, not converted.
     """
 
     name: str
@@ -52,13 +57,16 @@ class Row:
     depth: float
     obliquity_deg: float = 0.0
     attack_deg: float = 0.0
+    strength_basis: str = "cylinder"
 
 
 def read_set(path) -> list[Row]:
-    """The rows of one CSV data set (columns: COLUMNS, optionally obliquity_deg and attack_deg).
+    """The rows of one CSV data set (columns: COLUMNS, optionally obliquity_deg, attack_deg and
+    strength_basis; any other column, e.g. source, compilation_row, notes, is kept in the file and not read).
 
     Raises:
-        ValueError naming the file, row and column of a missing or non-numeric value.
+        ValueError naming the file, row and column of a missing or non-numeric value, or a strength_basis
+        not in STRENGTH_BASES.
     """
     path = Path(path)
     rows = []
@@ -70,9 +78,12 @@ def read_set(path) -> list[Row]:
         for i, r in enumerate(reader, start=2):
             try:
                 num = {c: float(r[c]) for c in COLUMNS[1:]}
+                basis = (r.get("strength_basis") or "").strip() or STRENGTH_BASES[0]
+                if basis not in STRENGTH_BASES:
+                    raise ValueError(f"strength_basis {basis!r}: must be one of {', '.join(STRENGTH_BASES)}")
                 rows.append(Row(r["shot"], num["d_mm"] / 1e3, num["L_mm"] / 1e3, num["m_kg"], num["crh"],
                                 num["v_ms"], num["fc_mpa"] * 1e6, num["rho_kgm3"], num["depth_m"],
-                                float(r.get("obliquity_deg") or 0.0), float(r.get("attack_deg") or 0.0)))
+                                float(r.get("obliquity_deg") or 0.0), float(r.get("attack_deg") or 0.0), basis))
             except (TypeError, ValueError) as err:
                 raise ValueError(f"{path}:{i}: {err}") from None
     return rows
