@@ -110,12 +110,10 @@ def _side_by_side(scenes, out: Path) -> dict:
 
 def hazard_figure(out: Path) -> None:
     """Hazard maps (max surface PEEQ along the axis) overlaid: C2/C3/C6 (angle) and C3/C4/C5 (speed)."""
-    import matplotlib
+    from matplotlib.figure import Figure
 
-    matplotlib.use("Agg")
-    import matplotlib.pyplot as plt
-
-    fig, ax = plt.subplots(1, 2, figsize=(12, 3.8))
+    fig = Figure(figsize=(12, 3.8))
+    ax = fig.subplots(1, 2)
     for a, (group, what) in zip(ax, ((("C2", "C3", "C6"), "obliquity"), (("C3", "C4", "C5"), "speed"))):
         for name in group:
             d = np.loadtxt(Path(out) / name / "hazard.csv", delimiter=",", skiprows=1)
@@ -125,7 +123,6 @@ def hazard_figure(out: Path) -> None:
         a.legend(fontsize=8)
     fig.tight_layout()
     fig.savefig(Path(out) / "hazard_maps.png", dpi=110)
-    plt.close(fig)
 
 
 def table(rows, sc) -> str:
@@ -151,12 +148,11 @@ def table(rows, sc) -> str:
 
 
 def figure(rows, out: Path) -> None:
-    import matplotlib
+    """validation.png: simulated against measured (Hy, Ty), (Hx, Tx), and the nose trajectories."""
+    from matplotlib.figure import Figure
 
-    matplotlib.use("Agg")
-    import matplotlib.pyplot as plt
-
-    fig, ax = plt.subplots(1, 3, figsize=(15, 4.6))
+    fig = Figure(figsize=(15, 4.6))
+    ax = fig.subplots(1, 3)
     for k, (a, b) in enumerate((("Hy", "Ty"), ("Hx", "Tx"))):
         for key, mark in ((a, "o"), (b, "s")):
             x = [r[f"{key}_exp_mm"] for r in rows]
@@ -181,4 +177,3 @@ def figure(rows, out: Path) -> None:
     ax[2].legend(fontsize=7, ncol=2)
     fig.tight_layout()
     fig.savefig(Path(out) / "validation.png", dpi=110)
-    plt.close(fig)
