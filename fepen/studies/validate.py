@@ -1,8 +1,9 @@
 """``fepen validate``: the eight Table 1 shots with one parameter set, compared with the experiments.
 
 Writes to DIR: one results directory per shot (DIR/C1 ...), validation.csv, validation.md (Table 1 with the
-simulated values and errors) and validation.png (simulated against measured nose and tail positions, and
-the trajectories).
+simulated values and errors), validation.png (simulated against measured nose and tail positions, and
+the trajectories) and paths.png (the nose and tail paths of the oblique shots against the straight line and
+the test's final projectile, fepen.post.paths; ``python -m fepen.post.paths`` puts several DIRs on one figure).
 """
 
 from __future__ import annotations
@@ -17,7 +18,7 @@ from mpi4py import MPI
 from fepen import scene as fscene
 from fepen.data import SHOTS
 from fepen.io import files
-from fepen.post import figures
+from fepen.post import figures, paths
 from fepen.runs import run_scene, setup
 
 FIELDS = ["shot", "v0_m_s", "obliquity_deg", "attack_deg", "Hx_mm", "Hy_mm", "Tx_mm", "Ty_mm", "Hx_exp_mm",
@@ -63,6 +64,7 @@ def validate(scene_path, sets, out, comm=MPI.COMM_WORLD) -> list[dict]:
         files.write_text(out / "validation.csv", buf.getvalue(), comm)
         files.write_text(out / "validation.md", table(rows, scenes["C1"]), comm)
         figure(rows, out)
+        paths.paths_figure({scenes["C1"].effects.fidelity: out}, out / "paths.png")
         if all((out / r["shot"] / "hazard.csv").is_file() for r in rows):
             hazard_figure(out)
     return rows
