@@ -102,6 +102,31 @@ def youngs_modulus_aci(fc_pa: float) -> float:
     return 4.7e9 * math.sqrt(fc_pa / 1e6)
 
 
+#: Eurocode 2 (EN 1992-1-1:2004, Table 3.1): the strength classes C f_ck / f_ck,cube, in MPa
+EC2_CYLINDER_MPA = (12.0, 16.0, 20.0, 25.0, 30.0, 35.0, 40.0, 45.0, 50.0, 55.0, 60.0, 70.0, 80.0, 90.0)
+EC2_CUBE_MPA = (15.0, 20.0, 25.0, 30.0, 37.0, 45.0, 50.0, 55.0, 60.0, 67.0, 75.0, 85.0, 95.0, 105.0)
+STRENGTH_BASES = ("cylinder", "cube")
+
+
+def cylinder_strength(fc_pa: float, basis: str = "cylinder") -> float:
+    """The cylinder strength f_c (Pa) of a concrete whose compressive strength ``fc_pa`` (Pa) was measured on
+    ``basis`` "cylinder" (returned as is) or "cube" (150 mm cubes, as Chinese GB 50010 grades such as C40 are
+    quoted): converted by Eurocode 2's pairs of cylinder and cube strengths (EN 1992-1-1 Table 3.1),
+    interpolated linearly between the classes and at the end classes' ratios outside them (0.80 below C12/15,
+    0.857 above C90/105) (docs/theory.md §8.1)."""
+    if basis == "cylinder":
+        return fc_pa
+    if basis != "cube":
+        raise ValueError(f"strength basis {basis!r}: one of {', '.join(STRENGTH_BASES)}")
+    cube = fc_pa / 1e6
+    lo, hi = EC2_CUBE_MPA[0], EC2_CUBE_MPA[-1]
+    if cube <= lo:
+        return fc_pa * EC2_CYLINDER_MPA[0] / lo
+    if cube >= hi:
+        return fc_pa * EC2_CYLINDER_MPA[-1] / hi
+    return float(np.interp(cube, EC2_CUBE_MPA, EC2_CYLINDER_MPA)) * 1e6
+
+
 def metal_cavity_stress(E: float, Y: float, n: float) -> float:
     """Quasi-static radial stress of a spherical cavity expanded in an incompressible elastic, power-law
     strain-hardening metal (σ = E ε, then σ = Y (E ε / Y)^n) (Luk, Forrestal & Amos 1991; the σ_s of
@@ -157,7 +182,8 @@ class TargetLaw:
         B: inertial factor. thickness: None for semi-infinite.
         crater: "none", "linear" or "energy"; k: crater depth factor; D: projectile diameter (m).
         separation, phi_min: switch and minimum separation angle (rad).
-        free_surface: switch the plastic-zone truncation by the face.
+        free_surface: switch the plastic-zone truncation by the face; surface_range: how far from the face it
+            acts, in plastic-zone widths (c/a → min(c/a, 1 + L_e/(surface_range ρ))).
         friction, mu: friction switch and (static) coefficient; mu_dynamic (None: mu) and mu_decay (s/m):
             the velocity-dependent sliding law (sliding_friction).
         lock_density: Q1 of the energy crater (kg/m^3); crush_strain: ε of the energy crater.
@@ -193,6 +219,7 @@ class TargetLaw:
     onset: float = 0.0
     top: float = 0.0
     bottom: float | None = None
+    surface_range: float = 1.0
 
     @property
     def lower(self) -> float | None:
@@ -244,18 +271,15 @@ def immersion(law: TargetLaw, x: np.ndarray, area: np.ndarray) -> np.ndarray:
     return w
 
 
-def escape_length(law: TargetLaw, x: np.ndarray, n: np.ndarray) -> np.ndarray:
-    """Distance L_e from the point to the nearest free face along the outward normal (inf if the normal
-    never reaches a face): the path along which crushed medium escapes (docs/theory.md §8.3)."""
+def escape_length(law: TargetLaw, x: np.ndarray) -> np.ndarray:
+    """Distance L_e from each point to the nearest free face of the target (m): the shortest distance to
+    the front face y = 0 and, for a slab or a block of layers, to its rear face y = −thickness
+    (docs/theory.md §8.3). Finite at every incidence: the depth of the point below the face for a
+    semi-infinite target, so that the crater and the free-surface rule act at normal incidence too."""
     depth = np.maximum(-x[:, 1], 0.0)
-    ny = n[:, 1]
-    L = np.full(len(x), np.inf)
-    up = ny > SIN_TOL
-    L[up] = depth[up] / ny[up]
-    if law.thickness is not None:
-        down = ny < -SIN_TOL
-        L[down] = np.maximum(law.thickness - depth[down], 0.0) / (-ny[down])
-    return L
+    if law.thickness is None:
+        return depth
+    return np.minimum(depth, np.maximum(law.thickness - depth, 0.0))
 
 
 def tunnel_stress(law: TargetLaw, vn: np.ndarray, sigma_s) -> np.ndarray:
@@ -314,12 +338,12 @@ def normal_stress(law: TargetLaw, s: SurfaceState, vhat_tol: float = SIN_TOL):
         loaded &= sin_phi > math.sin(law.phi_min)
     sigma_s = np.full(len(vn), law.sigma_s)
     need_L = law.free_surface or law.crater == "energy"
-    L_e = escape_length(law, s.x, s.n) if need_L else None
+    L_e = escape_length(law, s.x) if need_L else None
+    if law.free_surface:
+        ca = np.minimum(law.c_over_a, 1.0 + L_e / (law.surface_range * np.maximum(s.radius, 1e-12)))
     if law.free_surface and not law.given_sigma_s:
-        ca = np.minimum(law.c_over_a, 1.0 + L_e / np.maximum(s.radius, 1e-12))
         sigma_s = quasi_static_stress(law.Y, law.E, law.T, law.lam, ca)
     elif law.free_surface:  # σ_s given: scale it like the cavity-expansion value
-        ca = np.minimum(law.c_over_a, 1.0 + L_e / np.maximum(s.radius, 1e-12))
         sigma_s = law.sigma_s * quasi_static_stress(law.Y, law.E, law.T, law.lam, ca) / quasi_static_stress(
             law.Y, law.E, law.T, law.lam, law.c_over_a)
     if law.onset > 0.0:  # σ_s develops over the first `onset` of surface angle (grazing: no expansion)
@@ -454,7 +478,7 @@ def _law_numbers(law: TargetLaw) -> np.ndarray:
                      law.phi_min, float(law.free_surface), float(law.friction), law.mu,
                      law.mu if law.mu_dynamic is None else law.mu_dynamic, law.mu_decay, law.lock_density,
                      law.crush_strain, law.c_over_a, float(law.given_sigma_s), law.onset, law.top,
-                     -1.0 if law.lower is None else law.lower])
+                     -1.0 if law.lower is None else law.lower, law.surface_range])
 
 
 def _bind(lib):

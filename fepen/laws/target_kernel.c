@@ -9,7 +9,8 @@
 enum { P_DENSITY, P_Y, P_E, P_T, P_LAM, P_SIGMA_S, P_B, P_THICKNESS /* < 0: none */, P_CRATER /* 2: energy */,
        P_K, P_D, P_SEPARATION, P_PHI_MIN, P_FREE_SURFACE, P_FRICTION, P_MU, P_MU_DYNAMIC, P_MU_DECAY,
        P_LOCK_DENSITY, P_CRUSH_STRAIN, P_C_OVER_A, P_GIVEN_SIGMA_S, P_ONSET,
-       P_TOP /* the material's own faces in a block of layers */, P_LOWER /* < 0: none */, P_COUNT };
+       P_TOP /* the material's own faces in a block of layers */, P_LOWER /* < 0: none */,
+       P_SURFACE_RANGE /* the free face's reach in plastic-zone widths */, P_COUNT };
 
 #define SIN_TOL 1e-9
 
@@ -46,20 +47,16 @@ int32_t point_forces(int32_t k, const double *x, const double *v, const double *
         if (axis) loaded = loaded && (vi[0] * axis[0] + vi[1] * axis[1] + vi[2] * axis[2] > 0.0);
         if (p[P_SEPARATION] != 0.0) loaded = loaded && sin_phi > sin_min;
         if (!loaded || !(vn > 0.0)) continue;
-        double Le = INFINITY;
-        if (p[P_FREE_SURFACE] != 0.0 || p[P_CRATER] == 2.0) {
-            double depth = fmax(-y, 0.0), ny = ni[1];
-            if (ny > SIN_TOL) Le = depth / ny;
-            else if (thk >= 0.0 && ny < -SIN_TOL) Le = fmax(thk - depth, 0.0) / (-ny);
-        }
+        /* L_e: the shortest distance to the block's front face, or its rear face when it has one */
+        double depth = fmax(-y, 0.0), Le = thk >= 0.0 ? fmin(depth, fmax(thk - depth, 0.0)) : depth;
         double s = p[P_SIGMA_S];
         if (p[P_FREE_SURFACE] != 0.0) {
-            double ca = fmin(p[P_C_OVER_A], 1.0 + Le / fmax(radius[i], 1e-12));
+            double ca = fmin(p[P_C_OVER_A], 1.0 + Le / (p[P_SURFACE_RANGE] * fmax(radius[i], 1e-12)));
             s = p[P_GIVEN_SIGMA_S] != 0.0 ? p[P_SIGMA_S] * cavity_stress(p, ca) / ref : cavity_stress(p, ca);
         }
         if (p[P_ONSET] > 0.0) s *= fmin(sin_phi / sin_onset, 1.0);
         double sg = (s + p[P_B] * p[P_DENSITY] * vn * vn) * frac;
-        if (p[P_CRATER] == 2.0 && -y < p[P_K] * p[P_D] && isfinite(Le)) { /* else e_str = inf: kept */
+        if (p[P_CRATER] == 2.0 && -y < p[P_K] * p[P_D]) {
             double rho = fmax(radius[i], 1e-12), l = (p[P_C_OVER_A] - 1.0) * rho, integral = 0.0;
             for (int32_t g = 0; g < ng; ++g) {
                 double w = 0.5 * l * (gauss[g] + 1.0), q = rho / (rho + w);

@@ -110,6 +110,54 @@ def test_free_surface_truncates_the_plastic_zone():
     assert sig[2] == pytest.approx(L.sigma_s, rel=1e-9)  # deep: the full cavity-expansion stress
 
 
+def test_escape_length_is_the_shortest_distance_to_a_face():
+    """L_e is the distance to the nearest face whatever the normal (theory.md §8.3): the depth below the
+    front face, or the distance to a slab's rear face when that is nearer; finite at normal incidence."""
+    x = np.array([[0.0, 0.01, 0.0], [0.3, -0.05, 0.2], [0.0, -0.29, 0.0], [0.0, -0.31, 0.0]])
+    assert list(tg.escape_length(law(), x)) == pytest.approx([0.0, 0.05, 0.29, 0.31])
+    assert list(tg.escape_length(law(thickness=0.3), x)) == pytest.approx([0.0, 0.05, 0.01, 0.0])
+
+
+def test_free_surface_reach_scales_the_truncation():
+    """surface_range r: c/a -> min(c/a, 1 + L_e/(r rho)): r = 2 at depth 2h gives what r = 1 gives at h."""
+    base = dict(free_surface=True, sigma_s=float(tg.quasi_static_stress(40e6, 32.5e9, 4e6, 0.67)))
+    n = np.array([[0.0, -1.0, 0.0]])
+    v = np.array([[0.0, -100.0, 0.0]])
+
+    def sigma(r, h):
+        st = tg.SurfaceState(np.array([[0.0, -h, 0.0]]), v, n, np.full(1, SMALL), np.full(1, 0.01),
+                             np.full(1, np.inf), np.zeros(1))
+        return tg.normal_stress(law(surface_range=r, **base), st)[0][0]
+
+    assert sigma(2.0, 0.02) == pytest.approx(sigma(1.0, 0.01), rel=1e-12)
+    assert sigma(2.0, 0.02) < sigma(1.0, 0.02)
+
+
+def test_cube_strength_converts_by_eurocode_2():
+    """EN 1992-1-1 Table 3.1: C40/50 (a 50 MPa cube is a 40 MPa cylinder), linear between classes, the end
+    classes' ratios outside; a cylinder strength is returned as is; anything else is refused."""
+    assert tg.cylinder_strength(50e6, "cube") == pytest.approx(40e6)
+    assert tg.cylinder_strength(41e6, "cube") == pytest.approx(32.5e6)  # between C30/37 and C35/45
+    assert tg.cylinder_strength(10e6, "cube") == pytest.approx(8e6)
+    assert tg.cylinder_strength(210e6, "cube") == pytest.approx(180e6)
+    assert tg.cylinder_strength(33e6, "cylinder") == 33e6
+    cubes = np.linspace(5e6, 200e6, 300)
+    assert np.all(np.diff([tg.cylinder_strength(c, "cube") for c in cubes]) > 0)  # monotonic
+    with pytest.raises(ValueError):
+        tg.cylinder_strength(40e6, "prism")
+
+
+def test_the_papers_concrete_is_a_cube_strength():
+    """The default concrete is the paper's C40 (cube): f_c = 31.875 MPa, T = f_c/10; a strength given without
+    a basis is a cylinder's, and a given cube strength is converted."""
+    L = setup.target_law(scene.load(None, []))
+    assert L.Y == pytest.approx(31.875e6) and L.T == pytest.approx(3.1875e6)
+    L = setup.target_law(scene.load(None, ["target.compressive_strength=40e6"]))
+    assert L.Y == 40e6 and L.T == pytest.approx(4e6)
+    L = setup.target_law(scene.load(None, ["target.compressive_strength=50e6", 'target.strength_basis="cube"']))
+    assert L.Y == pytest.approx(40e6)
+
+
 def test_friction_opposes_sliding():
     L = law(friction=True, mu=0.2)
     n = np.array([[1.0, 0.0, 0.0]])
@@ -156,7 +204,8 @@ def test_scene_builds_the_law():
     sc = scene.load(None, ["effects.crater=linear", "target.quasi_static_stress=4.4e8"])
     L = setup.target_law(sc)
     assert L.sigma_s == 4.4e8 and L.crater == "linear" and L.given_sigma_s
-    L2 = setup.target_law(scene.load(None, ["target.strength_model=cavity-expansion"]))
+    L2 = setup.target_law(scene.load(None, ["target.strength_model=cavity-expansion",
+                                            "target.compressive_strength=40e6"]))
     E = 4.7e9 * math.sqrt(40.0)  # ACI 318 from fc when target.youngs_modulus is absent
     assert L2.E == pytest.approx(E) and not L2.given_sigma_s
     assert L2.sigma_s == pytest.approx(float(tg.quasi_static_stress(40e6, E, 4e6, 0.67)))
@@ -169,8 +218,9 @@ def test_friction_on_takes_the_constants_refitted_with_friction():
     D = 0.0236
     off = setup.target_law(scene.load(None, []))
     on = setup.target_law(scene.load(None, ["effects.friction=true"]))
-    assert off.sigma_s == pytest.approx(tg.strength_S(40e6, D, *tg.S_MODELS["scaled-S"]) * 40e6, rel=1e-12)
-    assert on.sigma_s == pytest.approx(tg.strength_S(40e6, D, *tg.SCALED_S_FRICTION) * 40e6, rel=1e-12)
+    fc = 31.875e6  # the paper's C40 as a cylinder strength
+    assert off.sigma_s == pytest.approx(tg.strength_S(fc, D, *tg.S_MODELS["scaled-S"]) * fc, rel=1e-12)
+    assert on.sigma_s == pytest.approx(tg.strength_S(fc, D, *tg.SCALED_S_FRICTION) * fc, rel=1e-12)
     assert on.sigma_s < off.sigma_s  # friction carries part of the resistance
     assert setup.friction_note(scene.load(None, ["effects.friction=true"])) is None
     assert setup.friction_note(scene.load(None, [])) is None
@@ -227,7 +277,8 @@ def test_forrestal_strength_model_gives_s_fc():
                                                  f"target.compressive_strength={fc}"]))
         assert law.sigma_s == pytest.approx(82.6 * (fc / 1e6) ** -0.544 * fc, rel=1e-12)
     cavity = setup.target_law(scene.load(None, ["target.strength_model=cavity-expansion",
-                                                "target.youngs_modulus=32.5e9"]))
+                                                "target.youngs_modulus=32.5e9",
+                                                    "target.compressive_strength=40e6"]))
     assert cavity.sigma_s == pytest.approx(369e6, rel=0.01)  # theory.md §8.1, the paper's concrete
 
 
@@ -252,5 +303,6 @@ def test_concrete_from_its_strength_alone():
         assert L.sigma_s == pytest.approx(tg.strength_S(fc, 0.0236, a, b, D0) * fc, rel=1e-14)
         assert L.given_sigma_s  # the free surface scales it, does not replace it by the cavity expansion
     L = setup.target_law(scene.load(None, ["target.youngs_modulus=20e9", "target.S_coefficient=50",
-                                           "target.S_exponent=0", "target.S_size=1e6"]))
+                                           "target.S_exponent=0", "target.S_size=1e6",
+                                               "target.compressive_strength=40e6"]))
     assert L.E == 20e9 and L.sigma_s == pytest.approx(50 * 40e6, rel=1e-6)

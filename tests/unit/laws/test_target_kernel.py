@@ -21,7 +21,8 @@ LAWS = {
     "friction mu(v)": dict(friction=True, mu=0.3, mu_dynamic=0.05, mu_decay=0.01),
     "Coulomb friction, energy crater, plate": dict(friction=True, mu=0.1, crater="energy", thickness=0.25),
     "everything": dict(crater="energy", free_surface=True, separation=True, phi_min=0.02, friction=True,
-                       mu=0.2, mu_dynamic=0.1, mu_decay=0.02, thickness=0.4, onset=0.03, given_sigma_s=True),
+                       mu=0.2, mu_dynamic=0.1, mu_decay=0.02, thickness=0.4, onset=0.03, given_sigma_s=True,
+                       surface_range=2.5),
 }
 
 
