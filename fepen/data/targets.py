@@ -23,4 +23,5 @@ FAMILIES = ("concrete", "rock", "metal", "soil")
 #: the target.* keys a material (or a layer's table) may set
 CONSTANTS = ("density", "compressive_strength", "youngs_modulus", "tensile_strength", "pressure_hardening",
              "strength_model", "S_coefficient", "S_exponent", "S_size", "quasi_static_stress", "inertial_factor",
-             "yield_stress", "hardening_exponent", "crater_depth_factor", "lock_density")
+             "yield_stress", "hardening_exponent", "crater_depth_factor", "lock_density", "crush_strain",
+             "free_surface_range", "strength_basis")

@@ -90,7 +90,8 @@ def material_law(scene, c: dict, thickness: float | None) -> tg.TargetLaw:
         T, lam, ca, crush, density = Y, 0.0, tg.metal_cavity_ratio(E, Y), 0.0, get("density")
         given_flag = True
     else:
-        Y, T, lam = get("compressive_strength"), get("tensile_strength"), get("pressure_hardening")
+        Y = tg.cylinder_strength(get("compressive_strength"), get("strength_basis") or "cylinder")
+        T, lam = get("tensile_strength"), get("pressure_hardening")
         E = get("youngs_modulus") or tg.youngs_modulus_aci(Y)
         density = get("density")
         if given is not None:
@@ -105,7 +106,7 @@ def material_law(scene, c: dict, thickness: float | None) -> tg.TargetLaw:
             sigma_s = tg.strength_S(Y, scene.projectile.diameter, a, b, size) * Y
         else:
             sigma_s = float(tg.quasi_static_stress(Y, E, T, lam))
-        ca, crush = tg.cavity_ratio(Y, E, T), 1.0 - density / lock
+        ca, crush = tg.cavity_ratio(Y, E, T), get("crush_strain") or 1.0 - density / lock
         given_flag = given is not None or model != "cavity-expansion"
     return tg.TargetLaw(
         density=density, Y=Y, E=E, T=T, lam=lam, sigma_s=sigma_s, B=B,
@@ -114,7 +115,8 @@ def material_law(scene, c: dict, thickness: float | None) -> tg.TargetLaw:
         free_surface=e.free_surface, friction=e.friction, mu=t.friction,
         mu_dynamic=scene.get("target.friction_dynamic"), mu_decay=t.friction_decay,
         lock_density=lock, crush_strain=crush, c_over_a=ca, given_sigma_s=given_flag,
-        onset=math.radians(t.onset_angle_deg))
+        onset=math.radians(t.onset_angle_deg),
+        surface_range=get("free_surface_range") or SCHEMA["target.free_surface_range"].default)
 
 
 #: cavity keys that, when the user gives any of them, fix the cavity (its length is still sized to the mass)

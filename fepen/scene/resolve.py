@@ -16,7 +16,7 @@ from typing import Any
 
 from fepen.data import CONSTANTS, STEELS, TARGETS, shot
 from fepen.errors import InputError
-from fepen.laws.target import a_over_c_cubed, youngs_modulus_aci
+from fepen.laws.target import a_over_c_cubed, cylinder_strength, youngs_modulus_aci
 from fepen.scene.keys import ABSENT, display_name
 from fepen.scene.schema import SCHEMA, SECTIONS
 
@@ -101,11 +101,12 @@ def _concrete_law(where: str, c: dict, family: str, given: set) -> None:
     if c.get("strength_model") == "metal":
         raise InputError(f"{where}.strength_model", f"'metal' is the law of a metal target.material (6061-T6511, "
                                                     f"armour-steel), not of a {family} one")
-    fc, T = c["compressive_strength"], c["tensile_strength"]
+    fc, T = cylinder_strength(c["compressive_strength"], c.get("strength_basis") or "cylinder"), c["tensile_strength"]
     if T >= fc:
         key = _given_one(given, "tensile_strength", "compressive_strength")
+        cube = "" if fc == c["compressive_strength"] else f" (of the {c['compressive_strength']:g} Pa cube)"
         raise InputError(f"{where}.{key}", f"tensile strength {T:g} Pa must be below compressive strength "
-                                           f"{fc:g} Pa")
+                                           f"{fc:g} Pa{cube}")
     E = c.get("youngs_modulus") or youngs_modulus_aci(fc)
     ratio = a_over_c_cubed(fc, E, T)
     if ratio >= 1.0:
@@ -379,18 +380,21 @@ def _resolve_steel(flat: dict, given: dict) -> None:
             flat[name] = SCHEMA[name].check(name, value)
 
 
-def _tensile_default(fc: float) -> float:
-    """target.tensile_strength when neither the scene nor the material gives it: f_c / 10."""
-    return 0.1 * fc
+def _tensile_default(fc: float, basis: str | None = "cylinder") -> float:
+    """target.tensile_strength when neither the scene nor the material gives it: f_c / 10, of the cylinder
+    strength (a cube strength converted, fepen.laws.target.cylinder_strength)."""
+    return 0.1 * cylinder_strength(fc, basis or "cylinder")
 
 
 def _material_constants(name: str, given: dict, crater_given: str | None) -> dict:
     """Every target constant of a named material, the given ones winning, with the derived defaults
     (tensile strength f_c/10) and its crater (the scene's explicit effects.crater, else the material's)."""
     out = {k: v for k, v in TARGETS[name].items() if k in CONSTANTS}
+    if "compressive_strength" in given and "strength_basis" in out:  # a material's basis goes with its strength
+        out["strength_basis"] = "cylinder"
     out.update(given)
     if "tensile_strength" not in out and "compressive_strength" in out:
-        out["tensile_strength"] = _tensile_default(out["compressive_strength"])
+        out["tensile_strength"] = _tensile_default(out["compressive_strength"], out.get("strength_basis"))
     out["crater"] = crater_given or TARGETS[name].get("crater", "energy")
     out["family"] = TARGETS[name]["family"]
     _metal_constants_known(name, out)
@@ -427,7 +431,8 @@ def _resolve_target(flat: dict, given: dict) -> None:
                 flat[f"target.{k}"] = SCHEMA[f"target.{k}"].check(f"target.{k}", constants[k])
         flat["effects.crater"] = constants["crater"]
     if "target.tensile_strength" not in flat:
-        flat["target.tensile_strength"] = _tensile_default(flat["target.compressive_strength"])
+        flat["target.tensile_strength"] = _tensile_default(flat["target.compressive_strength"],
+                                                           flat.get("target.strength_basis"))
 
 
 def resolve(given: dict[str, Any]) -> Scene:

@@ -115,7 +115,12 @@ SCHEMA: dict[str, Key] = {
     "target.yield_stress": positive(ABSENT, "Pa", 1.0e11, doc="Y of a metal target (strength_model 'metal')"),
     "target.hardening_exponent": number(ABSENT, "", 0.0, 1.0, hi_open=True,
                                         doc="n of a metal target's power-law hardening Y (E eps / Y)^n"),
-    "target.compressive_strength": number(40.0e6, "Pa", 1.0e5, 1.0e10),
+    "target.compressive_strength": number(40.0e6, "Pa", 1.0e5, 1.0e10,
+                                          doc="f_c, on target.strength_basis (a cube value is converted)"),
+    "target.strength_basis": choice("cylinder", "cylinder", "cube",
+                                    doc="what compressive_strength was measured on: 'cylinder' (f_c, ACI/ASTM), "
+                                        "or 'cube' (150 mm cubes, e.g. GB 50010 grades), converted to f_c by "
+                                        "Eurocode 2 Table 3.1 (docs/theory.md §8.1)"),
     "target.density": number(2400.0, "kg/m^3", 100.0, 30000.0),
     "target.youngs_modulus": positive(ABSENT, "Pa", 1.0e13, doc="absent: 4.7 sqrt(f_c / MPa) GPa (ACI 318)"),
     "target.tensile_strength": positive(ABSENT, "Pa", 1.0e10, doc="absent: compressive_strength / 10"),
@@ -143,6 +148,12 @@ SCHEMA: dict[str, Key] = {
     "target.thickness": positive(ABSENT, "m", 100.0, doc="absent: semi-infinite"),
     "target.lock_density": number(2650.0, "kg/m^3", 100.0, 30000.0,
                                   doc="Q1, density of fully compacted concrete (energy crater)"),
+    "target.crush_strain": number(ABSENT, "", 0.0, 1.0, lo_open=True,
+                                  doc="epsilon of the energy crater's strength energy; absent: 1 - density / "
+                                      "lock_density"),
+    "target.free_surface_range": number(1.0, "", 0.0, 20.0, lo_open=True,
+                                        doc="reach of the free face on sigma_s, in plastic-zone widths "
+                                            "(effects.free_surface; docs/theory.md §8.4)"),
     # --- striking conditions (Table 1; defaults are shot C3) ---
     "impact.velocity": number(_C3.v0, "m/s", 0.0, 3000.0, lo_open=True),
     "impact.obliquity_deg": number(_C3.obliquity_deg, "deg", 0.0, 90.0, hi_open=True),

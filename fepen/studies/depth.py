@@ -32,7 +32,7 @@ __all__ = ["Row", "read_set", "table1_set", "shipped_sets", "scene_sets", "rigid
 
 COLUMNS = ("shot", "d_mm", "m_kg", "crh", "L_mm", "v_ms", "fc_mpa", "rho_kgm3", "depth_m")
 #: what a set's f_c can have been measured on (column ``strength_basis``; absent or empty: the first)
-STRENGTH_BASES = ("cylinder", "cube")
+STRENGTH_BASES = tg.STRENGTH_BASES
 
 
 @dataclass(frozen=True)
@@ -90,9 +90,10 @@ def read_set(path) -> list[Row]:
 
 
 def table1_set() -> list[Row]:
-    """The paper's eight shots (Table 1) with its projectile and target (docs/paper.md): depth = Hy."""
+    """The paper's eight shots (Table 1) with its projectile and target (docs/paper.md; its 40 MPa is the C40
+    grade, a cube strength, docs/theory.md §8.1): depth = Hy."""
     return [Row(s.name, 0.0236, 0.144, 0.367, 3.0, s.v0, 40e6, 2400.0, s.Hy_mm / 1e3, s.obliquity_deg,
-                s.attack_deg) for s in SHOTS.values()]
+                s.attack_deg, "cube") for s in SHOTS.values()]
 
 
 def shipped_sets() -> dict[str, Path]:
@@ -107,7 +108,8 @@ def scene_sets(row: Row) -> list[str]:
     return ["effects.fidelity=rigid", f"projectile.diameter={row.D!r}", f"projectile.length={row.L!r}",
             f"projectile.crh={row.crh!r}", f"projectile.mass={row.mass!r}", f"impact.velocity={row.V!r}",
             f"impact.obliquity_deg={row.obliquity_deg!r}", f"impact.attack_deg={row.attack_deg!r}",
-            f"target.compressive_strength={row.fc!r}", f"target.density={row.rho!r}"]
+            f"target.compressive_strength={row.fc!r}", f"target.strength_basis={row.strength_basis!r}",
+            f"target.density={row.rho!r}"]
 
 
 def rigid_depth(row: Row, sets=()) -> float:
@@ -132,11 +134,13 @@ def closed_form_depth(row: Row, S: float | None = None, k: float = 2.0) -> float
         P = (m / (2π a² ρ N*)) ln(1 + N* ρ V1² / (S f_c)) + k D,
         V1² = (m V² − π a² k D S f_c) / (m + π a² k D N* ρ)   (P > k D; else the crater alone)
 
-    with Forrestal's S = 82.6 f_c^−0.544 unless S is given, and k = 2 (their 4a).
+    with Forrestal's S = 82.6 f_c^−0.544 unless S is given, and k = 2 (their 4a); f_c the row's cylinder
+    strength (a cube strength converted, fepen.laws.target.cylinder_strength).
     """
-    S = tg.forrestal_S(row.fc) if S is None else S
+    fc = tg.cylinder_strength(row.fc, row.strength_basis)
+    S = tg.forrestal_S(fc) if S is None else S
     a, m, N, rho = 0.5 * row.D, row.mass, tg.ogive_nose_factor(row.crh), row.rho
-    R, kD = S * row.fc, k * row.D
+    R, kD = S * fc, k * row.D
     V1sq = (m * row.V**2 - math.pi * a * a * kD * R) / (m + math.pi * a * a * kD * N * rho)
     if V1sq <= 0.0:  # stops in the crater, where the force is c z, c = π a² R/(k D): m V² = c P²
         return math.sqrt(m * row.V**2 * kD / (math.pi * a * a * R))

@@ -16,7 +16,8 @@ def test_defaults_are_the_paper_and_shot_c3():
     t = sc.target
     assert (t.density, t.compressive_strength, t.pressure_hardening) == (2400.0, 40e6, 0.67)
     assert sc.get("target.youngs_modulus") is None  # from fc (ACI 318) unless given
-    assert t.tensile_strength == pytest.approx(4e6)  # fc / 10 when not given
+    assert sc.get("target.strength_basis") == "cube"  # the paper's C40 (docs/theory.md §8.1)
+    assert t.tensile_strength == pytest.approx(3.1875e6)  # fc / 10 when not given, of the cylinder strength
     assert (sc.impact.velocity, sc.impact.obliquity_deg, sc.impact.attack_deg) == (584.3, 10.5, 0.10)
     assert sc.get("impact.shot") is None and sc.get("target.thickness") is None
 
