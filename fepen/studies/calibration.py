@@ -1,25 +1,31 @@
-"""The one calibration of the target's strength (docs/validation-depth.md): the constants of the "scaled-S"
-strength model, σ_s = a (f_c/MPa)^−b f_c / √(1 + D/D0), chosen once by one procedure on the calibration
-sets, with the rigid fidelity and everything else at fepen's defaults.
+"""The one calibration of the concrete law's open constants (docs/validation-depth.md, docs/validation.md):
+the separation angle φ_min, the energy crater's crush strain ε, the free face's reach on σ_s, and the
+"scaled-S" strength σ_s = a (f_c/MPa)^−b f_c / √(1 + D/D0), chosen together, once, by one procedure, on
+Table 1's nose and tail positions and on the public depth sets of CALIBRATION_SETS, with the rigid fidelity
+and everything else at fepen's defaults.
 
 The procedure:
-  1. for every calibration shot and each crater model of CRATERS, the rigid fidelity's depth at GRID values
-     of S = σ_s/f_c (given through target.quasi_static_stress; the law is then the "scaled-S" law at that S
-     exactly);
-  2. ln(depth) interpolated in ln S between those runs (depth falls monotonically with S);
-  3. b held at the published EXPONENT; (ln a, ln D0) minimising the mean over the sets of each set's mean
-     |ln(P_pred/P_meas)|, so that each set counts once however many shots it has (a grid, then
-     Nelder–Mead), for each crater. The paper's energy crater is kept unless another lowers the objective
-     by more than two standard deviations of the difference over bootstrap resamples of each set's shots
-     (a difference the data resolve). The same fit with b
-     free and without the size effect is reported beside it, and whether any (a, D0) would make every
-     set's mean |error| no larger than Forrestal's closed form's (closed_form_bound).
+  1. every combination ("node") of the open constants' values in OPEN;
+  2. for every node and every calibration shot, the rigid fidelity at the S = σ_s/f_c values S_SPAN times
+     Forrestal's published S of the shot's strength (given through target.quasi_static_stress: the law is
+     then the "scaled-S" law at that S exactly): Table 1's shots give their final nose and tail positions
+     (Hx, Hy, Tx, Ty), the depth sets' shots their depth;
+  3. each result interpolated in ln S between those runs (linearly; ln depth for the depth sets);
+  4. at every node, b held at the published EXPONENT and (ln a, ln D0) minimising the objective: the mean over
+     the groups of each group's mean error, so that each group counts once however many shots it has. Table
+     1's error of a shot is the mean of its nose and tail errors |H − H_exp|/|H_exp| (docs/validation.md);
+     a depth set's is |ln(P_pred/P_meas)|. A grid, then Nelder–Mead;
+  5. the node with the smallest fitted objective, with its a and D0, is the calibration.
 
-    .venv/bin/python -m fepen.studies.calibration DIR [CURVES_PREFIX]   # DIR: the sets' CSV files
+    .venv/bin/python -m fepen.studies.calibration [--data DIR] [--curves FILE] [--workers W] [--set K=V]
+
+Runs in about 10^4 rigid runs (docs/validation-depth.md gives the time); ``--curves`` keeps them in an .npz
+file so that the fit (seconds) can be repeated from them.
 """
 
 from __future__ import annotations
 
+import itertools
 import math
 import sys
 from pathlib import Path
@@ -29,210 +35,212 @@ import numpy as np
 from fepen.laws import target as tg
 from fepen.studies import depth
 
-__all__ = ["CALIBRATION_SETS", "CRATERS", "GRID", "closed_form_bound", "depth_curves", "difference_sd", "fit",
-           "main"]
+__all__ = ["CALIBRATION_SETS", "OPEN", "S_SPAN", "EXPONENT", "nodes", "curves", "predicted", "group_errors",
+           "objective", "fit", "calibrate", "shipped_node", "main"]
 
-#: the calibration sets (file stems; "table1" is the paper's Table 1) and what each informs
+#: the calibration groups (file stems of fepen/data/depth; "table1" is the paper's Table 1, by its positions)
+#: and what each informs
 CALIBRATION_SETS = {
-    "table1": "the paper's 8 shots, 40 MPa, 23.6 mm, 517-893 m/s, oblique",
-    "forrestal1994_d26.9mm": "f_c 32-108 MPa at one size (26.9 mm): the exponent b",
-    "oneil1999": "f_c 155-163 MPa at 26.9 mm: the exponent b at very high strength",
-    "forrestal1994_d76.2mm": "76.2 mm, 13 kg into 23 and 39 MPa: the size D0 and b",
+    "table1": "the paper's 8 shots, C40, 23.6 mm, 517-893 m/s, 0.4-20 deg: the nose and tail positions, the "
+              "turning of the oblique paths (phi_min, crater, free face) and S at one size",
+    "forrestal1994_d26.9mm": "f_c 32-108 MPa at one size (26.9 mm): S against f_c",
+    "oneil1999": "f_c 155-163 MPa at 26.9 mm: S at very high strength",
+    "forrestal1994_d76.2mm": "76.2 mm, 13 kg into 23 and 39 MPa: the size D0",
     "wu2020": "geometrically scaled 10-203 mm at one f_c and speed: the size D0",
 }
 #: the exponent b of f_c, held at Frew, Hanchak, Green and Forrestal's (1998) published value: the
 #: calibration sets have no small-calibre shot below 32 MPa, where b matters most
 EXPONENT = tg.S_MODELS["forrestal-S"][1]
-#: the crater models chosen between, with their scene settings: the paper's energy crater (k = 2.37), and
-#: Forrestal et al.'s (1994) linear crater with their k = 2, the crater their S(f_c) was fitted with
-CRATERS = {"energy": (), "linear": ("effects.crater=linear", "target.crater_depth_factor=2")}
-#: S = σ_s/f_c at which every calibration shot is run
-GRID = np.geomspace(1.5, 40.0, 15)
+#: the open constants and the values searched: the scene key -> values
+OPEN = {
+    "target.separation_angle_deg": (0.0, 3.0, 6.0, 9.0, 12.0),
+    "target.crush_strain": (0.094, 0.047, 0.0235),
+    "target.free_surface_range": (1.0, 2.0),
+}
+#: S = σ_s/f_c of the runs, as multiples of Forrestal's S = 82.6 (f_c/MPa)^−0.544 of the shot's strength
+S_SPAN = np.geomspace(0.4, 2.5, 7)
 
 
-def depth_curves(sets: dict[str, list], workers: int = 1, settings=()) -> dict[str, np.ndarray]:
-    """ln(depth) at every GRID value of S for every shot: name -> array (shots, len(GRID)).
+def nodes(open_=None) -> list[dict]:
+    """Every combination of the open constants' values: a list of {scene key: value}."""
+    open_ = OPEN if open_ is None else open_
+    return [dict(zip(open_, values)) for values in itertools.product(*open_.values())]
 
-    Args:
-        settings: further scene settings for every run (a crater model of CRATERS).
-    """
-    jobs = [(row, S, tuple(settings)) for rows in sets.values() for row in rows for S in GRID]
+
+def _forrestal_S(row) -> float:
+    return tg.forrestal_S(row.fc)
+
+
+def _scene_sets(name: str, row) -> list[str]:
+    """The rigid scene of one calibration shot: Table 1's shots as fepen runs them (the paper's projectile and
+    target), the depth sets' by fepen.studies.depth.scene_sets."""
+    if name == "table1":
+        return ["effects.fidelity=rigid", f'impact.shot="{row.name}"']
+    return depth.scene_sets(row)
+
+
+def _one(job) -> tuple:
+    """(Hx, Hy, Tx, Ty) (m) of one rigid run."""
+    from mpi4py import MPI
+
+    from fepen import scene
+    from fepen.runs.rigid import RigidRun
+
+    name, row, S, node, extra = job
+    sets = [*_scene_sets(name, row), f"target.quasi_static_stress={S * row.fc!r}",
+            *[f"{k}={v!r}" for k, v in node.items()], *extra]
+    s = RigidRun(scene.load(None, sets), None, MPI.COMM_SELF).run()
+    return tuple(s[k] / 1e3 for k in ("Hx_mm", "Hy_mm", "Tx_mm", "Ty_mm"))
+
+
+def _cylinder(row) -> float:
+    """The shot's cylinder strength (Pa): the row's strength on its basis (the paper's Table 1: C40 cube)."""
+    return tg.cylinder_strength(row.fc, getattr(row, "strength_basis", "cylinder"))
+
+
+def curves(sets: dict, node_list: list[dict], workers: int = 1, extra=()) -> np.ndarray:
+    """The runs of step 2: an object array [node][group] of arrays (shots, len(S_SPAN), 4) of (Hx, Hy, Tx, Ty)
+    (m); run shot by shot (all nodes and S of one shot together, so that a worker builds each projectile
+    once)."""
+    jobs = [(name, row, Sr * _forrestal_S(_Row(row)), node, tuple(extra))
+            for name, rows in sets.items() for row in rows for node in node_list for Sr in S_SPAN]
     if workers > 1:
         from concurrent.futures import ProcessPoolExecutor
 
         with ProcessPoolExecutor(workers) as pool:
-            p = list(pool.map(_one, jobs, chunksize=8))
+            out = list(pool.map(_one, jobs, chunksize=len(S_SPAN) * max(1, len(node_list) // 2)))
     else:
-        p = [_one(j) for j in jobs]
-    out, k = {}, 0
-    for name, rows in sets.items():
-        n = len(rows) * len(GRID)
-        out[name] = np.log(np.array(p[k:k + n])).reshape(len(rows), len(GRID))
-        k += n
+        out = [_one(j) for j in jobs]
+    res = np.array(out).reshape(-1, len(node_list), len(S_SPAN), 4)
+    table = np.empty((len(node_list), len(sets)), dtype=object)
+    k = 0
+    for j, rows in enumerate(sets.values()):
+        for i in range(len(node_list)):
+            table[i, j] = res[k:k + len(rows), i]
+        k += len(rows)
+    return table
+
+
+class _Row:
+    """A row seen with its cylinder strength (Forrestal's S and the scaled-S law take the cylinder f_c)."""
+
+    def __init__(self, row):
+        self.fc, self.D = _cylinder(row), row.D
+
+
+def strength_S(row, a: float, D0: float, b: float = EXPONENT) -> float:
+    """S of the scaled-S law for this shot (its cylinder strength, its diameter)."""
+    r = _Row(row)
+    return tg.strength_S(r.fc, r.D, a, b, D0)
+
+
+def predicted(rows, table: np.ndarray, a: float, D0: float, b: float = EXPONENT) -> np.ndarray:
+    """(Hx, Hy, Tx, Ty) (m) of the shots under the scaled-S constants, interpolated in ln S (step 3): (shots, 4)."""
+    out = np.empty((len(rows), 4))
+    for i, row in enumerate(rows):
+        grid = np.log(S_SPAN * _forrestal_S(_Row(row)))
+        s = math.log(strength_S(row, a, D0, b))
+        for q in range(4):
+            c = table[i, :, q]
+            out[i, q] = math.exp(np.interp(s, grid, np.log(c))) if q == 1 else np.interp(s, grid, c)
     return out
 
 
-def _one(job) -> float:
-    row, S, settings = job
-    return depth.rigid_depth(row, [f"target.quasi_static_stress={S * row.fc!r}", *settings])
+def group_errors(name: str, rows, pred: np.ndarray) -> np.ndarray:
+    """Each shot's error (step 4): Table 1's mean of nose and tail errors, a depth set's |ln(P_pred/P_meas)|."""
+    if name == "table1":
+        from fepen.data import SHOTS
+
+        e = [SHOTS[r.name] for r in rows]
+        H = np.array([(x.Hx_mm, x.Hy_mm) for x in e]) / 1e3
+        T = np.array([(x.Tx_mm, x.Ty_mm) for x in e]) / 1e3
+        nose = np.linalg.norm(np.abs(pred[:, :2]) - H, axis=1) / np.linalg.norm(H, axis=1)
+        tail = np.linalg.norm(np.abs(pred[:, 2:]) - T, axis=1) / np.linalg.norm(T, axis=1)
+        return 0.5 * (nose + tail)
+    return np.abs(np.log(pred[:, 1] / np.array([r.depth for r in rows])))
 
 
-def predicted(rows, curves: np.ndarray, a: float, b: float, D0: float) -> np.ndarray:
-    """Depths (m) of the shots under the scaled-S constants, from their interpolated curves."""
-    lnS = np.log([a * (r.fc / 1e6) ** -b / math.sqrt(1.0 + r.D / D0) for r in rows])
-    lg = np.log(GRID)
-    return np.exp([np.interp(s, lg, c) for s, c in zip(lnS, curves)])
+def objective(theta, sets: dict, tables) -> float:
+    """Mean over the groups of each group's mean error, at (ln a, ln D0) = theta; tables: [group] arrays."""
+    a, D0 = math.exp(theta[0]), math.exp(theta[1])
+    return float(np.mean([group_errors(name, rows, predicted(rows, t, a, D0)).mean()
+                          for (name, rows), t in zip(sets.items(), tables)]))
 
 
-def objective(theta, sets, curves) -> float:
-    """Mean over the sets of each set's mean |ln(P_pred/P_meas)|."""
-    a, b, D0 = math.exp(theta[0]), theta[1], math.exp(theta[2])
-    per_set = []
-    for name, rows in sets.items():
-        p = predicted(rows, curves[name], a, b, D0)
-        per_set.append(np.mean(np.abs(np.log(p / np.array([r.depth for r in rows])))))
-    return float(np.mean(per_set))
-
-
-def fit(sets, curves, exponent: float | None = EXPONENT, size: bool = True) -> tuple[float, float, float]:
-    """The constants (a, b, D0 (m)) of the scaled-S model that minimise objective(): a grid over
-    (ln a, [b,] ln D0), then Nelder–Mead from its best point.
-
-    Args:
-        exponent: b held at this value (default: the published EXPONENT); None: fitted too.
-        size: False holds D0 at infinity (no size effect).
-    """
+def fit(sets: dict, tables) -> tuple[float, float, float]:
+    """(a, D0 (m), objective) minimising objective() at one node: a grid over (ln a, ln D0), then Nelder–Mead."""
     from scipy.optimize import minimize
 
-    def unpack(x):
-        x = list(x)
-        la = x.pop(0)
-        b = exponent if exponent is not None else x.pop(0)
-        lD0 = x.pop(0) if size else 30.0
-        return [la, b, lD0]
-
-    grids = [np.linspace(math.log(10.0), math.log(300.0), 35)]
-    if exponent is None:
-        grids.append(np.linspace(0.2, 0.8, 13))
-    if size:
-        grids.append(np.linspace(math.log(0.005), math.log(10.0), 23))
-    mesh = np.stack([g.ravel() for g in np.meshgrid(*grids, indexing="ij")], axis=1)
-    start = min(mesh, key=lambda x: objective(unpack(x), sets, curves))
-    step = np.array([0.1, 0.05, 0.3][: len(start)] if exponent is None else [0.1, 0.3][: len(start)])
-    simplex = np.vstack([start] + [start + np.eye(len(start))[i] * step[i] for i in range(len(start))])
-    best = minimize(lambda x: objective(unpack(x), sets, curves), start, method="Nelder-Mead",
-                    options={"initial_simplex": simplex, "xatol": 1e-6, "fatol": 1e-8, "maxiter": 4000})
-    la, b, lD0 = unpack(best.x)
-    return math.exp(la), b, math.exp(lD0)
+    grid = [(la, lD) for la in np.linspace(math.log(20.0), math.log(400.0), 31)
+            for lD in np.linspace(math.log(0.005), math.log(10.0), 19)]
+    start = np.array(min(grid, key=lambda x: objective(x, sets, tables)))
+    simplex = np.vstack([start, start + [0.1, 0.0], start + [0.0, 0.3]])
+    best = minimize(lambda x: objective(x, sets, tables), start, method="Nelder-Mead",
+                    options={"initial_simplex": simplex, "xatol": 1e-6, "fatol": 1e-9, "maxiter": 4000})
+    return math.exp(best.x[0]), math.exp(best.x[1]), float(best.fun)
 
 
-def difference_sd(sets, curves_a, theta_a, curves_b, theta_b, resamples: int = 2000, seed: int = 0) -> float:
-    """Standard deviation of objective(b) − objective(a) over bootstrap resamples of each set's shots (the
-    constants held): how finely the data resolve two fitted models. theta: (a, b, D0)."""
-    def log_errors(curves, theta):
-        return {n: np.abs(np.log(predicted(rows, curves[n], *theta) / np.array([r.depth for r in rows])))
-                for n, rows in sets.items()}
-
-    ea, eb = log_errors(curves_a, theta_a), log_errors(curves_b, theta_b)
-    rng = np.random.default_rng(seed)
-    d = np.empty(resamples)
-    for k in range(resamples):
-        picks = {n: rng.integers(0, len(ea[n]), len(ea[n])) for n in sets}
-        d[k] = np.mean([eb[n][i].mean() - ea[n][i].mean() for n, i in picks.items()])
-    return float(d.std())
+def calibrate(sets: dict, table: np.ndarray, node_list: list[dict]) -> list[tuple]:
+    """Step 4 at every node and step 5: [(objective, node, a, D0)] best first."""
+    out = []
+    for i, node in enumerate(node_list):
+        a, D0, obj = fit(sets, list(table[i]))
+        out.append((obj, node, a, D0))
+    return sorted(out, key=lambda r: r[0])
 
 
-def set_errors(sets, curves, a: float, b: float, D0: float) -> dict[str, float]:
-    """Each set's mean |P_pred/P_meas − 1| under the scaled-S constants."""
-    return {name: depth.errors(predicted(rows, curves[name], a, b, D0), [r.depth for r in rows])["mean_abs"]
-            for name, rows in sets.items()}
+def shipped_node() -> dict:
+    """The open constants as fepen ships them (the scene's defaults for the paper's concrete)."""
+    from fepen import scene
+
+    sc = scene.load(None, ["effects.fidelity=rigid"])
+    from fepen.runs import setup
+
+    law = setup.target_law(sc)
+    return {"target.separation_angle_deg": round(math.degrees(law.phi_min), 9),
+            "target.crush_strain": law.crush_strain, "target.free_surface_range": law.surface_range}
 
 
-def closed_form_bound(sets, curves, b: float = EXPONENT):
-    """Whether some (a, D0) makes every set's mean |error| no larger than Forrestal's closed form's on the
-    same rows (the acceptance of docs/validation-depth.md), searched on a grid of a in 20–400 and D0 in
-    5 mm–10 m (and no size effect).
-
-    Returns:
-        (the closed form's mean |error| per set, the best objective among the (a, D0) that meet the bound,
-        or None, with its a, D0 and errors).
-    """
-    bound = {name: depth.errors([depth.closed_form_depth(r) for r in rows], [r.depth for r in rows])["mean_abs"]
-             for name, rows in sets.items()}
-    best = None
-    for la in np.linspace(math.log(20.0), math.log(400.0), 121):
-        for lD0 in [*np.linspace(math.log(0.005), math.log(10.0), 61), 30.0]:
-            a, D0 = math.exp(la), math.exp(lD0)
-            e = set_errors(sets, curves, a, b, D0)
-            if all(e[n] <= bound[n] for n in sets):
-                obj = objective([la, b, lD0], sets, curves)
-                if best is None or obj < best[0]:
-                    best = (obj, a, D0, e)
-    return bound, best
+def load_sets(folder=None) -> dict[str, list]:
+    """The calibration groups: table1 from fepen, the others from fepen/data/depth (or ``folder``)."""
+    folder = Path(folder) if folder else Path(depth.shipped_sets()["wu2020"]).parent
+    return {name: depth.table1_set() if name == "table1" else depth.read_set(folder / f"{name}.csv")
+            for name in CALIBRATION_SETS}
 
 
-def load_sets(folder) -> dict[str, list]:
-    """The calibration sets: table1 from fepen, the others from CSV files in ``folder``."""
-    out = {}
-    for name in CALIBRATION_SETS:
-        out[name] = depth.table1_set() if name == "table1" else depth.read_set(Path(folder) / f"{name}.csv")
-    return out
+def report(sets, table, node_list, ranked) -> None:
+    """Every node's fit, then each group's errors at the chosen one."""
+    for obj, node, a, D0 in ranked:
+        print(f"objective {obj:.4f}  a {a:7.3f}  D0 {D0 * 1e3:9.2f} mm  " +
+              "  ".join(f"{k.split('.')[-1]} {v:g}" for k, v in node.items()))
+    obj, node, a, D0 = ranked[0]
+    i = node_list.index(node)
+    print(f"== chosen: {node}, coefficient {a:.4g}, exponent {EXPONENT}, size {D0:.4g} m (objective {obj:.4f})")
+    for j, (name, rows) in enumerate(sets.items()):
+        e = group_errors(name, rows, predicted(rows, table[i, j], a, D0))
+        print(f"  {name:24s} n {len(rows):3d}  mean error {e.mean():.1%}  worst {e.max():.1%}")
 
 
 def main(argv=None) -> int:
-    """``python -m fepen.studies.calibration DIR [CURVES_PREFIX] [--set KEY=VALUE ...]``: run (or reuse, from
-    CURVES_PREFIX-<crater>.npz) the curves of each crater, fit, choose the crater, report. ``--set`` lines go
-    to every run: the refit of σ_s for a friction law, e.g. ``--set effects.friction=true``."""
+    """``python -m fepen.studies.calibration [--data DIR] [--curves FILE] [--workers W] [--set KEY=VALUE]``."""
     import argparse
 
     ap = argparse.ArgumentParser(prog="python -m fepen.studies.calibration")
-    ap.add_argument("data")
-    ap.add_argument("prefix", nargs="?", default="calibration-curves")
+    ap.add_argument("--data", default=None, help="folder of the depth sets (default: fepen/data/depth)")
+    ap.add_argument("--curves", default=None, help=".npz file of the runs: read if it exists, else written")
+    ap.add_argument("--workers", type=int, default=2)
     ap.add_argument("--set", dest="sets", action="append", default=[], metavar="KEY=VALUE")
     args = ap.parse_args(sys.argv[1:] if argv is None else argv)
     sets = load_sets(args.data)
-    prefix = args.prefix
-    chosen, all_curves = {}, {}
-    for crater, settings in CRATERS.items():
-        settings = (*settings, *args.sets)
-        path = Path(f"{prefix}-{crater}.npz")
-        if path.exists():
-            z = np.load(path)
-            curves = {k: z[k] for k in sets}
-        else:
-            curves = depth_curves(sets, workers=2, settings=settings)
-            np.savez(path, grid=GRID, **curves)
-        all_curves[crater] = curves
-        print(f"== crater {crater} ({' '.join(settings) or 'the defaults'})")
-        for label, kw in (("chosen: b published, a and D0 fitted", {}),
-                          ("alternative: b fitted too", {"exponent": None}),
-                          ("alternative: b published, no size effect", {"size": False})):
-            a, b, D0 = fit(sets, curves, **kw)
-            obj = objective([math.log(a), b, math.log(D0)], sets, curves)
-            if not kw:
-                chosen[crater] = (obj, a, b, D0)
-            print(f"{label}: coefficient {a:.4g}, exponent {b:.4g}, size {D0:.4g} m; objective {obj:.4f}")
-            for name, rows in sets.items():
-                e = depth.errors(predicted(rows, curves[name], a, b, D0), [r.depth for r in rows])
-                print(f"  {name:24s} n {e['count']:3d}  mean |error| {e['mean_abs']:.1%}  bias {e['bias']:+.1%}  "
-                      f"worst {e['worst']:+.1%}")
-        bound, best = closed_form_bound(sets, curves)
-        print("closed form's mean |error|: " + ", ".join(f"{n} {v:.1%}" for n, v in bound.items()))
-        if best is None:
-            print("no (a, D0) makes every set no worse than the closed form")
-        else:
-            print(f"best (a, D0) no worse than the closed form on every set: {best[1]:.4g}, {best[2]:.4g} m; "
-                  f"objective {best[0]:.4f}")
-    crater = "energy"
-    for other in chosen:
-        if other != crater:
-            gain = chosen[crater][0] - chosen[other][0]
-            sd = difference_sd(sets, all_curves[crater], chosen[crater][1:], all_curves[other], chosen[other][1:])
-            print(f"crater {other} lowers the objective by {gain:.4f}; bootstrap s.d. of the difference {sd:.4f}")
-            if gain > 2.0 * sd:
-                crater = other
-    obj, a, b, D0 = chosen[crater]
-    print(f"== chosen: crater {crater}, coefficient {a:.4g}, exponent {b:.4g}, size {D0:.4g} m (objective {obj:.4f})")
+    node_list = nodes()
+    path = Path(args.curves) if args.curves else None
+    if path is not None and path.exists():
+        table = np.load(path, allow_pickle=True)["table"]
+    else:
+        table = curves(sets, node_list, args.workers, args.sets)
+        if path is not None:
+            np.savez(path, table=table, nodes=np.array([repr(n) for n in node_list]))
+    report(sets, table, node_list, calibrate(sets, table, node_list))
     return 0
 
 
