@@ -24,4 +24,4 @@ FAMILIES = ("concrete", "rock", "metal", "soil")
 CONSTANTS = ("density", "compressive_strength", "youngs_modulus", "tensile_strength", "pressure_hardening",
              "strength_model", "S_coefficient", "S_exponent", "S_size", "quasi_static_stress", "inertial_factor",
              "yield_stress", "hardening_exponent", "crater_depth_factor", "lock_density", "crush_strain",
-             "free_surface_range", "strength_basis")
+             "free_surface_range", "strength_basis", "separation_angle_deg")

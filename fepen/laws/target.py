@@ -17,9 +17,9 @@ SIN_TOL = 1e-9  # v̂·n below this counts as zero (a surface parallel to the mo
 
 #: fepen's calibrated "scaled-S" strength model (docs/validation-depth.md: one fit, rigid fidelity, on the
 #: calibration sets listed there); S = coefficient (f_c/MPa)^-exponent / sqrt(1 + D/size)
-SCALED_S_COEFFICIENT = 89.47
+SCALED_S_COEFFICIENT = 132.1
 SCALED_S_EXPONENT = 0.544
-SCALED_S_SIZE = 0.05953
+SCALED_S_SIZE = 0.05631
 
 
 # ---------------------------------------------------------------------------------------------------------

@@ -111,7 +111,9 @@ def material_law(scene, c: dict, thickness: float | None) -> tg.TargetLaw:
     return tg.TargetLaw(
         density=density, Y=Y, E=E, T=T, lam=lam, sigma_s=sigma_s, B=B,
         thickness=thickness, crater=get("crater"), k=k,
-        D=scene.projectile.diameter, separation=e.separation, phi_min=math.radians(t.separation_angle_deg),
+        D=scene.projectile.diameter, separation=e.separation,
+        phi_min=math.radians(get("separation_angle_deg") if get("separation_angle_deg") is not None
+                             else t.separation_angle_deg),
         free_surface=e.free_surface, friction=e.friction, mu=t.friction,
         mu_dynamic=scene.get("target.friction_dynamic"), mu_decay=t.friction_decay,
         lock_density=lock, crush_strain=crush, c_over_a=ca, given_sigma_s=given_flag,

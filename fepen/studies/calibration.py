@@ -15,7 +15,9 @@ The procedure:
      the groups of each group's mean error, so that each group counts once however many shots it has. Table
      1's error of a shot is the mean of its nose and tail errors |H − H_exp|/|H_exp| (docs/validation.md);
      a depth set's is |ln(P_pred/P_meas)|. A grid, then Nelder–Mead;
-  5. the node with the smallest fitted objective, with its a and D0, is the calibration.
+  5. while the best node lies at the edge of the values searched in one of the open constants, the node one
+     STEP beyond it in that constant (within LIMITS) is run and fitted too (a pattern search);
+  6. the node with the smallest fitted objective, with its a and D0, is the calibration.
 
     .venv/bin/python -m fepen.studies.calibration [--data DIR] [--curves FILE] [--workers W] [--set K=V]
 
@@ -35,8 +37,8 @@ import numpy as np
 from fepen.laws import target as tg
 from fepen.studies import depth
 
-__all__ = ["CALIBRATION_SETS", "OPEN", "S_SPAN", "EXPONENT", "nodes", "curves", "predicted", "group_errors",
-           "objective", "fit", "calibrate", "shipped_node", "main"]
+__all__ = ["CALIBRATION_SETS", "OPEN", "STEP", "LIMITS", "S_SPAN", "EXPONENT", "nodes", "curves", "predicted",
+           "group_errors", "objective", "fit", "calibrate", "search", "shipped_node", "main"]
 
 #: the calibration groups (file stems of fepen/data/depth; "table1" is the paper's Table 1, by its positions)
 #: and what each informs
@@ -57,6 +59,10 @@ OPEN = {
     "target.crush_strain": (0.094, 0.047, 0.0235),
     "target.free_surface_range": (1.0, 2.0),
 }
+#: the step of the pattern search in each open constant (step 5; "x2" multiplies or divides) and its limits
+STEP = {"target.separation_angle_deg": 3.0, "target.crush_strain": "x2", "target.free_surface_range": 1.0}
+LIMITS = {"target.separation_angle_deg": (0.0, 30.0), "target.crush_strain": (0.003, 0.4),
+          "target.free_surface_range": (1.0, 8.0)}
 #: S = σ_s/f_c of the runs, as multiples of Forrestal's S = 82.6 (f_c/MPa)^−0.544 of the shot's strength
 S_SPAN = np.geomspace(0.4, 2.5, 7)
 
@@ -87,7 +93,7 @@ def _one(job) -> tuple:
     from fepen.runs.rigid import RigidRun
 
     name, row, S, node, extra = job
-    sets = [*_scene_sets(name, row), f"target.quasi_static_stress={S * row.fc!r}",
+    sets = [*_scene_sets(name, row), f"target.quasi_static_stress={S * _cylinder(row)!r}",
             *[f"{k}={v!r}" for k, v in node.items()], *extra]
     s = RigidRun(scene.load(None, sets), None, MPI.COMM_SELF).run()
     return tuple(s[k] / 1e3 for k in ("Hx_mm", "Hy_mm", "Tx_mm", "Ty_mm"))
@@ -189,6 +195,46 @@ def calibrate(sets: dict, table: np.ndarray, node_list: list[dict]) -> list[tupl
     return sorted(out, key=lambda r: r[0])
 
 
+def _key(node: dict) -> str:
+    return repr(sorted(node.items()))
+
+
+def _beyond(node: dict, seen: list[dict]) -> list[dict]:
+    """Step 5: the nodes one STEP beyond ``node`` in each constant where it is at the edge of ``seen``."""
+    out = []
+    for k, step in STEP.items():
+        values = sorted({n[k] for n in seen})
+        lo, hi = LIMITS[k]
+        for edge, sign in ((values[-1], 1), (values[0], -1)):
+            if node[k] != edge:
+                continue
+            v = (node[k] * 2.0 ** sign) if step == "x2" else node[k] + sign * step
+            if lo <= v <= hi:
+                out.append({**node, k: round(v, 9)})
+    return out
+
+
+def search(sets: dict, node_list: list[dict], workers: int = 1, extra=(), done: dict | None = None):
+    """Steps 2–6 from the starting nodes: [(objective, node, a, D0)] best first, and the runs of every node
+    visited ({node key: [group tables]}; ``done`` holds runs already made, reused)."""
+    tables, fits = dict(done or {}), {}
+    todo = list(node_list)
+    while True:
+        missing = [n for n in todo if _key(n) not in tables]
+        if missing:
+            t = curves(sets, missing, workers, extra)
+            for i, n in enumerate(missing):
+                tables[_key(n)] = list(t[i])
+        for k in tables:
+            if k not in fits:
+                a, D0, obj = fit(sets, tables[k])
+                fits[k] = (obj, dict(eval(k)), a, D0)  # noqa: S307 (our own repr of sorted (str, float) pairs)
+        ranked = sorted(fits.values(), key=lambda r: r[0])
+        todo = [n for n in _beyond(ranked[0][1], [r[1] for r in ranked]) if _key(n) not in tables]
+        if not todo:
+            return ranked, tables
+
+
 def shipped_node() -> dict:
     """The open constants as fepen ships them (the scene's defaults for the paper's concrete)."""
     from fepen import scene
@@ -208,16 +254,15 @@ def load_sets(folder=None) -> dict[str, list]:
             for name in CALIBRATION_SETS}
 
 
-def report(sets, table, node_list, ranked) -> None:
+def report(sets, tables: dict, ranked) -> None:
     """Every node's fit, then each group's errors at the chosen one."""
     for obj, node, a, D0 in ranked:
         print(f"objective {obj:.4f}  a {a:7.3f}  D0 {D0 * 1e3:9.2f} mm  " +
               "  ".join(f"{k.split('.')[-1]} {v:g}" for k, v in node.items()))
     obj, node, a, D0 = ranked[0]
-    i = node_list.index(node)
     print(f"== chosen: {node}, coefficient {a:.4g}, exponent {EXPONENT}, size {D0:.4g} m (objective {obj:.4f})")
-    for j, (name, rows) in enumerate(sets.items()):
-        e = group_errors(name, rows, predicted(rows, table[i, j], a, D0))
+    for (name, rows), t in zip(sets.items(), tables[_key(node)]):
+        e = group_errors(name, rows, predicted(rows, t, a, D0))
         print(f"  {name:24s} n {len(rows):3d}  mean error {e.mean():.1%}  worst {e.max():.1%}")
 
 
@@ -227,20 +272,25 @@ def main(argv=None) -> int:
 
     ap = argparse.ArgumentParser(prog="python -m fepen.studies.calibration")
     ap.add_argument("--data", default=None, help="folder of the depth sets (default: fepen/data/depth)")
-    ap.add_argument("--curves", default=None, help=".npz file of the runs: read if it exists, else written")
+    ap.add_argument("--curves", default=None, help=".npz file of the runs: reused if it exists, and rewritten")
     ap.add_argument("--workers", type=int, default=2)
     ap.add_argument("--set", dest="sets", action="append", default=[], metavar="KEY=VALUE")
     args = ap.parse_args(sys.argv[1:] if argv is None else argv)
     sets = load_sets(args.data)
-    node_list = nodes()
     path = Path(args.curves) if args.curves else None
+    done = {}
     if path is not None and path.exists():
-        table = np.load(path, allow_pickle=True)["table"]
-    else:
-        table = curves(sets, node_list, args.workers, args.sets)
-        if path is not None:
-            np.savez(path, table=table, nodes=np.array([repr(n) for n in node_list]))
-    report(sets, table, node_list, calibrate(sets, table, node_list))
+        z = np.load(path, allow_pickle=True)
+        done = {k: list(t) for k, t in zip(z["keys"], z["tables"])}
+    ranked, tables = search(sets, nodes(), args.workers, args.sets, done)
+    if path is not None:
+        keys = list(tables)
+        arr = np.empty((len(keys), len(sets)), dtype=object)
+        for i, k in enumerate(keys):
+            for j, t in enumerate(tables[k]):
+                arr[i, j] = t
+        np.savez(path, keys=np.array(keys), tables=arr)
+    report(sets, tables, ranked)
     return 0
 
 
