@@ -15,7 +15,8 @@ V0 = 800.0  # the paper's normal-incidence scenario (docs/charge.md)
 D, L, MASS, FC = 0.0236, 0.144, 0.367, 40e6
 SIGMA_S = tg.forrestal_S(FC) * FC  # one sigma_s for fepen and the closed form
 NORMAL = ["effects.fidelity=rigid", f"projectile.crh={{crh}}", f"impact.velocity={V0}", "impact.obliquity_deg=0",
-          "impact.attack_deg=0", f"target.quasi_static_stress={SIGMA_S}", f"target.compressive_strength={FC}"]
+          "impact.attack_deg=0", f"target.quasi_static_stress={SIGMA_S}", f"target.compressive_strength={FC}",
+          "target.separation_angle_deg=0"]  # the whole nose loaded, as in the closed forms
 
 
 def depth_mm(crh, *sets):
@@ -28,20 +29,28 @@ def li_chen_k(crh: float) -> float:
     return 0.707 + math.sqrt(crh - 0.25)
 
 
-@pytest.mark.slow
-@pytest.mark.parametrize("crh", [2.0, 3.0, 4.0])
-def test_the_near_face_work_is_the_closed_forms_crater(crh):
-    """Rigid, normal, 800 m/s, sigma_s = Forrestal's S f_c. Li and Chen's crater of k = 0.707 + H/d diameters,
-    over which the force rises linearly, saves k d/2 of tunnel work: the closed form goes k d/2 deeper with it
-    than with the full tunnel force from the face (checked to 2 %). fepen's near-face stage is everything
-    that lowers its force near the face (the nose entering, the crater, the free face): it goes as much
-    deeper than that same full-force closed form, within 15 %."""
+def near_face_ratio(crh, *sets) -> float:
+    """fepen's near-face gain over the closed form's k d/2 gain (see the test below)."""
     k = li_chen_k(crh)
     row = depth.Row("normal", D, L, MASS, crh, V0, FC, 2400.0, 1.0)  # the default body is built to 0.367 kg
     full_force = 1e3 * depth.closed_form_depth(row, S=SIGMA_S / FC, k=1e-9)
     gain_closed = 1e3 * depth.closed_form_depth(row, S=SIGMA_S / FC, k=k) - full_force
     assert gain_closed == pytest.approx(1e3 * k * D / 2, rel=0.02)
-    assert depth_mm(crh) - full_force == pytest.approx(gain_closed, rel=0.15)
+    return (depth_mm(crh, *sets) - full_force) / gain_closed
+
+
+@pytest.mark.slow
+@pytest.mark.parametrize("crh", [2.0, 3.0, 4.0])
+def test_the_near_face_work_against_the_closed_forms_crater(crh):
+    """Rigid, normal, 800 m/s, sigma_s = Forrestal's S f_c, no separation angle (the closed forms load the
+    whole nose). Li and Chen's crater of k = 0.707 + H/d diameters, over which the force rises linearly, saves
+    k d/2 of tunnel work: the closed form goes k d/2 deeper with it than with the full tunnel force from the
+    face (checked to 2 %). fepen's near-face stage is everything that lowers its force near the face (the nose
+    entering, the crater and the free face): with the plastic zone cut exactly at the face (reach 1) it goes
+    as much deeper as the closed form, within 15 %; at the calibrated reach 2 it saves 1.44-1.50 times k d/2
+    (docs/theory.md §8.3: the calibration wants more near-face relief than the closed forms give)."""
+    assert near_face_ratio(crh, "target.free_surface_range=1") == pytest.approx(1.0, abs=0.15)
+    assert 1.35 < near_face_ratio(crh) < 1.6
 
 
 @pytest.mark.slow
