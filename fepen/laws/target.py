@@ -312,9 +312,7 @@ def crater_energy_ejects(law: TargetLaw, vn, L_e, radius, R_meridian, sin_phi0, 
         growth = (1.0 + w / R_meridian) * (1.0 + w * sin_phi0 / rho)
         integral += 0.5 * l * wi * growth * (rho / (rho + w)) ** 4
     e_kin = 0.5 * law.lock_density * vn * vn * integral
-    finite = np.isfinite(L_e)
-    e_str = np.full_like(rho, np.inf)
-    e_str[finite] = law.crush_strain * law.Y * (2.0 * rho[finite] * L_e[finite] + L_e[finite] ** 2) / rho[finite]
+    e_str = law.crush_strain * law.Y * (2.0 * rho * L_e + L_e**2) / rho
     return e_kin - e_str >= 0.0
 
 

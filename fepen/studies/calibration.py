@@ -196,7 +196,16 @@ def calibrate(sets: dict, table: np.ndarray, node_list: list[dict]) -> list[tupl
 
 
 def _key(node: dict) -> str:
-    return repr(sorted(node.items()))
+    """A node as text (the .npz keeps it): JSON of its sorted items."""
+    import json
+
+    return json.dumps(sorted(node.items()))
+
+
+def _node(key: str) -> dict:
+    import json
+
+    return dict(json.loads(key))
 
 
 def _beyond(node: dict, seen: list[dict]) -> list[dict]:
@@ -228,7 +237,7 @@ def search(sets: dict, node_list: list[dict], workers: int = 1, extra=(), done: 
         for k in tables:
             if k not in fits:
                 a, D0, obj = fit(sets, tables[k])
-                fits[k] = (obj, dict(eval(k)), a, D0)  # noqa: S307 (our own repr of sorted (str, float) pairs)
+                fits[k] = (obj, _node(k), a, D0)
         ranked = sorted(fits.values(), key=lambda r: r[0])
         todo = [n for n in _beyond(ranked[0][1], [r[1] for r in ranked]) if _key(n) not in tables]
         if not todo:
