@@ -24,8 +24,8 @@ import argparse
 import csv
 import re
 import sys
-import zipfile
 import xml.etree.ElementTree as ET
+import zipfile
 from pathlib import Path
 
 REPO = "DavidZyh-0319/Concrete-Penetration-Failure-Response-Dataset"
