@@ -74,3 +74,25 @@ def load_points(shape: Shape, size: float, n_theta: int | None = None, n_gauss: 
     X = np.stack([r * cc, y, r * ss], axis=1)
     N = np.stack([nr * cc, ny, nr * ss], axis=1)
     return dict(X=X, area0=area / n_theta, N=N, radius=r, R_meridian=Rm, sin_phi0=sphi)
+
+
+def nose_zone(shape, X: np.ndarray, radius: np.ndarray) -> tuple[float, float]:
+    """The nose zone that wear shortens (docs/theory.md §14.3): from the tip to where the outer radius first
+    reaches the calibre, or to the front of a cavity if that comes first; and the outer radius there.
+
+    Args:
+        shape: the Shape, or a CadBody (no meridian: its zone from the surface points, assumed solid).
+        X: points on the outer surface (k, 3) (m), axis +y from the tip. radius: their distances from the
+            axis (k,) (m).
+
+    Returns:
+        (y_c, r_c) (m).
+    """
+    if not isinstance(shape, Shape):
+        y_c = float(X[radius >= (1.0 - 1e-3) * radius.max(), 1].min())
+        return y_c, float(radius.max())
+    y_c = shape.nose_length
+    inner = shape.inner_path
+    if inner:
+        y_c = min(y_c, min(min(seg.p0[1], seg.p1[1]) for seg in inner))
+    return y_c, float(shape.outer_radius(y_c))

@@ -20,6 +20,8 @@ SIN_TOL = 1e-9  # v̂·n below this counts as zero (a surface parallel to the mo
 SCALED_S_COEFFICIENT = 132.1
 SCALED_S_EXPONENT = 0.544
 SCALED_S_SIZE = 0.05631
+#: the same fit with the calibrated nose wear on (effects.wear; docs/wear.md §2: fepen.studies.wear_calibration)
+SCALED_S_WEAR = (124.6, SCALED_S_EXPONENT, 0.06291)
 
 
 # ---------------------------------------------------------------------------------------------------------

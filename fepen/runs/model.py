@@ -10,7 +10,8 @@ import numpy as np
 from mpi4py import MPI
 
 from fepen.geometry import mesh as fmesh
-from fepen.geometry import tags
+from fepen.geometry import revolution, tags
+from fepen.geometry.shape import Shape
 from fepen.laws import target as tg
 from fepen.runs import setup, shot
 from fepen.solver import erosion, explicit, probes, recession, rigid_wall, shell_charge, surface, target_load
@@ -96,9 +97,22 @@ def build(sh, comm: MPI.Comm = MPI.COMM_WORLD) -> Model:
         eroding = erosion.Erosion(s, surf, sh.erosion.strain, sh.erosion.step_ratio)
     if sh.wear is not None and surf is not None:
         w = sh.wear
-        receding = recession.Recession(s, surf, w.friction, w.efficiency, w.enthalpy, w.density)
+        y_c = _nose_zone(s, surf, sh.built.shape) if w.distribution == "nose" else None
+        receding = recession.Recession(s, surf, w.friction, w.efficiency, w.enthalpy, w.density, zone_end=y_c)
         load.wear = receding
     R, v = sh.rotation, sh.velocity
     s.set_initial(displacement=lambda X: X @ R.T - X, velocity=lambda X: np.tile(v, (len(X), 1)))
     return Model(pm, s, load, contact, tip, tail, sh.speed, surf, sh.law, mesh_s, time.perf_counter() - t0,
                  eroding, receding)
+
+
+def _nose_zone(s, surf, shape) -> float:
+    """The nose zone's end y_c (m) of the meshed body (fepen.geometry.revolution.nose_zone); a CAD body's
+    from its surface nodes on every rank (collective)."""
+    if isinstance(shape, Shape):
+        return revolution.nose_zone(shape, np.zeros((0, 3)), np.zeros(0))[0]
+    xb = s.X[np.unique(surf.tri.ravel())]
+    r = np.hypot(xb[:, 0], xb[:, 2])
+    r_max = s.comm.allreduce(float(r.max(initial=0.0)), op=MPI.MAX)
+    y = xb[r >= (1.0 - 1e-3) * r_max, 1]
+    return s.comm.allreduce(float(y.min(initial=np.inf)), op=MPI.MIN)

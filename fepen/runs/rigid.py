@@ -149,7 +149,15 @@ class RigidRun(Run):
         self.ke0 = self.body.kinetic_energy(self.state)
         self.loaded = 0
         self.area = 0.0
-        self.wear = Wear(sh.wear) if sh.wear is not None else None
+        self.wear = None
+        if sh.wear is not None:
+            if sh.wear.distribution == "nose":
+                self.pts = g = {k: np.array(v, copy=True) for k, v in g.items()}  # the nose moves its points
+                self.body = RigidBody(self.mass, c0, inertia, g["X"], g["N"])
+                y_c, r_c = revolution.nose_zone(self.shape, g["X"], g["radius"])
+                self.wear = Wear(sh.wear, g, y_c, r_c)
+            else:
+                self.wear = Wear(sh.wear)
         self.t, self.step_count = 0.0, 0
         self.prev = self.state
         self.F = self.body.derivative(self.state, self.force_fn)[1]  # the force of a row: at its step's start
@@ -178,6 +186,7 @@ class RigidRun(Run):
         self.w_ext += work
         if self.wear is not None:
             s = self.wear.step(self.body, s, self.dt)
+            self.tip_ref[1] = self.wear.shortening
         self.state = s
         self.t += self.dt
         self.step_count += 1
@@ -217,7 +226,8 @@ class RigidRun(Run):
         return Snapshot(tip, tail, s.V, self.F, body.mass, en, self.loaded, self.dt, 0.0, self.area, rear)
 
     def removal(self) -> Removal:
-        w, length = self.wear, self.shape.length * 1e3  # a rigid body keeps its length
+        w = self.wear
+        length = (self.shape.length - (w.shortening if w is not None else 0.0)) * 1e3
         if w is None:
             return Removal(remaining_kg=self.body.mass, length_mm=length)
         return Removal(w.mass_lost, w.heat, 0, w.kinetic_removed, remaining_kg=self.body.mass, length_mm=length)
@@ -232,26 +242,43 @@ class RigidRun(Run):
 
 
 class Wear:
-    """The scalar nose wear of the rigid fidelity (docs/theory.md §14): the interface heat μ σ_n |v_t| summed
-    over the load points with the RK4 weights of the step's four stages, and the mass η Q/h it melts, taken
-    off the body after each step (fepen.laws.wear).
+    """The nose wear of the rigid fidelity (docs/theory.md §14): the interface heat μ σ_n |v_t| summed over
+    the load points with the RK4 weights of the step's four stages, and the mass η Q/h it melts, taken off
+    the body after each step (fepen.laws.wear). With ``distribution = "nose"`` the load points of the nose
+    zone (ahead of ``zone_end``) follow the nose's contraction along its axis (fepen.laws.wear.contract_points),
+    so the worn nose's shape feeds back into the load and the tip recedes.
 
     Args:
         p: the wear parameters (fepen.runs.shot.WearParameters).
+        points: the run's load points (its own copies: the nose writes into them), or None (mass only).
+        zone_end: y_c, the end of the nose zone (m). radius_end: the body's radius there (m).
     """
 
-    def __init__(self, p):
-        self.mu, self.efficiency, self.enthalpy = p.friction, p.efficiency, p.enthalpy
+    def __init__(self, p, points: dict | None = None, zone_end: float = 0.0, radius_end: float = 0.0):
+        self.mu, self.efficiency, self.enthalpy, self.density = p.friction, p.efficiency, p.enthalpy, p.density
         self.stages: list[float] = []
         self.heat = self.mass_lost = self.kinetic_removed = 0.0
+        self.contraction = 1.0
+        self.points = points
+        if points is not None:
+            self.original = {k: points[k].copy() for k in ("X", "N", "area0", "R_meridian")}
+            self.zone_end = zone_end
+            self.zone0 = wear.zone_volume(points["X"], points["N"], points["area0"], zone_end, radius_end)
+            if not self.zone0 > 0.0:  # a flat nose: nothing to shorten, the mass alone leaves
+                self.points = None
+
+    @property
+    def shortening(self) -> float:
+        """How much shorter the nose is (m)."""
+        return (1.0 - self.contraction) * self.zone_end if self.points is not None else 0.0
 
     def stage(self, force, n, v) -> None:
         """Record one RK4 stage's heat rate (W)."""
         self.stages.append(wear.heat_rate(force, n, v, self.mu))
 
     def step(self, body, s, dt: float):
-        """Add the step's heat (its four RK4 stages, the last recorded), take its melted mass off the body; the
-        state after."""
+        """Add the step's heat (its four RK4 stages, the last recorded), take its melted mass off the body and
+        contract the nose by its volume; the state after."""
         q = self.stages[-4:]
         self.stages.clear()
         heat = dt / 6.0 * (q[0] + 2.0 * q[1] + 2.0 * q[2] + q[3])
@@ -262,4 +289,19 @@ class Wear:
         s, ke = body.remove_mass(s, dm)
         self.mass_lost += dm
         self.kinetic_removed += ke
+        if self.points is not None:
+            self._contract(body, wear.contraction_after(self.contraction, dm / self.density, self.zone0))
         return s
+
+    def _contract(self, body, contraction: float) -> None:
+        """Move the nose zone's load points to the contraction λ (in place: the body's arms and normals, the
+        law's areas, angles and curvatures)."""
+        if contraction == self.contraction:
+            return
+        self.contraction = contraction
+        o, g = self.original, self.points
+        X, N, A, sphi, Rm = wear.contract_points(o["X"], o["N"], o["area0"], o["R_meridian"], self.zone_end,
+                                                 contraction)
+        body.r0[:] = X - body.centre0
+        body.N0[:] = N
+        g["X"][:], g["N"][:], g["area0"][:], g["sin_phi0"][:], g["R_meridian"][:] = X, N, A, sphi, Rm

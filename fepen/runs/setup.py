@@ -98,7 +98,9 @@ def material_law(scene, c: dict, thickness: float | None) -> tg.TargetLaw:
             sigma_s = given
         elif model in tg.S_MODELS:
             a, b, size = tg.S_MODELS[model]
-            if model == "scaled-S" and e.friction:  # refitted with friction on (theory.md §8.1)
+            if model == "scaled-S" and e.wear:  # refitted with the calibrated wear on (docs/wear.md §2)
+                a, b, size = tg.SCALED_S_WEAR
+            elif model == "scaled-S" and e.friction:  # refitted with friction on (theory.md §8.1)
                 a, b, size = tg.SCALED_S_FRICTION
             a = get("S_coefficient") or a
             b = get("S_exponent") if get("S_exponent") is not None else b

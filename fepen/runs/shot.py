@@ -35,6 +35,7 @@ class WearParameters:
     efficiency: float
     enthalpy: float
     density: float
+    distribution: str = "nose"  #: where the mass leaves: "nose" (the nose shortens) or "surface" (where heated)
 
 
 @dataclass(frozen=True)
@@ -151,7 +152,7 @@ def _wear(scene) -> WearParameters | None:
     mu = scene.get("projectile.wear.friction")
     return WearParameters(scene.target.friction if mu is None else mu, w.efficiency,
                           wear.melt_enthalpy(m.specific_heat, m.melt_temperature, m.room_temperature, w.latent_heat),
-                          m.density)
+                          m.density, w.distribution)
 
 
 def _outputs(scene) -> OutputSettings:

@@ -79,11 +79,16 @@ SCHEMA: dict[str, Key] = {
     "projectile.material.reference_strain_rate": positive(1.0, "1/s", 1.0e9),
     "projectile.material.specific_heat": positive(470.0, "J/(kg K)", 1.0e5),
     "projectile.material.taylor_quinney": number(0.9, "", 0.0, 1.0),
-    "projectile.wear.efficiency": number(1.0, "", 0.0, 1.0,
+    "projectile.wear.efficiency": number(0.4437, "", 0.0, 1.0,
                                          doc="eta: the fraction of the interface heat that melts the surface off "
                                              "(effects.wear; docs/theory.md §14)"),
     "projectile.wear.friction": number(ABSENT, "", 0.0, 2.0,
                                        doc="mu of the interface heat mu sigma_n |v_t|; absent: target.friction"),
+    "projectile.wear.distribution": choice("nose", "nose", "surface",
+                                           doc="where the melted mass leaves: 'nose', the nose shortens along its "
+                                               "axis keeping its kind (docs/theory.md §14.3); 'surface', each "
+                                               "point recedes by its own heat (meshed projectile; the rigid "
+                                               "fidelity then only loses mass)"),
     "projectile.wear.latent_heat": number(2.7e5, "J/kg", 0.0, 1.0e7, doc="latent heat of fusion of the steel"),
     "projectile.erosion.strain": number(1.0, "", 0.0, 100.0, lo_open=True,
                                         doc="equivalent plastic strain at which a cell erodes (effects.erosion; "

@@ -1,5 +1,11 @@
-"""Nose abrasion on the deforming mesh (docs/theory.md §14.2): the interface heat of each load point
-(fepen.laws.wear) melts the surface, which recedes along its normal; a thin layer behind it relaxes.
+"""Nose abrasion on the deforming mesh (docs/theory.md §14.2–§14.3): the interface heat of the load points
+(fepen.laws.wear) melts mass off the nose.
+
+By default (``zone_end`` given: the "nose" distribution, §14.3) the melted volume η Q/(h ρ) of each
+application shortens the nose zone (reference y < y_c) along its axis: every node of the zone moves toward
+y_c by the factor κ = 1 − ΔV/V_zone (y' = y_c − κ (y_c − y)), so the tip recedes the most and the cells
+keep their shape up to the axial factor (no surface cell is flattened). Otherwise (the "surface"
+distribution, §14.2) each point's own heat makes it recede along its normal:
 
 Each step the target load hands its point forces, normals and velocities to :meth:`Recession.add`, which
 shares each point's heat rate × Δt to its facet's three nodes. Every ``every`` (50) steps :meth:`apply`
@@ -42,8 +48,10 @@ class Recession:
     """
 
     def __init__(self, solver, surface, mu: float, efficiency: float, enthalpy: float, density: float,
-                 every: int = 50, layers: int = 3):
+                 every: int = 50, layers: int = 3, zone_end: float | None = None):
         self.solver, self.surface = solver, surface
+        self.zone_end = zone_end
+        self.contraction = 1.0  # the nose zone's length factor λ (the "nose" distribution)
         self.mu, self.efficiency, self.enthalpy, self.density = mu, efficiency, enthalpy, density
         self.every, self.layers = every, layers
         imap = solver.V.dofmap.index_map
@@ -59,18 +67,37 @@ class Recession:
         self._adjacency_all = (rows, cols, n)
         self.boundary = self._boundary_nodes()
         self._adj = None
+        if zone_end is not None:
+            self.zone0 = self._zone_volume()
+            if not self.zone0 > 0.0:  # a flat nose: the surface recedes where heated
+                self.zone_end = None
 
     # --------------------------------------------------------------------------------------------------
     def state(self) -> dict[str, np.ndarray]:
         """The heat and recession so far (for checkpoints)."""
-        return {"heat_nodes": self.heat_nodes, "depth": self.depth, "heat_total": np.array([self.heat_total])}
+        return {"heat_nodes": self.heat_nodes, "depth": self.depth, "heat_total": np.array([self.heat_total]),
+                "contraction": np.array([self.contraction])}
 
     def restore(self, state: dict) -> None:
         """Put back what state() returned."""
         self.heat_nodes[:] = state["heat_nodes"]
         self.depth[:] = state["depth"]
         self.heat_total = float(state["heat_total"][0])
+        if "contraction" in state:
+            self.contraction = float(state["contraction"][0])
 
+    def _zone_volume(self) -> float:
+        """Reference volume of the nose zone (y < zone_end) (m³, all ranks): each live owned cell's volume
+        times the share of its nodes in the zone (cells across y_c count by halves, about)."""
+        s = self.solver
+        inside = (s.X[:, 1] < self.zone_end)[s.dofs].mean(axis=1)
+        own = s.mat[: s.n_cells] >= 0
+        return s.comm.allreduce(float(np.sum(s.vol0[own] * inside[own])), op=MPI.SUM)
+
+    @property
+    def shortening(self) -> float:
+        """How much the nose zone has shortened (m)."""
+        return (1.0 - self.contraction) * self.zone_end if self.zone_end is not None else 0.0
     def add(self, force: np.ndarray, n: np.ndarray, v: np.ndarray, dt: float) -> None:
         """Record one step's heat at the surface's points (their target forces, normals, velocities): the
         heat of fepen.laws.wear.heat_rates × Δt, a third to each of the point's facet nodes."""
@@ -117,6 +144,8 @@ class Recession:
         """Recede the surface by the heat gathered since the last call (collective). Returns the largest
         recession of this application (m), all ranks."""
         s, surf = self.solver, self.surface
+        if self.zone_end is not None:
+            return self._contract()
         heat = self._ghost_sum(self._vec1, self.heat_nodes)
         self.heat_nodes[:] = 0.0
         nrm = np.zeros((s.n_nodes, 3))
@@ -144,6 +173,29 @@ class Recession:
         surf.follow_reference(X_old, s.X)
         self.depth += d
         return largest
+
+    def _contract(self) -> float:
+        """The "nose" distribution: shorten the nose zone by the volume melted since the last call
+        (collective). Returns the tip's recession of this application (m)."""
+        s, surf = self.solver, self.surface
+        heat = s.comm.allreduce(float(self.heat_nodes.sum()), op=MPI.SUM)
+        self.heat_nodes[:] = 0.0
+        volume = wear.melted_mass(heat, self.efficiency, self.enthalpy) / self.density
+        if volume <= 0.0:
+            return 0.0
+        old = self.contraction
+        new = wear.contraction_after(old, volume, self.zone0)
+        kappa = new / old
+        self.contraction = new
+        y = s.X[:, 1]
+        zone = y < self.zone_end
+        dX = np.zeros_like(s.X)
+        dX[zone, 1] = (1.0 - kappa) * (self.zone_end - y[zone])
+        X_old = s.X.copy()
+        reference.change_reference(s, dX)
+        surf.follow_reference(X_old, s.X)
+        self.depth += dX[:, 1]
+        return (1.0 - kappa) * old * self.zone_end
 
     def _relax(self, dX: np.ndarray, on_surface: np.ndarray) -> np.ndarray:
         """Spread the surface move over the band of ``layers`` node layers behind it (Jacobi sweeps of the
