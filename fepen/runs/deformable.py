@@ -11,7 +11,7 @@ from __future__ import annotations
 import numpy as np
 from mpi4py import MPI
 
-from fepen.errors import BeyondMethod, InputError, Interrupted
+from fepen.errors import BeyondMethod, InputError, Interrupted, SimulationError
 from fepen.geometry.frames import unit_axis
 from fepen.io import results
 from fepen.io.fields import FieldWriter
@@ -22,6 +22,10 @@ from fepen.solver import diagnostics, explicit, probes
 
 #: steps between two checks of the stop rules in the target (each costs a few reductions)
 EVENT_EVERY = 20
+
+
+#: a run whose energy balance is off by more than this fraction stops (it would report garbage)
+ENERGY_LIMIT = 0.05
 
 
 class DeformableRun(Run):
@@ -159,6 +163,12 @@ class DeformableRun(Run):
         e = diagnostics.energies(s)
         en = dict(kinetic=e.kinetic, internal_work=e.internal_work, external_work=e.external_work,
                   elastic=e.elastic, plastic=e.plastic, heat=e.heat, energy_error=e.balance_error)
+        if e.balance_error > ENERGY_LIMIT:
+            raise SimulationError(
+                f"energy balance lost: error {e.balance_error:.1%} at step {s.step_count}, t = {s.t * 1e6:.3f} us "
+                f"(kinetic energy {e.kinetic:.4g} J, carried off by removed material {e.removed_kinetic:.4g} J, "
+                f"internal work {e.internal_work:.4g} J): the explicit step is unstable in distorted or eroding "
+                "cells; the rows written so far are kept")
         tip, tail = probes.node_value(s, m.tip, x), probes.node_value(s, m.tail, x)
         extra = []
         if self.pm.charge:

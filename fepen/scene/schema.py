@@ -81,7 +81,8 @@ SCHEMA: dict[str, Key] = {
     "projectile.material.taylor_quinney": number(0.9, "", 0.0, 1.0),
     "projectile.wear.efficiency": number(0.4437, "", 0.0, 1.0,
                                          doc="eta: the fraction of the interface heat that melts the surface off "
-                                             "(effects.wear; docs/theory.md §14)"),
+                                             "(effects.wear; docs/theory.md §14), calibrated once on the paper's "
+                                             "recovered projectiles (docs/wear.md §2)"),
     "projectile.wear.friction": number(ABSENT, "", 0.0, 2.0,
                                        doc="mu of the interface heat mu sigma_n |v_t|; absent: target.friction"),
     "projectile.wear.distribution": choice("nose", "nose", "surface",

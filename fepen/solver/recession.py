@@ -94,6 +94,13 @@ class Recession:
         own = s.mat[: s.n_cells] >= 0
         return s.comm.allreduce(float(np.sum(s.vol0[own] * inside[own])), op=MPI.SUM)
 
+    def _zone_eroding(self) -> bool:
+        """Whether a cell of the nose zone has eroded (collective): the nose no longer keeps its kind (it
+        mushrooms or breaks up), so from then on each point recedes by its own heat (§14.3's limit)."""
+        s = self.solver
+        ahead = (s.X[s.dofs].mean(axis=1)[:, 1] < self.zone_end) & (s.mat < 0)
+        return s.comm.allreduce(bool(ahead.any()), op=MPI.LOR)
+
     @property
     def shortening(self) -> float:
         """How much the nose zone has shortened (m)."""
@@ -144,7 +151,7 @@ class Recession:
         """Recede the surface by the heat gathered since the last call (collective). Returns the largest
         recession of this application (m), all ranks."""
         s, surf = self.solver, self.surface
-        if self.zone_end is not None:
+        if self.zone_end is not None and not self._zone_eroding():
             return self._contract()
         heat = self._ghost_sum(self._vec1, self.heat_nodes)
         self.heat_nodes[:] = 0.0

@@ -215,7 +215,8 @@ def test_rigid_wear_conserves_mass_and_energy_and_scales_with_striking_energy(tm
     """Scalar wear: the removed mass is η Q/h of the interface heat, the mass is conserved, the energy balance
     holds with the removed material's kinetic energy, and the mass loss grows with the striking kinetic
     energy (Silling and Forrestal 2007)."""
-    runs = {v: wear_run(v, out=tmp_path / str(v) if v == 700 else None) for v in (500, 700, 900)}
+    eta1 = ("projectile.wear.efficiency=1", 'projectile.wear.distribution="surface"')
+    runs = {v: wear_run(v, *eta1, out=tmp_path / str(v) if v == 700 else None) for v in (500, 700, 900)}
     for v, s in runs.items():
         ke0 = 0.5 * s["mass_kg"] * v * v
         h = 470.0 * (1765.0 - 294.0) + 2.7e5
@@ -235,13 +236,29 @@ def test_rigid_wear_conserves_mass_and_energy_and_scales_with_striking_energy(tm
 
 
 def test_rigid_wear_off_or_without_melting_changes_nothing():
-    plain = wear_run(700, "effects.wear=false")
-    none = wear_run(700, "projectile.wear.efficiency=0")
+    """At one σ_s (wear on otherwise takes its own scaled-S constants): no melting is no wear; the calibrated
+    wear shortens the nose by about 1.95 mm per percent of mass (the nose's own volume), and the worn
+    projectile stops sooner."""
+    sigma = "target.quasi_static_stress=5.0e8"
+    plain = wear_run(700, "effects.wear=false", sigma)
+    none = wear_run(700, "projectile.wear.efficiency=0", sigma)
     assert none["mass_loss_kg"] == 0.0 and none["wear_heat_J"] > 0.0
     assert none["Hy_mm"] == pytest.approx(plain["Hy_mm"], rel=1e-12)
     assert plain["mass_loss_kg"] == 0.0 and plain["wear_heat_J"] == 0.0  # the removal keys of every run
-    worn = wear_run(700)
-    assert worn["Hy_mm"] < plain["Hy_mm"]  # a lighter projectile stops sooner
+    assert none["length_change_mm"] == 0.0
+    worn = wear_run(700, sigma)
+    assert worn["Hy_mm"] < plain["Hy_mm"]  # a lighter, blunter projectile stops sooner
+    from fepen.runs import setup
+
+    sc = scene.load(None, [])
+    shp, rho = setup.projectile_shape(sc), sc.projectile.material.density
+    z = np.linspace(0.0, shp.nose_length, 20001)
+    zone = np.pi * np.trapz(shp.outer_radius(z) ** 2, z)  # the nose's volume ahead of the shoulder
+    per_kg = shp.nose_length / (rho * zone)  # m of length per kg: exact for the contraction
+    assert -worn["length_change_mm"] * 1e-3 == pytest.approx(per_kg * worn["mass_loss_kg"], rel=1e-6)
+    assert -worn["length_change_mm"] / worn["mass_loss_percent"] == pytest.approx(1.95, rel=0.05)  # about
+    mass_only = wear_run(700, sigma, 'projectile.wear.distribution="surface"')
+    assert mass_only["length_change_mm"] == 0.0 and worn["Hy_mm"] < mass_only["Hy_mm"]
 
 
 def test_erosion_on_a_rigid_run_is_refused_before_meshing():

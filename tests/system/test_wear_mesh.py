@@ -27,13 +27,9 @@ def live_mass(solver) -> float:
     return solver.comm.allreduce(float(np.sum(rho[solver.mat[live]] * solver.vol0[live])), op=MPI.SUM)
 
 
-#: a known defect (issue 29's closing note): at the calibrated defaults the 1200 m/s normal shot with wear and
-#: erosion erodes a cell whose nodes had blown up (removed kinetic energy 3.6e13 J at 218 mm) instead of stopping
-#: as unstable; the energy balance then fails
-BLOWS_UP = pytest.mark.xfail(strict=True, reason="a blown-up cell is eroded instead of stopping the run")
 
 
-@pytest.mark.parametrize("name", [pytest.param(n, marks=BLOWS_UP) if n == "normal_1200" else n for n in SUITE])
+@pytest.mark.parametrize("name", SUITE)
 def test_hard_case_with_wear_and_erosion_conserves_mass_and_energy(name, tmp_path):
     """Initial mass = remaining + removed to 1e-12 (the removed mass summed event by event, the remaining
     one from the nodes and, independently, from the live cells' volumes); the energy balance with the
@@ -72,7 +68,8 @@ def test_recession_reproduces_its_closed_form_on_a_constant_velocity_slide():
     """A uniform normal stress σ on the shank sliding at V along the axis for a time t: every shank node
     recedes by d = η μ σ V t / (h ρ) (to round-off), and the mass removed is the melted mass η Q / h, the
     volume the surface swept (to the flat facets' order); the cavity wall behind the thin shank stays put."""
-    sc, m = built(["projectile.wear.efficiency=0.7", "projectile.wear.friction=0.2"])
+    sc, m = built(["projectile.wear.efficiency=0.7", "projectile.wear.friction=0.2",
+                   'projectile.wear.distribution="surface"'])
     s, surf, rec = m.solver, m.surface, m.recession
     mat = sc.projectile.material
     h = wear.melt_enthalpy(mat.specific_heat, mat.melt_temperature, mat.room_temperature,
