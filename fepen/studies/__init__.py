@@ -2,5 +2,5 @@
 fepen processes, the shot engine on MPI groups, sweeps and their figures, the limit studies (ballistic limit,
 ricochet) and the closed forms they are checked against."""
 
-__all__ = ["validate", "depth", "calibration", "accuracy_cost", "processes", "engine",
+__all__ = ["validate", "depth", "calibration", "wear_calibration", "accuracy_cost", "processes", "engine",
            "sweep", "sweep_figures", "limits", "closed_forms"]
