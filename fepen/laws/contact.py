@@ -90,3 +90,16 @@ def wall_normals(x, tri, out):
             out[tri[i, j], 0] += cx
             out[tri[i, j], 1] += cy
             out[tri[i, j], 2] += cz
+
+
+@numba.njit(cache=True, error_model="numpy")
+def wall_facet_normals(x, tri, out):
+    """Each wall facet's area vector over 6 (oriented out of the charge), into out (f, 3): the term
+    wall_normals adds to each of its three nodes."""
+    for i in range(tri.shape[0]):
+        i0, i1, i2 = tri[i, 0], tri[i, 1], tri[i, 2]
+        ax, ay, az = x[i1, 0] - x[i0, 0], x[i1, 1] - x[i0, 1], x[i1, 2] - x[i0, 2]
+        bx, by, bz = x[i2, 0] - x[i0, 0], x[i2, 1] - x[i0, 1], x[i2, 2] - x[i0, 2]
+        out[i, 0] = (ay * bz - az * by) / 6.0
+        out[i, 1] = (az * bx - ax * bz) / 6.0
+        out[i, 2] = (ax * by - ay * bx) / 6.0

@@ -417,8 +417,9 @@ def load_on_points(law: TargetLaw, x, v, n, area, radius, R_meridian, sin_phi0, 
         law: the TargetLaw. x, v, n, area, radius, R_meridian, sin_phi0, axis: as SurfaceState, over all of
             this process's points.
         crater: a ForrestalCrater (the "linear" crater) or None. tip_depth: the nose tip's depth (m).
-        reduce: sums an array over the processes that share the points (the MPI sum of a distributed
-            surface), or None when this process holds them all.
+        reduce: the totals over the processes that share the points (a distributed surface), as
+            ``reduce(f, sums)`` -> sums (5,), from this process's point forces f (k, 3) and its sums (force
+            (3), loaded points, loaded area); None when this process holds them all.
 
     Returns:
         The PointLoad.
@@ -429,7 +430,7 @@ def load_on_points(law: TargetLaw, x, v, n, area, radius, R_meridian, sin_phi0, 
     else:
         f, sums = kernel(law, x, v, n, area, radius, R_meridian, sin_phi0, axis)
     if reduce is not None:
-        sums = reduce(sums)
+        sums = reduce(f, sums)
     total = sums[:3]
     if crater is not None:
         scale = crater.scale(tip_depth, -float(total @ axis))

@@ -12,7 +12,7 @@ from dolfinx import cpp as _cpp
 from mpi4py import MPI
 
 from fepen.laws import energy
-from fepen.solver import kernels
+from fepen.solver import assembly, kernels
 
 
 @dataclass
@@ -51,10 +51,16 @@ def energies(solver) -> Energies:
     if not s.nodal:
         vol = _element_volumetric_energy(s)
     dev = _deviatoric_energy(s)
-    sums = c.allreduce(np.array([s._w_int, s._w_ext, vol + dev, s._plastic, s._heat,
-                                 s._w_if_n, s._w_if_t, s._removed[1], s._removed[2]]), op=MPI.SUM)
-    return Energies(ke, sums[0], sums[1], sums[2], sums[3], sums[4], s.ke0 or 0.0, sums[5], -sums[6],
-                    sums[7], sums[8])
+    w_int, w_ext = work_sums(s)
+    sums = c.allreduce(np.array([vol + dev, s._plastic, s._heat, s._w_if_n, s._w_if_t, s._removed[1],
+                                 s._removed[2]]), op=MPI.SUM)
+    return Energies(ke, w_int, w_ext, sums[0], sums[1], sums[2], s.ke0 or 0.0, sums[3], -sums[4], sums[5], sums[6])
+
+
+def work_sums(solver) -> tuple[float, float]:
+    """(internal, external) work done since the start (J), all ranks: exact sums of each owned node's
+    running sum (the same on any partition)."""
+    return tuple(assembly.exact_sum(solver._work[: solver.n_owned], solver.comm))
 
 
 def _cell_J(solver) -> np.ndarray:
@@ -77,8 +83,7 @@ def _element_volumetric_energy(solver) -> float:
 def momentum_velocity(solver) -> np.ndarray:
     """Velocity of the centre of mass (m/s), all ranks."""
     n = solver.n_owned
-    p = np.sum(solver.mass[:n, None] * solver.velocity_at_step()[:n], axis=0)
-    return solver.comm.allreduce(p, op=MPI.SUM) / solver.total_mass
+    return assembly.exact_sum(solver.mass[:n, None] * solver.velocity_at_step()[:n], solver.comm) / solver.total_mass
 
 
 def body_accelerations(solver, axis: np.ndarray) -> np.ndarray:
@@ -87,8 +92,7 @@ def body_accelerations(solver, axis: np.ndarray) -> np.ndarray:
     cells (interface nodes share theirs)."""
     n = solver.n_owned
     along = solver.acc[:n] @ axis
-    local = np.array([float(solver.mass_by_material[:n, k] @ along) for k in range(len(solver.materials))])
-    return solver.comm.allreduce(local, op=MPI.SUM) / solver.body_mass
+    return assembly.exact_sum(solver.mass_by_material[:n] * along[:, None], solver.comm) / solver.body_mass
 
 
 def max_peeq(solver) -> float:

@@ -17,7 +17,7 @@ from mpi4py import MPI
 
 from fepen.errors import SimulationError
 from fepen.laws import materials as M
-from fepen.solver import ckernel, failures, kernels, reference
+from fepen.solver import assembly, ckernel, failures, kernels, reference
 
 _log.set_log_level(_log.LogLevel.WARNING)  # quiet dolfinx wherever the solver is used
 
@@ -68,8 +68,8 @@ class Interface(Protocol):
 
 #: the solver's state between two steps (checkpoints): nodal and cell arrays, and scalars; the work sums
 #: are each rank's own partial sums
-STATE_ARRAYS = ("U", "Vel", "acc", "fint", "fext", "s", "eps_p", "temp", "sy0", "X", "mat", "_removed")
-STATE_SCALARS = ("t", "step_count", "dt", "dt_prev", "dt0", "dt_min", "_w_int", "_w_ext", "_plastic", "_heat",
+STATE_ARRAYS = ("U", "Vel", "acc", "fint", "fext", "s", "eps_p", "temp", "sy0", "X", "mat", "_removed", "_work")
+STATE_SCALARS = ("t", "step_count", "dt", "dt_prev", "dt0", "dt_min", "_plastic", "_heat",
                  "ke0", "_w_if_n", "_w_if_t")
 
 
@@ -118,26 +118,30 @@ class ExplicitSolver:
         rho = np.array([m.density for m in materials])[self.mat]
         mvec = la.vector(imap, bs=nm)
         arr = mvec.array.reshape(-1, nm)
-        for k in range(nm):
-            sel = self.mat == k
-            arr[:, k] += np.bincount(self.dofs[sel].ravel(), weights=np.repeat(0.25 * rho[sel] * self.vol0[sel], 4),
-                                     minlength=len(arr))
-        self._ghost_sum(mvec)
+        _per_material_to_nodes(self, 0.25 * rho * self.vol0, mvec)
         self.mass_by_material = arr[: self.n_nodes].copy()
         self.mass = self.mass_by_material.sum(axis=1)
-        self.body_mass = self.comm.allreduce(self.mass_by_material[: self.n_owned].sum(axis=0), op=MPI.SUM)
+        self.body_mass = assembly.exact_sum(self.mass_by_material[: self.n_owned], self.comm)
         self.orphans = self.mass <= 0.0
         if not orphans_allowed and np.any(self.orphans[: self.n_owned]):
             raise SimulationError("a node has no mass (an orphan node in the mesh)")
         self._mass_div = self.mass
         if np.any(self.orphans):
             self._mass_div = np.where(self.orphans, 1.0, self.mass)
-        self.total_mass = self.comm.allreduce(float(self.mass[: self.n_owned].sum()), op=MPI.SUM)
+        self.total_mass = assembly.exact_sum(self.mass[: self.n_owned], self.comm)
 
     # ------------------------------------------------------------------------------------------------
     def _ghost_sum(self, vec) -> None:
         vec.scatter_reverse(la.ScatterMode.add)
         vec.scatter_forward()
+
+    def _volumes_to_nodes(self, cvol: np.ndarray, vec) -> None:
+        """Nodal volumes per material (vector vec), Σ V_e / 4 over live cells, ghosts refreshed."""
+        _per_material_to_nodes(self, 0.25 * cvol, vec)
+
+    def _cells_to_nodes(self, Fc: np.ndarray, out: np.ndarray) -> None:
+        """The cells' nodal forces Fc (n_cells, 4, 3) summed into the owned rows of out (ghosts stale)."""
+        self._cell_sum(Fc, out)
 
     def positions(self) -> np.ndarray:
         """Current node positions (n_nodes, 3), ghosts included."""
@@ -147,7 +151,7 @@ class ExplicitSolver:
         """Safety x min over cells of (shortest altitude / dilatational speed), current mesh, all ranks."""
         # a scratch array: nodal_vol must keep the ghost-summed volumes of the last step (energies use them)
         _, _, h_c, _ = kernels.volumes_and_step(self.positions(), self.dofs, self.orient, self.vol0,
-                                                       self.mat, self.speed, np.empty_like(self.nodal_vol))
+                                                       self.mat, self.speed, np.empty(self.n_cells))
         return self.safety * self.step_gain * self.comm.allreduce(h_c, op=MPI.MIN)
 
     def calibrate_step(self, iterations: int = 400, rtol: float = 1e-5) -> tuple[float, float]:
@@ -194,7 +198,7 @@ class ExplicitSolver:
             a[:] = 0.0
         self.eps_p[:] = 0.0
         _, _, h_c, _ = kernels.volumes_and_step(self.positions(), self.dofs, self.orient, self.vol0, self.mat,
-                                                   self.speed, np.empty_like(self.nodal_vol))
+                                                   self.speed, np.empty(self.n_cells))
         h_c = self.comm.allreduce(h_c, op=MPI.MIN)
         dt_crit = 2.0 / np.sqrt(lam)
         # rounded down to a multiple of GAIN_QUANTUM: the Rayleigh quotient of a 1e-9 L displacement carries
@@ -226,9 +230,9 @@ class ExplicitSolver:
             self.interface(self)
 
     def kinetic_energy(self, vel: np.ndarray) -> float:
-        """Σ ½ m v² over owned nodes, all ranks."""
-        local = 0.5 * float(np.sum(self.mass[: self.n_owned, None] * vel[: self.n_owned] ** 2))
-        return self.comm.allreduce(local, op=MPI.SUM)
+        """Σ ½ m v² over owned nodes, all ranks (an exact sum: the same on any partition)."""
+        n = self.n_owned
+        return assembly.exact_sum(0.5 * self.mass[:n] * np.sum(vel[:n] ** 2, axis=1), self.comm)
 
     def velocity_at_step(self) -> np.ndarray:
         """v^n ≈ v^{n-1/2} + Δt/2 a^n (the velocity at the integer step, for energies and output)."""
@@ -242,16 +246,15 @@ class ExplicitSolver:
         x = np.add(self.X, self.U, out=self._x)
         with_step = self.step_count % STEP_EVERY == 0
         jmin, worst, h_c, self._step_cell = kernels.volumes_and_step(
-            x, self.dofs, self.orient, self.vol0, self.mat, self.speed, self.nodal_vol, with_step, self.cell_dt)
+            x, self.dofs, self.orient, self.vol0, self.mat, self.speed, self.cvol, with_step, self.cell_dt)
         if self._any_inverted(jmin):
             if self.on_inverted is None or not self.on_inverted(x):
                 failures.inverted(self, x, jmin, worst)
             jmin, worst, h_c, self._step_cell = kernels.volumes_and_step(  # the inverted cells eroded
-                x, self.dofs, self.orient, self.vol0, self.mat, self.speed, self.nodal_vol, with_step, self.cell_dt)
+                x, self.dofs, self.orient, self.vol0, self.mat, self.speed, self.cvol, with_step, self.cell_dt)
             if self._any_inverted(jmin):
                 failures.inverted(self, x, jmin, worst)
-        if self.nodal:
-            self._ghost_sum(self._nvol)
+        self._volumes_to_nodes(self.cvol, self._nvol)
         t1 = perf_counter()
         if self.nodal:
             kernels.nodal_pressures(self.nodal_vol, self.nodal_vol0, self.bulk, self.nodal_p)
@@ -284,12 +287,12 @@ class ExplicitSolver:
         self._heat += self._totals[1]
 
     def assemble_internal_force(self) -> None:
-        """f_int = ∫ P : ∇_X w dX from the packed P (ghost contributions summed to their owners), in one pass
-        over the owned cells with their reference gradients (kernels.internal_force: the compiled form's
-        vector to round-off, at a fraction of dolfinx's cost, which rebuilds each cell's geometry)."""
-        self.fint[:] = 0.0
-        kernels.internal_force(self.P_packed, self.dofs, self.grad0, self.vol0, self.fint)
-        self.fint_fn.x.scatter_reverse(la.ScatterMode.add)
+        """f_int = ∫ P : ∇_X w dX from the packed P on the owned nodes: each cell's four nodal forces with
+        its reference gradients (kernels.internal_force_cells: the compiled form's vector to round-off, at a
+        fraction of dolfinx's cost, which rebuilds each cell's geometry), summed at the nodes in the
+        partition-independent order (contributions of other ranks' cells included; ghost rows are stale)."""
+        kernels.internal_force_cells(self.P_packed, self.dofs, self.grad0, self.vol0, self.Fc)
+        self._cells_to_nodes(self.Fc, self.fint)
 
     def _any_inverted(self, jmin: float) -> bool:
         """Whether a live cell on any rank is inverted (or NaN); every rank gets the same answer."""
@@ -318,8 +321,7 @@ class ExplicitSolver:
         if self.fixed is not None:
             self.acc[self.fixed] = 0.0
         self.a_fn.x.scatter_forward()
-        self._w_int += 0.5 * float(np.sum(du[:n] * (self.fint_old[:n] + self.fint[:n])))
-        self._w_ext += 0.5 * float(np.sum(du[:n] * (self.fext_old[:n] + self.fext[:n])))
+        kernels.work_increments(du, self.fint_old, self.fint, self.fext_old, self.fext, n, self._work)
         self.t += dt
         self.step_count += 1
         self.dt_prev = dt
@@ -371,6 +373,22 @@ class ExplicitSolver:
         self._w_if_t += tangential
 
 
+def _per_material_to_nodes(s: ExplicitSolver, cell_values: np.ndarray, vec) -> None:
+    """Each live cell's value (n_cells,) to each of its four nodes, in its material's column of the vector
+    ``vec`` (bs = number of materials), summed in the partition-independent order (assembly.NodalSum),
+    ghosts refreshed."""
+    nm = len(s.materials)
+    if nm == 1:
+        np.multiply(cell_values, s.mat >= 0, out=s._cvol4[:, 0])  # eroded cells give nothing
+        vals = s._cvol4
+    else:
+        live = s.mat >= 0
+        vals = np.zeros((s.n_cells, nm))
+        vals[np.flatnonzero(live), s.mat[live]] = cell_values[live]
+    s._cell_sum(vals, vec.array.reshape(-1, nm))
+    vec.scatter_forward()
+
+
 # ------------------------------------------------------------------------------------------------
 # the solver's set-up, in the order ExplicitSolver.__init__ calls them
 
@@ -396,6 +414,12 @@ def _reference_body(s: ExplicitSolver, mesh) -> None:
     s.X[:] = s.geometry_x[s._geometry_node, :3]  # the mesh's own numbers (tabulated ones may differ in
     s.X0[:] = s.X  # the last bit), so that writing X back into the geometry changes nothing
     s.grad0, s.vol0, s.orient = kernels.reference_gradients(s.X, s.dofs)
+    # each node's input-mesh number (the same on any partition) and the cells' nodal sums in their order
+    s.input_index = np.asarray(mesh.geometry.input_global_indices, dtype=np.int64)[s._geometry_node]
+    s._cell_sum = assembly.NodalSum(s.comm, imap, s.dofs, assembly.input_keys(s.dofs, s.input_index))
+    s.cvol = np.zeros(n_cells)  # each cell's current volume
+    s._cvol4 = np.zeros((n_cells, 1))
+    s.Fc = np.zeros((n_cells, 4, 3))  # each cell's internal forces on its nodes
 
 
 def _material_tables(s: ExplicitSolver, materials: list[M.Material], cell_material: np.ndarray) -> None:
@@ -431,8 +455,10 @@ def _clock(s: ExplicitSolver) -> None:
     s.t = s.dt_prev = 0.0
     s.step_count = 0
     s.dt = s.dt0 = s.dt_min = s.stable_step()
-    # the work sums: internal, external, plastic, heat, and the interface's normal and tangential forces
-    s._w_int = s._w_ext = s._plastic = s._heat = s._w_if_n = s._w_if_t = 0.0
+    # the work sums: each node's internal and external work (_work, summed exactly when asked: work_sums),
+    # this rank's plastic work, heat, and the interface's normal and tangential work
+    s._work = np.zeros((s.n_nodes, 2))
+    s._plastic = s._heat = s._w_if_n = s._w_if_t = 0.0
     s.interface = None
     # called with the current positions when a live cell inverts (collective): True if it eroded the
     # inverted cells (fepen.solver.erosion), False or None to stop the run
@@ -459,8 +485,8 @@ def _nodal_arrays(s: ExplicitSolver, V, imap, nm: int) -> None:
     s.nodal_vol = s._nvol.array.reshape(-1, nm)
     s.nodal_vol0 = s._nvol0.array.reshape(-1, nm)
     s.nodal_p = np.zeros_like(s.nodal_vol0)
-    kernels.volumes_and_step(s.X, s.dofs, s.orient, s.vol0, s.mat, s.speed, s.nodal_vol0)
-    s._ghost_sum(s._nvol0)
+    kernels.volumes_and_step(s.X, s.dofs, s.orient, s.vol0, s.mat, s.speed, s.cvol)
+    s._volumes_to_nodes(s.cvol, s._nvol0)
 
 
 def _internal_force_form(s: ExplicitSolver, V, Q) -> None:

@@ -70,8 +70,8 @@ def _six_volume(x, dofs, e):
 
 
 @numba.njit(cache=True, fastmath=_FAST, error_model="numpy")
-def volumes_and_step(x, dofs, orient, vol0, mat, speed, nodal_vol, with_step=True, cell_dt=None):
-    """Current cell volumes into nodal volumes; the smallest J; the stable step of the current mesh.
+def volumes_and_step(x, dofs, orient, vol0, mat, speed, cvol, with_step=True, cell_dt=None):
+    """Current cell volumes; the smallest J; the stable step of the current mesh.
     Eroded cells (material −1) are skipped: no volume, no J, no step.
 
     Args:
@@ -79,14 +79,14 @@ def volumes_and_step(x, dofs, orient, vol0, mat, speed, nodal_vol, with_step=Tru
         dofs, vol0, mat: see stress_update. orient: +1 or −1 per cell, the sign of the reference
             det(X1 − X0, X2 − X0, X3 − X0) (so that J > 0 for an uninverted cell whatever the node order).
         speed: dilatational wave speed per material (m/s).
-        nodal_vol: (n_nodes, n_materials) output, zeroed and filled with Σ V_e / 4.
+        cvol: (n_cells,) output, each cell's current volume (0 for eroded cells); the nodal volumes are their
+            sums (fepen.solver.assembly.NodalSum, in a partition-independent order).
         with_step: also compute the shortest altitudes (else the third result is inf).
         cell_dt: None, or (n_cells,) output of each live cell's altitude / wave speed (with_step only).
 
     Returns:
         (min J, cell of min J, min over cells of shortest altitude / wave speed, cell of that minimum).
     """
-    nodal_vol[:] = 0.0
     jmin = np.inf
     worst = -1
     dtmin = np.inf
@@ -94,6 +94,7 @@ def volumes_and_step(x, dofs, orient, vol0, mat, speed, nodal_vol, with_step=Tru
     for e in range(dofs.shape[0]):
         m = mat[e]
         if m < 0:
+            cvol[e] = 0.0
             continue
         # J = det(x1 - x0, x2 - x0, x3 - x0) / (6 V0): needs the positions only, not the gradients
         J = _six_volume(x, dofs, e) / (6.0 * vol0[e]) * orient[e]
@@ -102,8 +103,7 @@ def volumes_and_step(x, dofs, orient, vol0, mat, speed, nodal_vol, with_step=Tru
                 jmin = J
                 worst = e
         V = J * vol0[e]
-        for a in range(4):
-            nodal_vol[dofs[e, a], m] += 0.25 * V
+        cvol[e] = V
         if not with_step:
             continue
         # shortest altitude = 3 V / largest face area
@@ -403,6 +403,37 @@ def internal_force(P, dofs, grad0, vol0, f):
             f[nd, 0] += P00 * g0 + P01 * g1 + P02 * g2
             f[nd, 1] += P10 * g0 + P11 * g1 + P12 * g2
             f[nd, 2] += P20 * g0 + P21 * g1 + P22 * g2
+
+
+@numba.njit(cache=True, error_model="numpy")
+def internal_force_cells(P, dofs, grad0, vol0, Fc):
+    """Each cell's internal forces on its four nodes, V0_e P_e grad0_{e,a}, into Fc (n_cells, 4, 3) (the
+    terms internal_force adds; their nodal sums are taken in a partition-independent order by
+    fepen.solver.assembly.NodalSum)."""
+    for e in range(dofs.shape[0]):
+        v = vol0[e]
+        P00, P01, P02 = v * P[e, 0], v * P[e, 1], v * P[e, 2]
+        P10, P11, P12 = v * P[e, 3], v * P[e, 4], v * P[e, 5]
+        P20, P21, P22 = v * P[e, 6], v * P[e, 7], v * P[e, 8]
+        for a in range(4):
+            g0, g1, g2 = grad0[e, a, 0], grad0[e, a, 1], grad0[e, a, 2]
+            Fc[e, a, 0] = P00 * g0 + P01 * g1 + P02 * g2
+            Fc[e, a, 1] = P10 * g0 + P11 * g1 + P12 * g2
+            Fc[e, a, 2] = P20 * g0 + P21 * g1 + P22 * g2
+
+
+@numba.njit(cache=True, error_model="numpy")
+def work_increments(du, f_old, f, g_old, g, n, work):
+    """Each owned node's work over a step by the trapezoidal rule, ½ Δu·(f_old + f) for the internal forces
+    f and the external forces g, added into work (n_nodes, 2) (its sums: ExplicitSolver.work_sums)."""
+    for a in range(n):
+        wi = 0.0
+        we = 0.0
+        for k in range(3):
+            wi += du[a, k] * (f_old[a, k] + f[a, k])
+            we += du[a, k] * (g_old[a, k] + g[a, k])
+        work[a, 0] += 0.5 * wi
+        work[a, 1] += 0.5 * we
 
 
 @numba.njit(cache=True, fastmath=_FAST, error_model="numpy")

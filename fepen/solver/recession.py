@@ -29,7 +29,7 @@ from dolfinx import mesh as dmesh
 from mpi4py import MPI
 
 from fepen.laws import wear
-from fepen.solver import reference
+from fepen.solver import assembly, reference
 
 __all__ = ["Recession"]
 
@@ -59,6 +59,8 @@ class Recession:
         self._vec1 = la.vector(imap, bs=1)
         self.heat_nodes = np.zeros(solver.n_nodes)  # heat since the last application (J), this rank's facets
         self.heat_total = 0.0  # this rank's heat so far (J)
+        # the heat since the last application, summed exactly (the contraction's: the same on any partition)
+        self._heat_exact = assembly.ExactAccumulator(1)
         self.depth = np.zeros(solver.n_nodes)  # total recession of each node (m), ghosts consistent
         n = solver.n_nodes
         d = solver.dofs
@@ -76,7 +78,7 @@ class Recession:
     def state(self) -> dict[str, np.ndarray]:
         """The heat and recession so far (for checkpoints)."""
         return {"heat_nodes": self.heat_nodes, "depth": self.depth, "heat_total": np.array([self.heat_total]),
-                "contraction": np.array([self.contraction])}
+                "contraction": np.array([self.contraction]), "heat_limbs": self._heat_exact.limbs}
 
     def restore(self, state: dict) -> None:
         """Put back what state() returned."""
@@ -85,6 +87,8 @@ class Recession:
         self.heat_total = float(state["heat_total"][0])
         if "contraction" in state:
             self.contraction = float(state["contraction"][0])
+        if "heat_limbs" in state:
+            self._heat_exact.limbs[:] = state["heat_limbs"]
 
     def _zone_volume(self) -> float:
         """Reference volume of the nose zone (y < zone_end) (m³, all ranks): each live owned cell's volume
@@ -92,7 +96,7 @@ class Recession:
         s = self.solver
         inside = (s.X[:, 1] < self.zone_end)[s.dofs].mean(axis=1)
         own = s.mat[: s.n_cells] >= 0
-        return s.comm.allreduce(float(np.sum(s.vol0[own] * inside[own])), op=MPI.SUM)
+        return assembly.exact_sum(s.vol0[own] * inside[own], s.comm)
 
     def _zone_eroding(self) -> bool:
         """Whether a cell of the nose zone has eroded (collective): the nose no longer keeps its kind (it
@@ -108,7 +112,10 @@ class Recession:
     def add(self, force: np.ndarray, n: np.ndarray, v: np.ndarray, dt: float) -> None:
         """Record one step's heat at the surface's points (their target forces, normals, velocities): the
         heat of fepen.laws.wear.heat_rates × Δt, a third to each of the point's facet nodes."""
-        self.heat_total += _heat_to_nodes(force, n, v, self.surface.tri, self.mu * dt, self.heat_nodes)
+        q = np.zeros(len(force))
+        self.heat_total += _heat_to_nodes(force, n, v, self.surface.tri, self.mu * dt, self.heat_nodes, q)
+        if self.zone_end is not None:
+            self._heat_exact.add(q[q > 0.0])
 
     def _ghost_sum(self, vec, values: np.ndarray) -> np.ndarray:
         """The sum over ranks of a nodal array (n_nodes, k), ghosts consistent."""
@@ -155,6 +162,7 @@ class Recession:
             return self._contract()
         heat = self._ghost_sum(self._vec1, self.heat_nodes)
         self.heat_nodes[:] = 0.0
+        self._heat_exact.clear()
         nrm = np.zeros((s.n_nodes, 3))
         area = np.zeros(s.n_nodes)
         av = 0.5 * np.cross(s.X[surf.tri[:, 1]] - s.X[surf.tri[:, 0]], s.X[surf.tri[:, 2]] - s.X[surf.tri[:, 0]])
@@ -185,7 +193,8 @@ class Recession:
         """The "nose" distribution: shorten the nose zone by the volume melted since the last call
         (collective). Returns the tip's recession of this application (m)."""
         s, surf = self.solver, self.surface
-        heat = s.comm.allreduce(float(self.heat_nodes.sum()), op=MPI.SUM)
+        heat = float(self._heat_exact.total(s.comm)[0])
+        self._heat_exact.clear()
         self.heat_nodes[:] = 0.0
         volume = wear.melted_mass(heat, self.efficiency, self.enthalpy) / self.density
         if volume <= 0.0:
@@ -224,9 +233,9 @@ class Recession:
 
 
 @numba.njit(cache=True)
-def _heat_to_nodes(force, n, v, tri, coef, out):
-    """Add coef × max(−f·n, 0) × |v_t| of each point to its facet's three nodes in ``out``; returns the sum
-    (the same heat as fepen.laws.wear.heat_rates × Δt, in one pass)."""
+def _heat_to_nodes(force, n, v, tri, coef, out, q_out):
+    """Add coef × max(−f·n, 0) × |v_t| of each point to its facet's three nodes in ``out`` and into q_out
+    (per point); returns the sum (the same heat as fepen.laws.wear.heat_rates × Δt, in one pass)."""
     total = 0.0
     for i in range(force.shape[0]):
         fn = -(force[i, 0] * n[i, 0] + force[i, 1] * n[i, 1] + force[i, 2] * n[i, 2])
@@ -238,6 +247,7 @@ def _heat_to_nodes(force, n, v, tri, coef, out):
         t2 = v[i, 2] - vn * n[i, 2]
         q = coef * fn * np.sqrt(t0 * t0 + t1 * t1 + t2 * t2)
         total += q
+        q_out[i] = q
         for k in range(3):
             out[tri[i, k]] += q / 3.0
     return total

@@ -56,9 +56,8 @@ def rebuild(solver, cells: np.ndarray) -> None:
         s._trial.refresh(s.mat, 6.0 * s.vol0 * s.orient)
     old = s.mass.copy()
     v = s.velocity_at_step()
-    kernels.volumes_and_step(s.X, s.dofs, s.orient, s.vol0, s.mat, s.speed,
-                             s.nodal_vol0, False)
-    s._ghost_sum(s._nvol0)
+    kernels.volumes_and_step(s.X, s.dofs, s.orient, s.vol0, s.mat, s.speed, s.cvol, False)
+    s._volumes_to_nodes(s.cvol, s._nvol0)
     nm = len(s.materials)
     s._lumped_mass(s.V.dofmap.index_map, nm, orphans_allowed=True)
     n = s.n_owned

@@ -7,7 +7,8 @@ import numpy as np
 from mpi4py import MPI
 
 from fepen.geometry import tags
-from fepen.laws.contact import pair_forces, pair_work, wall_normals
+from fepen.laws.contact import pair_forces, pair_work, wall_facet_normals
+from fepen.solver import assembly
 
 
 class ShellChargeContact:
@@ -35,6 +36,9 @@ class ShellChargeContact:
         self.tri = oriented_facets(s.V, facet_tags, tags.CHARGE_FACE)
         self._nvec = la.vector(s.V.dofmap.index_map, bs=3)
         self.nodal_n = self._nvec.array.reshape(-1, 3)
+        self._facet_n = np.zeros((len(self.tri), 3))
+        self._wall_sum = assembly.NodalSum(s.comm, s.V.dofmap.index_map, self.tri,
+                                           assembly.input_keys(self.tri, s.input_index))
         # wall nodes: those of the owned wall facets, marked and ghost-summed
         mark = la.vector(s.V.dofmap.index_map, bs=1)
         mark.array[np.unique(self.tri)] = 1.0
@@ -75,12 +79,9 @@ class ShellChargeContact:
     def normals(self, x=None) -> np.ndarray:
         """Unit normals out of the charge at the pairs, current configuration (x: the current positions,
         if at hand)."""
-        from dolfinx import la
-
         s = self.solver
-        self.nodal_n[:] = 0.0
-        wall_normals(s.positions() if x is None else x, self.tri, self.nodal_n)
-        self._nvec.scatter_reverse(la.ScatterMode.add)
+        wall_facet_normals(s.positions() if x is None else x, self.tri, self._facet_n)
+        self._wall_sum(self._facet_n, self.nodal_n)  # in the facets' canonical order: any partition alike
         self._nvec.scatter_forward()
         nn = self.nodal_n[self.pb]
         return nn / np.linalg.norm(nn, axis=1)[:, None]

@@ -133,6 +133,9 @@ class Surface:
     cell: np.ndarray
 
     FIELDS = ("tri", "X", "area0", "flat0", "N0", "n_flat0", "radius", "R_meridian", "sin_phi0", "cell")
+    #: bumped whenever the facets change (keep, restore: collective, on every rank alike), so that their
+    #: nodal sums (fepen.solver.assembly.NodalSum) are rebuilt
+    version = 0
 
     def state(self) -> dict[str, np.ndarray]:
         """The load points (for checkpoints: wear and erosion change them)."""
@@ -142,11 +145,13 @@ class Surface:
         """Put back what state() returned."""
         for k in self.FIELDS:
             setattr(self, k, np.ascontiguousarray(state[k]))
+        self.version += 1
 
     def keep(self, mask: np.ndarray) -> None:
         """Keep only the facets where mask is True (in place)."""
         for k in self.FIELDS:
             setattr(self, k, np.ascontiguousarray(getattr(self, k)[mask]))
+        self.version += 1
 
     def append_flat(self, X_ref: np.ndarray, tri: np.ndarray, cell: np.ndarray) -> None:
         """Add facets exposed inside the body (by erosion): their own flat normals and areas, no exact
@@ -246,9 +251,20 @@ def smoothed_normals(P: np.ndarray, n: np.ndarray, area: np.ndarray, comm) -> np
     return out
 
 
+def node_positions(V) -> np.ndarray:
+    """The mesh's own coordinates of V's nodes (owned and ghost) (n_nodes, 3): the solver's reference
+    positions, bit for bit (tabulated dof coordinates are interpolated and may differ in the last bit, and
+    differently on another partition)."""
+    mesh = V.mesh
+    imap = V.dofmap.index_map
+    geometry_node = np.zeros(imap.size_local + imap.num_ghosts, dtype=np.int64)
+    geometry_node[V.dofmap.list.array] = mesh.geometry.dofmap.array
+    return mesh.geometry.x[geometry_node, :3].copy()
+
+
 def oriented_facets(V, facet_tags, tag: int, with_cells: bool = False):
     """The owned facets carrying ``tag``, as node triples (block indices of V) ordered so that their area
-    vectors point out of the cell they bound.
+    vectors point out of the cell they bound, each starting at its node of the smallest input-mesh number.
 
     Args:
         V: the P1 vector function space of the solver (its block indices are the nodes).
@@ -280,6 +296,13 @@ def oriented_facets(V, facet_tags, tag: int, with_cells: bool = False):
         p = X[tri[i]]
         if np.dot(np.cross(p[1] - p[0], p[2] - p[0]), p.mean(axis=0) - X[opp]) < 0:
             tri[i, [1, 2]] = tri[i, [2, 1]]
+    # start each facet at its corner of the smallest input-mesh number (a turn: the orientation stays), so
+    # that a facet's arithmetic (its centroid (x0 + x1 + x2) / 3, ...) is the same on any partition
+    gdofs = mesh.geometry.dofmap.array.reshape(-1, 4)
+    geometry_node = np.zeros(len(X), dtype=np.int64)
+    geometry_node[cdofs.ravel()] = gdofs.ravel()
+    first = np.argmin(np.asarray(mesh.geometry.input_global_indices, dtype=np.int64)[geometry_node][tri], axis=1)
+    tri = tri[np.arange(len(tri))[:, None], (first[:, None] + np.arange(3)) % 3]
     return (tri, cells) if with_cells else tri
 
 
@@ -292,8 +315,7 @@ def outer_surface(V, facet_tags, shape, tag: int = tags.OUTER) -> Surface:
         shape: the exact fepen.geometry.shape.Shape the mesh was built from (body frame = reference frame),
             or its CadBody.
     """
-    imap = V.dofmap.index_map
-    X = V.tabulate_dof_coordinates()[: imap.size_local + imap.num_ghosts]
+    X = node_positions(V)
     tri, cells = oriented_facets(V, facet_tags, tag, with_cells=True)
     if isinstance(shape, CadBody):  # no exact surface: the facets' areas, their normals smoothed across smooth edges
         empty = np.zeros(0, dtype=np.int64)

@@ -2,8 +2,8 @@
 (docs/theory.md §10).
 
 Each step: the load points of the deformed surface (fepen.solver.surface) → the target law on them
-(fepen.laws.target.load_on_points) → forces shared to the facets' nodes, summed across ranks, added to
-the owned nodes' external force.
+(fepen.laws.target.load_on_points) → forces shared to the facets' nodes, summed in the facets' canonical
+order whatever rank holds them, added to the owned nodes' external force.
 """
 
 from __future__ import annotations
@@ -11,17 +11,18 @@ from __future__ import annotations
 from time import perf_counter
 
 import numpy as np
-from dolfinx import la
-from mpi4py import MPI
 
 from fepen.geometry.frames import unit_axis
 from fepen.laws import target as tg
-from fepen.solver import probes
+from fepen.solver import assembly, probes
 from fepen.solver.surface import Surface
 
 
 class TargetLoad:
     """External force of the concrete target on an ExplicitSolver (an explicit.Load).
+
+    The same numbers on any partition: the points' forces reach their nodes in the facets' canonical order
+    (fepen.solver.assembly.NodalSum), and the total force that scales the crater is an exact sum.
 
     Args:
         solver: the ExplicitSolver.
@@ -33,11 +34,21 @@ class TargetLoad:
 
     def __init__(self, solver, surf: Surface, law: tg.TargetLaw, tip, tail, crater=None):
         self.surf, self.law, self.tip, self.tail, self.crater = surf, law, tip, tail, crater
-        self.buf = la.vector(solver.V.dofmap.index_map, bs=3)
         self.force = np.zeros(3)
         self.contact_nodes = 0
         self.area = 0.0
         self.wear = None  # a fepen.solver.recession.Recession fed each step's point loads, or None
+        self._nodes = np.zeros((solver.n_nodes, 3))
+        self._sum = None  # the facets' NodalSum, rebuilt when the facets change (erosion; collective)
+        self._sum_version = -1
+
+    def _facet_sum(self, solver) -> assembly.NodalSum:
+        if self._sum is None or self._sum_version != self.surf.version:
+            tri = self.surf.tri
+            self._sum = assembly.NodalSum(solver.comm, solver.V.dofmap.index_map, tri,
+                                          assembly.input_keys(tri, solver.input_index))
+            self._sum_version = self.surf.version
+        return self._sum
 
     def __call__(self, solver, dt: float) -> None:
         x_all = solver.positions()  # from X and U: a load may be evaluated on a state set by hand (wear playback)
@@ -45,30 +56,31 @@ class TargetLoad:
         tip, tail = probes.node_values(solver, (self.tip, self.tail), x_all)  # one reduction for both
         comm_s = perf_counter() - t0
         axis = unit_axis(tip, tail)
+        comm = solver.comm
 
-        def reduce(a):
+        def reduce(f, sums):
+            """All ranks' totals in one reduction: the force exactly, the loaded count and area."""
             nonlocal comm_s
             t1 = perf_counter()
-            a = np.array(a, dtype=float)
-            if solver.comm.size > 1:
-                solver.comm.Allreduce(MPI.IN_PLACE, a, op=MPI.SUM)
+            hit = np.flatnonzero(np.any(f != 0.0, axis=1))
+            terms = np.zeros((len(hit) + 1, 5))
+            terms[:-1, :3] = f[hit]
+            terms[-1, 3:] = sums[3:]
+            out = assembly.exact_sum(terms, comm)
             comm_s += perf_counter() - t1
-            return a
+            return out
 
         x, v, area, n = self.surf.kinematics(x_all, solver.Vel)
         s = self.surf
         load = tg.load_on_points(self.law, x, v, n, area, s.radius, s.R_meridian, s.sin_phi0, axis, self.crater,
                                  -tip[1], reduce)
-        arr = self.buf.array.reshape(-1, 3)
-        arr[:] = 0.0
-        self.surf.to_nodes(load.force, arr)
         if self.wear is not None:
             self.wear.add(load.force, n, v, dt)
         t1 = perf_counter()
-        self.buf.scatter_reverse(la.ScatterMode.add)
+        self._facet_sum(solver)(load.force / 3.0, self._nodes)  # a third to each corner
         comm_s += perf_counter() - t1
         n_own = solver.n_owned
-        solver.fext[:n_own] += arr[:n_own]
+        solver.fext[:n_own] += self._nodes[:n_own]
         self.force, self.contact_nodes, self.area = load.total, load.loaded, load.area
         solver.times.target_comm += comm_s
 

@@ -40,6 +40,14 @@ def test_gradients_reproduce_linear_fields():
     assert np.all(v0 > 0)
 
 
+def nodal_volumes(x, dofs, orient, v0, mat, speed, out):
+    """The nodal volumes Σ V_e / 4 (one material) from volumes_and_step's cell volumes."""
+    cvol = np.empty(len(dofs))
+    K.volumes_and_step(x, dofs, orient, v0, mat, speed, cvol)
+    out[:] = 0.0
+    np.add.at(out[:, 0], dofs.ravel(), np.repeat(0.25 * cvol, 4))
+
+
 def run_motion(X, dofs, positions, dt, s0, material, nodal=True, kernel="numba", full=False):
     """Drive the stress update through a prescribed sequence of node positions.
 
@@ -59,7 +67,7 @@ def run_motion(X, dofs, positions, dt, s0, material, nodal=True, kernel="numba",
     work = 0.0
     nv, nv0, npres = np.zeros((len(X), 1)), np.zeros((len(X), 1)), np.zeros((len(X), 1))
     speed = np.array([6000.0])
-    K.volumes_and_step(X, dofs, orient, v0, mat, speed, nv0)
+    nodal_volumes(X, dofs, orient, v0, mat, speed, nv0)
     xb, vb = np.empty_like(X), np.empty_like(X)
     if kernel == "C":
         trial = ckernel.TrialPass(xb, vb, np.ascontiguousarray(X), dofs, mat, 6.0 * v0 * orient,
@@ -67,7 +75,7 @@ def run_motion(X, dofs, positions, dt, s0, material, nodal=True, kernel="numba",
     for a, b in zip(positions[:-1], positions[1:]):
         xb[:] = b
         vb[:] = (b - a) / dt
-        K.volumes_and_step(xb, dofs, orient, v0, mat, speed, nv)
+        nodal_volumes(xb, dofs, orient, v0, mat, speed, nv)
         K.nodal_pressures(nv, nv0, np.array([material.bulk_modulus]), npres)
         if kernel == "C":
             K.plastic_pass(xb, dt, dofs, g, v0, mat, params, s, ep, T, sy0, P, trial(dt), tot)
