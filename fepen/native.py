@@ -15,7 +15,9 @@ from fepen.atomic import replacing
 
 __all__ = ["FLAGS", "cache_dir", "load"]
 
-FLAGS = ["-O3", "-march=native", "-fopenmp-simd", "-fPIC", "-shared"]
+#: no fast-math (NaN and inf must propagate); -fno-math-errno only lets sqrt be one instruction (errno is never
+#: read), without which GCC keeps a loop that takes a square root scalar
+FLAGS = ["-O3", "-march=native", "-fopenmp-simd", "-fno-math-errno", "-fPIC", "-shared"]
 
 
 def _cpu_flags() -> str:

@@ -83,8 +83,10 @@ class ExplicitSolver:
         safety: stable-step safety factor f in Δt = f min(h/c).
         nodal_pressure: averaged nodal pressure (True) or the plain tetrahedron (False).
         external: a Load (adds external nodal forces into ``solver.fext``), or None.
-        kernel: the stress update: "C" (the C trial pass and the numba return), "numba" (the numba kernel
-            alone, the reference), or None: C where it can be built (always numba for the plain element).
+        kernel: the step's kernels: "C" (the C passes, fepen/solver/cell_kernel.c: kinematics, one fused
+            stress-return-force pass, node update), "numba" (the numba kernels, the reference), or None: C
+            where it can be built (always numba for the plain element). The C passes do not write
+            ``P_packed`` (the form's coefficient; only the numba path and assemble_internal_force use it).
 
     ``interface``: an Interface set after construction (fepen.solver.shell_charge), called once a^n is
     known and Δt_{n+1/2} chosen, to add constraint forces of the coming step to ``acc``.
@@ -235,9 +237,12 @@ class ExplicitSolver:
         return self.Vel + 0.5 * self.dt_prev * self.acc
 
     # ------------------------------------------------------------------------------------------------
-    def _forces(self, dt: float) -> float:
+    def _forces(self, dt: float, x_ready: bool = False) -> float:
         """Internal and external forces at the current positions; returns the new stable-step estimate
-        (h/c over the current mesh, before the safety factor) on this rank."""
+        (h/c over the current mesh, before the safety factor) on this rank. x_ready: ``self._x`` already
+        holds X + U (the C update pass wrote it)."""
+        if self._cells is not None:
+            return self._forces_c(dt, x_ready)
         t0 = perf_counter()
         x = np.add(self.X, self.U, out=self._x)
         with_step = self.step_count % STEP_EVERY == 0
@@ -259,27 +264,71 @@ class ExplicitSolver:
         t2 = perf_counter()
         self.assemble_internal_force()
         t3 = perf_counter()
+        self._external_forces()
+        self._times(t0, t1, t2, t3)
+        return h_c
+
+    def _forces_c(self, dt: float, x_ready: bool) -> float:
+        """_forces through the C passes (fepen/solver/cell_kernel.c): the kinematics pass (cvol, J, h/c),
+        the nodal volumes and pressures, the fused stress-and-force pass (Fc), the nodal forces."""
+        t0 = perf_counter()
+        x = self._x if x_ready else np.add(self.X, self.U, out=self._x)
+        with_step = self.step_count % STEP_EVERY == 0
+        cells = self._cells
+        jmin, worst, h_c, self._step_cell = cells.kinematics(with_step)
+        if self._any_inverted(jmin):
+            if self.on_inverted is None or not self.on_inverted(x):
+                failures.inverted(self, x, jmin, worst)
+            jmin, worst, h_c, self._step_cell = cells.kinematics(with_step)  # the inverted cells eroded
+            if self._any_inverted(jmin):
+                failures.inverted(self, x, jmin, worst)
+        self._volumes_to_nodes(self.cvol, self.nodal_vol)
+        t1 = perf_counter()
+        self._nodes.nodal_pressure(self.nodal_vol, self.nodal_vol0, self.bulk, self.nodal_p)
+        cells.cells(dt)
+        self._plastic += self._totals[0]
+        self._heat += self._totals[1]
+        t2 = perf_counter()
+        self._cells_to_nodes(self.Fc, self.fint)
+        t3 = perf_counter()
+        self._external_forces()
+        self._times(t0, t1, t2, t3)
+        return h_c
+
+    def _volumes_to_nodes(self, cvol: np.ndarray, nodal_vol: np.ndarray) -> None:
+        """The nodal volumes per material, ghosts summed: nodal_vol[a, k] = Σ over the live cells of material
+        k at node a of cvol / 4 (a plain sum in cell order, then the ghost sum)."""
+        self._nodes.scatter_volumes(self._cells._dofs, self.mat, cvol, nodal_vol)
+        self._ghost_sum(self._nvol)
+
+    def _cells_to_nodes(self, Fc: np.ndarray, fint: np.ndarray) -> None:
+        """The internal nodal forces: fint[a] = Σ over the cells at node a of their Fc (a plain sum in cell
+        order), ghost contributions summed to their owners."""
+        self._nodes.scatter_forces(self._cells._dofs, Fc, fint)
+        self.fint_fn.x.scatter_reverse(la.ScatterMode.add)
+
+    def _external_forces(self) -> None:
+        """fext from the external load (zero without one)."""
         self.fext[:] = 0.0
         if self.external is not None:
             self.external(self, self.dt)
+
+    def _times(self, t0: float, t1: float, t2: float, t3: float) -> None:
+        """Add a force evaluation's parts (kinematics t0–t1, material t1–t2, assembly t2–t3, boundary
+        t3–now) to ``times``."""
         t4 = perf_counter()
         tm = self.times
         tm.kinematics += t1 - t0
         tm.material += t2 - t1
         tm.assembly += t3 - t2
         tm.boundary += t4 - t3
-        return h_c
 
     def _stress_update(self, x: np.ndarray, dt: float) -> None:
-        """Every cell's stress over the step and P into the packed coefficient; plastic work and heat."""
-        if self._trial is not None:
-            yielding = self._trial(dt)
-            kernels.plastic_pass(x, dt, self.dofs, self.grad0, self.vol0, self.mat, self.params, self.s,
-                                 self.eps_p, self.temp, self.sy0, self.P_packed, yielding, self._totals)
-        else:
-            kernels.stress_update(x, self.Vel, dt, self.dofs, self.grad0, self.vol0, self.mat, self.params,
-                                  self.nodal_p, self.nodal, self.s, self.eps_p, self.temp, self.sy0,
-                                  self.P_packed, self._totals)
+        """Every cell's stress over the step and P into the packed coefficient; plastic work and heat (the
+        numba reference)."""
+        kernels.stress_update(x, self.Vel, dt, self.dofs, self.grad0, self.vol0, self.mat, self.params,
+                              self.nodal_p, self.nodal, self.s, self.eps_p, self.temp, self.sy0,
+                              self.P_packed, self._totals)
         self._plastic += self._totals[0]
         self._heat += self._totals[1]
 
@@ -303,23 +352,33 @@ class ExplicitSolver:
     def step(self) -> None:
         """Advance one central-difference step."""
         dt = self.dt
-        t0 = perf_counter()
-        self.Vel += (0.5 * (self.dt_prev + dt)) * self.acc
-        du = dt * self.Vel
-        self.U += du
-        self.fint_old[:] = self.fint
-        self.fext_old[:] = self.fext
-        self.times.update += perf_counter() - t0
-        h_c = self._forces(dt)
-        t0 = perf_counter()
         n = self.n_owned
-        f = self.fext[:n] - self.fint[:n]
-        self.acc[:n] = f / self._mass_div[:n, None]
-        if self.fixed is not None:
-            self.acc[self.fixed] = 0.0
+        t0 = perf_counter()
+        h = 0.5 * (self.dt_prev + dt)
+        if self._nodes is not None:  # the C node passes: x = X + U written too
+            w_int, w_ext = self._nodes.update_begin(h, dt, n, self.acc, self.Vel, self.U, self.X, self._x,
+                                                    self._du, self.fint, self.fext)
+        else:
+            self.Vel += h * self.acc
+            du = np.multiply(dt, self.Vel, out=self._du)
+            self.U += du
+            w_int = float(np.sum(du[:n] * self.fint[:n]))
+            w_ext = float(np.sum(du[:n] * self.fext[:n]))
+        self.times.update += perf_counter() - t0
+        h_c = self._forces(dt, x_ready=self._nodes is not None)
+        t0 = perf_counter()
+        du = self._du
+        if self._nodes is not None:
+            wi, we = self._nodes.update_end(n, self.fint, self.fext, self._mass_div, self.fixed, du, self.acc)
+        else:
+            self.acc[:n] = (self.fext[:n] - self.fint[:n]) / self._mass_div[:n, None]
+            if self.fixed is not None:
+                self.acc[self.fixed] = 0.0
+            wi = float(np.sum(du[:n] * self.fint[:n]))
+            we = float(np.sum(du[:n] * self.fext[:n]))
         self.a_fn.x.scatter_forward()
-        self._w_int += 0.5 * float(np.sum(du[:n] * (self.fint_old[:n] + self.fint[:n])))
-        self._w_ext += 0.5 * float(np.sum(du[:n] * (self.fext_old[:n] + self.fext[:n])))
+        self._w_int += 0.5 * (w_int + wi)
+        self._w_ext += 0.5 * (w_ext + we)
         self.t += dt
         self.step_count += 1
         self.dt_prev = dt
@@ -450,10 +509,9 @@ def _nodal_arrays(s: ExplicitSolver, V, imap, nm: int) -> None:
     s.a_fn = fem.Function(V, name="acceleration")
     s.acc = s.a_fn.x.array.reshape(-1, 3)
     s.fint = s.fint_fn.x.array.reshape(-1, 3)
-    s.fint_old = np.zeros_like(s.fint)
+    s._du = np.zeros_like(s.fint)  # the displacement increment of the step (for the work of the forces)
     s.fixed = None  # (n_nodes, 3) bool: velocity components held at zero (symmetry planes)
     s.fext = np.zeros((s.n_nodes, 3))
-    s.fext_old = np.zeros_like(s.fext)
     s._nvol = la.vector(imap, bs=nm)
     s._nvol0 = la.vector(imap, bs=nm)
     s.nodal_vol = s._nvol.array.reshape(-1, nm)
@@ -477,18 +535,22 @@ def _internal_force_form(s: ExplicitSolver, V, Q) -> None:
 
 
 def _stress_kernel(s: ExplicitSolver, kernel: str | None) -> None:
-    """The stress update: the C trial pass + numba radial return, or the numba kernel alone (the
-    reference; also the plain element's)."""
+    """The step's kernels: the C passes (fepen.solver.ckernel: kinematics, fused stress and force, node
+    update), or the numba kernels alone (the reference; also the plain element's)."""
     materials = s.materials
     s._x = np.empty((s.n_nodes, 3))  # current positions X + U of the last force evaluation (the kernels')
     s._flag = np.zeros(1)
-    s._trial = None
+    s._cells = s._nodes = None
     if kernel not in (None, "C", "numba"):
         raise ValueError(f"kernel must be 'C', 'numba' or None, not {kernel!r}")
     if kernel == "C" and (not s.nodal or ckernel.library() is None):
         raise RuntimeError(f"the C kernel is not available: {ckernel.why_not() or 'plain element'}")
     if s.nodal and kernel != "numba" and ckernel.library() is not None:
         s.G_m = np.array([m.shear_modulus for m in materials])
-        s._trial = ckernel.TrialPass(s._x, s.Vel, s.X, s.dofs, s.mat, 6.0 * s.vol0 * s.orient, s.G_m,
-                                     s.nodal_p, s._sT, s.sy0, s.P_packed)
-    s.kernel = "C" if s._trial is not None else "numba"
+        s.cvol = np.zeros(s.n_cells)  # current volume of each cell (0: eroded)
+        s.Fc = np.zeros((s.n_cells, 4, 3))  # each cell's internal force on its four nodes
+        s._cells = ckernel.CellPasses(s._x, s.Vel, s.dofs, s.mat, s.orient, s.vol0, s.speed, s.params, s.G_m,
+                                      s.nodal_p, s._sT, s.eps_p, s.temp, s.sy0, s.cvol, s.cell_dt, s.Fc,
+                                      s._totals)
+        s._nodes = ckernel.NodePasses()
+    s.kernel = "C" if s._cells is not None else "numba"

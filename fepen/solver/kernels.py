@@ -97,10 +97,9 @@ def volumes_and_step(x, dofs, orient, vol0, mat, speed, nodal_vol, with_step=Tru
             continue
         # J = det(x1 - x0, x2 - x0, x3 - x0) / (6 V0): needs the positions only, not the gradients
         J = _six_volume(x, dofs, e) / (6.0 * vol0[e]) * orient[e]
-        if not (J > jmin):
-            if not (J >= jmin):  # also catches NaN
-                jmin = J
-                worst = e
+        if not (J >= jmin) and jmin == jmin:  # smaller, or the first NaN (kept: a later cell must not hide it)
+            jmin = J
+            worst = e
         V = J * vol0[e]
         for a in range(4):
             nodal_vol[dofs[e, a], m] += 0.25 * V
