@@ -1,69 +1,383 @@
-/* The elastic trial pass of fepen's stress update, in C so that the compiler vectorises it across cells.
+/* The deformable step of fepen's explicit solver in C: a few passes over the cells and nodes, vectorised
+   across cells by the compiler, with no Python between their pieces (docs/theory.md §3.3).
 
-   The arithmetic of fepen.kinematics.stress_update (its reference, written for numba, which does not
-   vectorise it), written with edge matrices so that no per-cell reference gradients are streamed from
-   memory (the pass is memory-bound on large meshes): with E, U, R the current, step-increment (v dt) and
-   reference edge matrices of a cell and a = E - U/2 the mid-step one,
-       F = E R^-1,  L = D F_m^-1 = U a^-1,  cof F = cof(E) R^T / det R,
-   the Hughes-Winget (Cayley) rotation of the deviatoric stress, s += 2 G dev sym L, P = (s + p I) cof F
-   with p the average of the cell's four nodal pressures. Cells whose trial von Mises stress exceeds their
-   static flow stress are listed; their radial return is done afterwards, in fepen.kinematics.plastic_pass.
+   Passes of one step (fepen/solver/explicit.py calls them in this order):
+     update_begin     nodes: v += (dt_prev + dt)/2 a, du = dt v, u += du, x = X + u; the work of the old forces
+     kinematics_pass  cells: current volume cvol (the nodal volumes are summed from it by the solver), the
+                      smallest J (inverted or NaN cells), and every STEP_EVERY steps h/c per cell
+     scatter_volumes  cells -> nodes: nodal volume per material (a plain sum in cell order; replaceable)
+     nodal_pressure   nodes: p_a = K ln(J_a) / J_a per material
+     cell_pass        cells, ONE fused pass: elastic trial stress (Hughes-Winget), the radial return of the
+                      cells over their flow stress (inline, in the same block), and the cell's internal force
+                      on its four nodes, Fc
+     scatter_forces   cells -> nodes: f_int = sum of Fc (a plain sum in cell order; replaceable)
+     update_end       nodes: a = (f_ext - f_int) / m, the work of the new forces
 
-   Layouts: the deviatoric stress s is component-major (k * n + e) so that the cell loop's loads and stores
-   are contiguous; nodal arrays (x, v, X, nodal_p) are row-major and gathered through dofs; P is written
-   row-major (n, 9), as dolfinx packs the coefficient, through a small block buffer. No fast-math: NaN and
-   inf propagate, so inverted or broken cells are still detected. Built by fepen/ckernel.py. */
+   The arithmetic is that of the numba reference, fepen.solver.kernels.stress_update (and, for the return,
+   fepen.laws.materials.radial_return, ported line by line), written with edge matrices: with E, U the current
+   and step-increment (v dt) edge matrices of a cell (column j = edge from node 0 to node j + 1) and
+   a = E - U/2 the mid-step one,
+       L = U a^-1,   f_j = (orient / 6) sigma cof(E) e_{j-1} (j = 1..3),   f_0 = -(f_1 + f_2 + f_3),
+   which is V0 P grad0_j with P = J sigma F^-T: the reference geometry drops out of the force (sigma = s + p I,
+   p the average of the cell's four nodal pressures of its material).
+
+   Layouts: cell state is structure-of-arrays so that the cell loop streams it: the deviatoric stress s is
+   component-major (6, n) (k * n + e), eps_p, temp, sy0, orient, vol0, cvol, cell_dt are (n,); dofs (n, 4)
+   int32; mat (n,) int64 (-1: eroded); nodal arrays (x, v, u, X, a, f, nodal_p) are row-major (n_nodes, 3) or
+   (n_nodes, n_materials) and gathered through dofs; Fc is (n, 4, 3) row-major, written through a small block
+   buffer that stays in L1. Material parameters are the rows of fepen.laws.materials' parameter vectors.
+
+   No fast-math: NaN and inf propagate (built with -fno-math-errno only, so that sqrt is one instruction and
+   the loops that take it vectorise), so inverted or broken cells are still detected. Built and loaded by
+   fepen/solver/ckernel.py (fepen/native.py). */
+#include <math.h>
 #include <stdint.h>
 
 #define BLOCK 64
 
-/* Elastic trial state of cells [0, n). s (6, n) in/out, P (n, 9) out; yielding receives the indices of the
-   cells over their flow stress sy0; returns their number. inv_detR = 1 / det R per cell. */
-int32_t trial_pass(int32_t n, const double *restrict x, const double *restrict v, const double *restrict X,
-                   double dt, const int32_t *restrict dofs, const double *restrict inv_detR,
-                   const int32_t *restrict mat, const double *restrict G_m, const double *restrict nodal_p,
-                   int32_t nmat, double *restrict s, const double *restrict sy0, double *restrict P,
-                   int32_t *restrict yielding)
+/* the layout of a material's parameter vector (fepen.laws.materials) */
+enum { KIND, E_, NU, RHO, A_, B_, N_, C_, M_, TMELT, TROOM, EPS0, CP, BETA, RATE_ON, THERMAL_ON, H_, N_PARAMS };
+enum { ELASTIC = 0, JOHNSON_COOK = 1, BILINEAR = 2 };
+
+/* ------------------------------------------------------------------------------------------------------
+   The material law (fepen.laws.materials, same branches and constants; Python's min/max order kept so that
+   NaN propagates the same way) */
+
+static double homologous_temperature(double T, const double *p)
 {
-    double PT[9 * BLOCK];  /* P of one block, component-major: stays in L1 until copied out */
-    double excess[BLOCK];  /* q_trial^2 - sigma_y^2 */
-    int32_t n_yield = 0;
+    double ts = (T - p[TROOM]) / (p[TMELT] - p[TROOM]);
+    if (0.0 > ts) ts = 0.0;
+    if (1.0 < ts) ts = 1.0;
+    return ts;
+}
+
+/* flow stress at plastic strain eps_p, plastic strain rate `rate`, temperature T */
+static double yield_stress(double eps_p, double rate, double T, const double *p)
+{
+    int kind = (int)p[KIND];
+    if (kind == BILINEAR) return p[A_] + p[H_] * eps_p;
+    if (kind != JOHNSON_COOK) return INFINITY;
+    double e = 0.0 > eps_p ? 0.0 : eps_p;
+    double s = p[A_] + p[B_] * pow(e, p[N_]);
+    if (p[RATE_ON] > 0.0 && rate > p[EPS0]) s *= 1.0 + p[C_] * log(rate / p[EPS0]);
+    if (p[THERMAL_ON] > 0.0) s *= 1.0 - pow(homologous_temperature(T, p), p[M_]);
+    return s;
+}
+
+/* sigma_y(eps_p + d, d/dt, T) into the return value, its slope in d into *ds, the adiabatic temperature
+   T = T0 + beta s_heat d / (rho c_p) into *Tn (materials._yield_and_slope) */
+static double yield_and_slope(double eps_p, double d, double dt, double T0, const double *p, double s_heat,
+                              double *ds, double *Tn)
+{
+    if ((int)p[KIND] == BILINEAR) {
+        *ds = p[H_];
+        *Tn = T0;
+        return p[A_] + p[H_] * (eps_p + d);
+    }
+    double e = eps_p + d, emin = 1e-12;
+    double ee = emin > e ? emin : e;
+    double en = pow(ee, p[N_]);
+    double h0 = p[A_] + p[B_] * en;
+    double dh0 = e > emin ? p[N_] * p[B_] * en / ee : 0.0;
+    if (dh0 > 1e3 * p[E_]) dh0 = 1e3 * p[E_];  /* n < 1: infinite slope at eps_p = 0; capped for Newton */
+    double r = 1.0, dr = 0.0;
+    if (p[RATE_ON] > 0.0 && dt > 0.0) {
+        double rate = d / dt;
+        if (rate > p[EPS0]) {
+            r = 1.0 + p[C_] * log(rate / p[EPS0]);
+            dr = p[C_] / d;
+        }
+    }
+    double g = h0 * r, dg = dh0 * r + h0 * dr;
+    if (p[THERMAL_ON] <= 0.0) {
+        *ds = dg;
+        *Tn = T0;
+        return g;
+    }
+    double k = p[BETA] / (p[RHO] * p[CP]);
+    double T = T0 + k * s_heat * d;
+    double ts = homologous_temperature(T, p);
+    *Tn = T;
+    if (ts <= 0.0) {
+        *ds = dg;
+        return g;
+    }
+    double tm = pow(ts, p[M_]);
+    double s = g * (1.0 - tm), dss = dg * (1.0 - tm);
+    if (ts < 1.0) dss -= g * p[M_] * tm / ts * k * s_heat / (p[TMELT] - p[TROOM]);
+    *ds = dss;
+    return s;
+}
+
+/* q_trial - 3 G d - sigma_y(eps_p + d, d/dt, T(d)) = 0 for d >= 0 by safeguarded Newton
+   (materials.radial_return); returns d, the flow stress into *sy and the temperature after into *Tn */
+static double radial_return(double q, double eps_p, double T, double dt, double G, const double *p,
+                            double *sy, double *Tn)
+{
+    if ((int)p[KIND] == ELASTIC) {
+        *sy = INFINITY;
+        *Tn = T;
+        return 0.0;
+    }
+    double ds, Tdummy;
+    double s0 = yield_and_slope(eps_p, 0.0, dt, T, p, 0.0, &ds, &Tdummy);
+    if (q <= s0) {
+        *sy = s0;
+        *Tn = T;
+        return 0.0;
+    }
+    double lo = 0.0, hi = q / (3.0 * G);
+    double d = (q - s0) / (3.0 * G);
+    if (1e-14 > d) d = 1e-14;
+    if (hi < d) d = hi;
+    double s = s0, Tk = T, s_heat = s0;
+    for (int it = 0; it < 100; it++) {
+        s = yield_and_slope(eps_p, d, dt, T, p, s_heat, &ds, &Tk);
+        double f = q - 3.0 * G * d - s;
+        if (fabs(f) <= 1e-12 * q && fabs(s - s_heat) <= 1e-12 * q) break;
+        s_heat = s;
+        if (f > 0.0) lo = d;
+        else hi = d;
+        double dn = d + f / (3.0 * G + ds);
+        if (!(lo < dn && dn < hi)) dn = 0.5 * (lo + hi);  /* Newton left the bracket: bisect */
+        d = dn;
+    }
+    *sy = s;
+    *Tn = Tk;
+    return d;
+}
+
+/* ------------------------------------------------------------------------------------------------------
+   Node passes */
+
+/* Before the forces: v += h a (h = (dt_prev + dt) / 2), du = dt v, u += du, x = X + u over all n_nodes
+   nodes (ghosts included); w (n, 2) gets each owned node's half of the old forces' work over the step,
+   du . f_int / 2 and du . f_ext / 2 (the trapezoidal rule; each node's running sum is the same on any
+   partition, and the solver sums the nodes exactly). */
+void update_begin(int32_t n_nodes, int32_t n_owned, double h, double dt, const double *restrict a,
+                  double *restrict v, double *restrict u, const double *restrict X, double *restrict x,
+                  double *restrict du, const double *restrict fint, const double *restrict fext, double *restrict w)
+{
+    for (int32_t i = 0; i < 3 * n_nodes; i++) {
+        double vi = v[i] + h * a[i];
+        double di = dt * vi;
+        double ui = u[i] + di;
+        v[i] = vi;
+        du[i] = di;
+        u[i] = ui;
+        x[i] = X[i] + ui;
+    }
+    for (int32_t n = 0; n < n_owned; n++) {  /* each node's own running sums: the same on any partition */
+        const double *d = du + 3 * n, *fi = fint + 3 * n, *fe = fext + 3 * n;
+        w[2 * n] += 0.5 * (d[0] * fi[0] + d[1] * fi[1] + d[2] * fi[2]);
+        w[2 * n + 1] += 0.5 * (d[0] * fe[0] + d[1] * fe[1] + d[2] * fe[2]);
+    }
+}
+
+/* After the forces: a = (f_ext - f_int) / m over the owned nodes (0 where fixed[i] != 0, fixed may be NULL);
+   w (n, 2) gets each owned node's half of the new forces' work, du . f_int / 2 and du . f_ext / 2. */
+void update_end(int32_t n_owned, const double *restrict fint, const double *restrict fext,
+                const double *restrict mass, const uint8_t *restrict fixed, const double *restrict du,
+                double *restrict a, double *restrict w)
+{
+    for (int32_t n = 0; n < n_owned; n++) {
+        double im = 1.0 / mass[n];
+        for (int32_t k = 0; k < 3; k++) {
+            int32_t i = 3 * n + k;
+            a[i] = (fext[i] - fint[i]) * im;
+        }
+        const double *d = du + 3 * n, *fi = fint + 3 * n, *fe = fext + 3 * n;
+        w[2 * n] += 0.5 * (d[0] * fi[0] + d[1] * fi[1] + d[2] * fi[2]);
+        w[2 * n + 1] += 0.5 * (d[0] * fe[0] + d[1] * fe[1] + d[2] * fe[2]);
+    }
+    if (fixed)
+        for (int32_t i = 0; i < 3 * n_owned; i++)
+            if (fixed[i]) a[i] = 0.0;
+}
+
+/* p_a = K ln(J_a) / J_a per node and material, J_a = V_a / V0_a; 0 where V0_a = 0 */
+void nodal_pressure(int32_t n_rows, const double *restrict vol, const double *restrict vol0,
+                    const double *restrict bulk, int32_t nmat, double *restrict p)
+{
+    for (int32_t n = 0; n < n_rows; n++)
+        for (int32_t m = 0; m < nmat; m++) {
+            int32_t i = n * nmat + m;
+            double v0 = vol0[i];
+            double Ja = vol[i] / v0;
+            p[i] = v0 > 0.0 ? bulk[m] * log(Ja) / Ja : 0.0;
+        }
+}
+
+/* ------------------------------------------------------------------------------------------------------
+   Cell -> node sums (plain, in cell order; the solver may replace them by a canonical-order gather) */
+
+/* vol (n_rows, nmat) = 0, then vol[dofs[e, j], mat[e]] += cvol[e] / 4 over the live cells */
+void scatter_volumes(int32_t n, const int32_t *restrict dofs, const int64_t *restrict mat,
+                     const double *restrict cvol, int32_t nmat, int32_t n_rows, double *restrict vol)
+{
+    for (int32_t i = 0; i < n_rows * nmat; i++) vol[i] = 0.0;
+    for (int32_t e = 0; e < n; e++) {
+        int64_t m = mat[e];
+        if (m < 0) continue;
+        double q = 0.25 * cvol[e];
+        for (int32_t j = 0; j < 4; j++) vol[dofs[4 * e + j] * nmat + m] += q;
+    }
+}
+
+/* f (n_rows, 3) = 0, then f[dofs[e, j]] += Fc[e, j] */
+void scatter_forces(int32_t n, const int32_t *restrict dofs, const double *restrict Fc, int32_t n_rows,
+                    double *restrict f)
+{
+    for (int32_t i = 0; i < 3 * n_rows; i++) f[i] = 0.0;
+    for (int32_t e = 0; e < n; e++)
+        for (int32_t j = 0; j < 4; j++) {
+            double *fn = f + 3 * dofs[4 * e + j];
+            const double *c = Fc + 12 * e + 3 * j;
+            fn[0] += c[0];
+            fn[1] += c[1];
+            fn[2] += c[2];
+        }
+}
+
+/* ------------------------------------------------------------------------------------------------------
+   Cell passes */
+
+/* kinematics_pass on the block [e0, e0 + nb): J (inf for eroded cells) into Jb, h/c (inf where not
+   computed) into tb; with_step a constant after inlining, so that each variant is one vector loop */
+static inline __attribute__((always_inline)) void
+kinematics_block(int32_t e0, int32_t nb, const double *restrict x, const int32_t *restrict dofs,
+                 const int64_t *restrict mat, const double *restrict orient, const double *restrict vol0,
+                 const double *restrict speed, const int32_t with_step, double *restrict cvol,
+                 double *restrict cell_dt, double *restrict Jb, double *restrict tb)
+{
+#pragma omp simd
+    for (int32_t k = 0; k < nb; k++) {
+        int32_t e = e0 + k;
+        int32_t live = mat[e] >= 0;
+        int32_t m = live ? (int32_t)mat[e] : 0;
+        int32_t n0 = dofs[4 * e], n1 = dofs[4 * e + 1], n2 = dofs[4 * e + 2], n3 = dofs[4 * e + 3];
+        double x0 = x[3 * n0], y0 = x[3 * n0 + 1], z0 = x[3 * n0 + 2];
+        double x1 = x[3 * n1], y1 = x[3 * n1 + 1], z1 = x[3 * n1 + 2];
+        double x2 = x[3 * n2], y2 = x[3 * n2 + 1], z2 = x[3 * n2 + 2];
+        double x3 = x[3 * n3], y3 = x[3 * n3 + 1], z3 = x[3 * n3 + 2];
+        double ax = x1 - x0, ay = y1 - y0, az = z1 - z0;
+        double bx = x2 - x0, by = y2 - y0, bz = z2 - z0;
+        double cx = x3 - x0, cy = y3 - y0, cz = z3 - z0;
+        double six = ax * (by * cz - bz * cy) - ay * (bx * cz - bz * cx) + az * (bx * cy - by * cx);
+        double J = six / (6.0 * vol0[e]) * orient[e];
+        double V = J * vol0[e];
+        cvol[e] = live ? V : 0.0;
+        Jb[k] = live ? J : INFINITY;
+        if (with_step) {
+            /* shortest altitude = 3 V / largest face area; faces (1,2,3), (2,3,0), (3,0,1), (0,1,2) */
+            double dx = x3 - x1, dy = y3 - y1, dz = z3 - z1;
+            double ex = x2 - x1, ey = y2 - y1, ez = z2 - z1;
+            double f0x = ey * dz - ez * dy, f0y = ez * dx - ex * dz, f0z = ex * dy - ey * dx;
+            double f1x = by * cz - bz * cy, f1y = bz * cx - bx * cz, f1z = bx * cy - by * cx;
+            double f2x = ay * cz - az * cy, f2y = az * cx - ax * cz, f2z = ax * cy - ay * cx;
+            double f3x = ay * bz - az * by, f3y = az * bx - ax * bz, f3z = ax * by - ay * bx;
+            double a0 = f0x * f0x + f0y * f0y + f0z * f0z, a1 = f1x * f1x + f1y * f1y + f1z * f1z;
+            double a2 = f2x * f2x + f2y * f2y + f2z * f2z, a3 = f3x * f3x + f3y * f3y + f3z * f3z;
+            double amax = 0.0;
+            amax = a0 > amax ? a0 : amax;
+            amax = a1 > amax ? a1 : amax;
+            amax = a2 > amax ? a2 : amax;
+            amax = a3 > amax ? a3 : amax;
+            int32_t ok = live & (amax > 0.0) & (V > 0.0);  /* & not &&: no branch */
+            double t = 3.0 * V / (0.5 * sqrt(amax)) / speed[m];
+            tb[k] = ok ? t : INFINITY;
+            cell_dt[e] = ok ? t : cell_dt[e];
+        } else {
+            tb[k] = INFINITY;
+        }
+    }
+}
+
+/* Current volume of every cell into cvol (0 for eroded cells); with_step: each live cell's shortest altitude
+   over its dilatational speed into cell_dt (left as it was where the volume or the faces vanish).
+   out: [smallest J = V / V0 over live cells (a NaN wins), its cell, smallest h/c (inf if not with_step), its
+   cell] (cells as doubles, -1 for none): the first of equal minima, the first NaN. */
+void kinematics_pass(int32_t n, const double *restrict x, const int32_t *restrict dofs,
+                     const int64_t *restrict mat, const double *restrict orient, const double *restrict vol0,
+                     const double *restrict speed, int32_t with_step, double *restrict cvol,
+                     double *restrict cell_dt, double *restrict out)
+{
+    double Jb[BLOCK], tb[BLOCK];
+    double jmin = INFINITY, dtmin = INFINITY;
+    int32_t worst = -1, dtcell = -1;
     for (int32_t e0 = 0; e0 < n; e0 += BLOCK) {
         int32_t nb = n - e0 < BLOCK ? n - e0 : BLOCK;
+        if (with_step)
+            kinematics_block(e0, nb, x, dofs, mat, orient, vol0, speed, 1, cvol, cell_dt, Jb, tb);
+        else
+            kinematics_block(e0, nb, x, dofs, mat, orient, vol0, speed, 0, cvol, cell_dt, Jb, tb);
+        for (int32_t k = 0; k < nb; k++) {
+            double J = Jb[k];
+            if (!(J >= jmin) && jmin == jmin && mat[e0 + k] >= 0) {  /* smaller, or the first NaN */
+                jmin = J;
+                worst = e0 + k;
+            }
+            if (tb[k] < dtmin) {
+                dtmin = tb[k];
+                dtcell = e0 + k;
+            }
+        }
+    }
+    out[0] = jmin;
+    out[1] = worst;
+    out[2] = dtmin;
+    out[3] = dtcell;
+}
+
+/* The fused stress and force pass over cells [0, n), one block of BLOCK cells at a time:
+     1. (vectorised) the elastic trial deviatoric stress, its von Mises stress, cof(E), the current volume;
+     2. (scalar, only the cells of the block over their static flow stress sy0) the radial return: s scaled
+        to the flow stress, eps_p, temp, sy0 updated, plastic work, heat and the largest increment summed
+        into totals (kernels.stress_update's bookkeeping);
+     3. (vectorised) s stored, the cell's four nodal forces into Fc.
+   s (6, n) in/out; Fc (n, 4, 3) out (zero for eroded cells); totals (4,) out: plastic work, heat, 0, the
+   largest plastic increment. params (nmat, N_PARAMS); G_m shear modulus per material; nodal_p
+   (n_nodes, nmat). Returns the number of cells that yielded. */
+int32_t cell_pass(int32_t n, const double *restrict x, const double *restrict v, double dt,
+                  const int32_t *restrict dofs, const int64_t *restrict mat, const double *restrict orient,
+                  int32_t nmat, const double *restrict params, const double *restrict G_m,
+                  const double *restrict nodal_p, double *restrict s, double *restrict eps_p,
+                  double *restrict temp, double *restrict sy0, double *restrict Fc, double *restrict totals)
+{
+    double sb[6][BLOCK], kb[9][BLOCK], pb[BLOCK], qb[BLOCK], vb[BLOCK], wb[BLOCK], Fb[12][BLOCK];
+    int32_t yb[BLOCK];
+    int32_t n_yield = 0;
+    double plastic = 0.0, heat = 0.0, dmax = 0.0;
+    for (int32_t e0 = 0; e0 < n; e0 += BLOCK) {
+        int32_t nb = n - e0 < BLOCK ? n - e0 : BLOCK;
+        /* 1. trial state */
 #pragma omp simd
         for (int32_t k = 0; k < nb; k++) {
             int32_t e = e0 + k;
-            int32_t live = mat[e] >= 0;  /* eroded cells (material -1): P and s stay 0, never yielding */
-            int32_t m = live ? mat[e] : 0;
-            int32_t n0 = dofs[4 * e + 0];
-            int32_t n1 = dofs[4 * e + 1];
-            int32_t n2 = dofs[4 * e + 2];
-            int32_t n3 = dofs[4 * e + 3];
+            int32_t live = mat[e] >= 0;
+            int32_t m = live ? (int32_t)mat[e] : 0;
+            int32_t n0 = dofs[4 * e + 0], n1 = dofs[4 * e + 1], n2 = dofs[4 * e + 2], n3 = dofs[4 * e + 3];
             double x0_0 = x[3 * n0], x0_1 = x[3 * n0 + 1], x0_2 = x[3 * n0 + 2];
-            double v0_0 = v[3 * n0], v0_1 = v[3 * n0 + 1], v0_2 = v[3 * n0 + 2];
-            double X0_0 = X[3 * n0], X0_1 = X[3 * n0 + 1], X0_2 = X[3 * n0 + 2];
             double x1_0 = x[3 * n1], x1_1 = x[3 * n1 + 1], x1_2 = x[3 * n1 + 2];
-            double v1_0 = v[3 * n1], v1_1 = v[3 * n1 + 1], v1_2 = v[3 * n1 + 2];
-            double X1_0 = X[3 * n1], X1_1 = X[3 * n1 + 1], X1_2 = X[3 * n1 + 2];
             double x2_0 = x[3 * n2], x2_1 = x[3 * n2 + 1], x2_2 = x[3 * n2 + 2];
-            double v2_0 = v[3 * n2], v2_1 = v[3 * n2 + 1], v2_2 = v[3 * n2 + 2];
-            double X2_0 = X[3 * n2], X2_1 = X[3 * n2 + 1], X2_2 = X[3 * n2 + 2];
             double x3_0 = x[3 * n3], x3_1 = x[3 * n3 + 1], x3_2 = x[3 * n3 + 2];
+            double v0_0 = v[3 * n0], v0_1 = v[3 * n0 + 1], v0_2 = v[3 * n0 + 2];
+            double v1_0 = v[3 * n1], v1_1 = v[3 * n1 + 1], v1_2 = v[3 * n1 + 2];
+            double v2_0 = v[3 * n2], v2_1 = v[3 * n2 + 1], v2_2 = v[3 * n2 + 2];
             double v3_0 = v[3 * n3], v3_1 = v[3 * n3 + 1], v3_2 = v[3 * n3 + 2];
-            double X3_0 = X[3 * n3], X3_1 = X[3 * n3 + 1], X3_2 = X[3 * n3 + 2];
             double pm = 0.25 * (nodal_p[n0 * nmat + m] + nodal_p[n1 * nmat + m] + nodal_p[n2 * nmat + m]
                                 + nodal_p[n3 * nmat + m]);
-            /* edge matrices, column j = edge from node 0 to node j + 1: current (E), step increment (U),
-               mid-step (a = E - U/2), reference (R) */
-            double E00 = x1_0 - x0_0, U00 = (v1_0 - v0_0) * dt, R00 = X1_0 - X0_0;
-            double E01 = x2_0 - x0_0, U01 = (v2_0 - v0_0) * dt, R01 = X2_0 - X0_0;
-            double E02 = x3_0 - x0_0, U02 = (v3_0 - v0_0) * dt, R02 = X3_0 - X0_0;
-            double E10 = x1_1 - x0_1, U10 = (v1_1 - v0_1) * dt, R10 = X1_1 - X0_1;
-            double E11 = x2_1 - x0_1, U11 = (v2_1 - v0_1) * dt, R11 = X2_1 - X0_1;
-            double E12 = x3_1 - x0_1, U12 = (v3_1 - v0_1) * dt, R12 = X3_1 - X0_1;
-            double E20 = x1_2 - x0_2, U20 = (v1_2 - v0_2) * dt, R20 = X1_2 - X0_2;
-            double E21 = x2_2 - x0_2, U21 = (v2_2 - v0_2) * dt, R21 = X2_2 - X0_2;
-            double E22 = x3_2 - x0_2, U22 = (v3_2 - v0_2) * dt, R22 = X3_2 - X0_2;
+            pb[k] = live ? pm : 0.0;
+            /* edge matrices: current (E), step increment (U), mid-step (a = E - U/2) */
+            double E00 = x1_0 - x0_0, U00 = (v1_0 - v0_0) * dt;
+            double E01 = x2_0 - x0_0, U01 = (v2_0 - v0_0) * dt;
+            double E02 = x3_0 - x0_0, U02 = (v3_0 - v0_0) * dt;
+            double E10 = x1_1 - x0_1, U10 = (v1_1 - v0_1) * dt;
+            double E11 = x2_1 - x0_1, U11 = (v2_1 - v0_1) * dt;
+            double E12 = x3_1 - x0_1, U12 = (v3_1 - v0_1) * dt;
+            double E20 = x1_2 - x0_2, U20 = (v1_2 - v0_2) * dt;
+            double E21 = x2_2 - x0_2, U21 = (v2_2 - v0_2) * dt;
+            double E22 = x3_2 - x0_2, U22 = (v3_2 - v0_2) * dt;
             double a00 = E00 - 0.5 * U00, a01 = E01 - 0.5 * U01, a02 = E02 - 0.5 * U02;
             double a10 = E10 - 0.5 * U10, a11 = E11 - 0.5 * U11, a12 = E12 - 0.5 * U12;
             double a20 = E20 - 0.5 * U20, a21 = E21 - 0.5 * U21, a22 = E22 - 0.5 * U22;
@@ -80,12 +394,15 @@ int32_t trial_pass(int32_t n, const double *restrict x, const double *restrict v
             double L20 = (U20 * c00 + U21 * c01 + U22 * c02) * idet;
             double L21 = (U20 * c10 + U21 * c11 + U22 * c12) * idet;
             double L22 = (U20 * c20 + U21 * c21 + U22 * c22) * idet;
+            /* Hughes-Winget rotation Q = (I - W/2)^-1 (I + W/2) in closed form (Cayley) */
             double w0 = 0.25 * (L21 - L12), w1 = 0.25 * (L02 - L20), w2 = 0.25 * (L10 - L01);
             double c = 2.0 / (1.0 + w0 * w0 + w1 * w1 + w2 * w2);
-            double Q00 = 1.0 - c * (w1 * w1 + w2 * w2), Q11 = 1.0 - c * (w0 * w0 + w2 * w2), Q22 = 1.0 - c * (w0 * w0 + w1 * w1);
+            double Q00 = 1.0 - c * (w1 * w1 + w2 * w2), Q11 = 1.0 - c * (w0 * w0 + w2 * w2);
+            double Q22 = 1.0 - c * (w0 * w0 + w1 * w1);
             double Q01 = c * (-w2 + w0 * w1), Q10 = c * (w2 + w0 * w1), Q02 = c * (w1 + w0 * w2);
             double Q20 = c * (-w1 + w0 * w2), Q12 = c * (-w0 + w1 * w2), Q21 = c * (w0 + w1 * w2);
-            double S00 = s[0 * n + e], S11 = s[1 * n + e], S22 = s[2 * n + e], S01 = s[3 * n + e], S12 = s[4 * n + e], S02 = s[5 * n + e];
+            double S00 = s[0 * n + e], S11 = s[1 * n + e], S22 = s[2 * n + e];
+            double S01 = s[3 * n + e], S12 = s[4 * n + e], S02 = s[5 * n + e];
             double T00 = Q00 * S00 + Q01 * S01 + Q02 * S02;
             double T01 = Q00 * S01 + Q01 * S11 + Q02 * S12;
             double T02 = Q00 * S02 + Q01 * S12 + Q02 * S22;
@@ -103,45 +420,79 @@ int32_t trial_pass(int32_t n, const double *restrict x, const double *restrict v
             double s3 = T00 * Q10 + T01 * Q11 + T02 * Q12 + G2 * 0.5 * (L01 + L10);
             double s4 = T10 * Q20 + T11 * Q21 + T12 * Q22 + G2 * 0.5 * (L12 + L21);
             double s5 = T00 * Q20 + T01 * Q21 + T02 * Q22 + G2 * 0.5 * (L02 + L20);
-            /* cof F = cof(E) cof(R^-1) = cof(E) R^T / det R */
+            sb[0][k] = live ? s0 : 0.0; sb[1][k] = live ? s1 : 0.0; sb[2][k] = live ? s2 : 0.0;
+            sb[3][k] = live ? s3 : 0.0; sb[4][k] = live ? s4 : 0.0; sb[5][k] = live ? s5 : 0.0;
+            double q = sqrt(1.5 * (s0 * s0 + s1 * s1 + s2 * s2 + 2.0 * (s3 * s3 + s4 * s4 + s5 * s5)));
+            qb[k] = q;
+            yb[k] = live & (q > sy0[e]);
+            /* cof(E), columns: the area vectors of the faces opposite nodes 1, 2, 3 (times 2) */
             double k00 = E11 * E22 - E12 * E21, k01 = E12 * E20 - E10 * E22, k02 = E10 * E21 - E11 * E20;
             double k10 = E02 * E21 - E01 * E22, k11 = E00 * E22 - E02 * E20, k12 = E01 * E20 - E00 * E21;
             double k20 = E01 * E12 - E02 * E11, k21 = E02 * E10 - E00 * E12, k22 = E00 * E11 - E01 * E10;
-            double r = inv_detR[e];
-            double C00 = (k00 * R00 + k01 * R01 + k02 * R02) * r;
-            double C01 = (k00 * R10 + k01 * R11 + k02 * R12) * r;
-            double C02 = (k00 * R20 + k01 * R21 + k02 * R22) * r;
-            double C10 = (k10 * R00 + k11 * R01 + k12 * R02) * r;
-            double C11 = (k10 * R10 + k11 * R11 + k12 * R12) * r;
-            double C12 = (k10 * R20 + k11 * R21 + k12 * R22) * r;
-            double C20 = (k20 * R00 + k21 * R01 + k22 * R02) * r;
-            double C21 = (k20 * R10 + k21 * R11 + k22 * R12) * r;
-            double C22 = (k20 * R20 + k21 * R21 + k22 * R22) * r;
-            s0 = live ? s0 : 0.0; s1 = live ? s1 : 0.0; s2 = live ? s2 : 0.0;
-            s3 = live ? s3 : 0.0; s4 = live ? s4 : 0.0; s5 = live ? s5 : 0.0;
-            pm = live ? pm : 0.0;
-            C00 = live ? C00 : 0.0; C01 = live ? C01 : 0.0; C02 = live ? C02 : 0.0;
-            C10 = live ? C10 : 0.0; C11 = live ? C11 : 0.0; C12 = live ? C12 : 0.0;
-            C20 = live ? C20 : 0.0; C21 = live ? C21 : 0.0; C22 = live ? C22 : 0.0;
-            s[0 * n + e] = s0; s[1 * n + e] = s1; s[2 * n + e] = s2; s[3 * n + e] = s3; s[4 * n + e] = s4; s[5 * n + e] = s5;
-            excess[k] = live ? 1.5 * (s0 * s0 + s1 * s1 + s2 * s2 + 2.0 * (s3 * s3 + s4 * s4 + s5 * s5)) - sy0[e] * sy0[e] : -1.0;
-            double p00 = s0 + pm, p11 = s1 + pm, p22 = s2 + pm;
-            PT[0 * BLOCK + k] = p00 * C00 + s3 * C10 + s5 * C20;
-            PT[1 * BLOCK + k] = p00 * C01 + s3 * C11 + s5 * C21;
-            PT[2 * BLOCK + k] = p00 * C02 + s3 * C12 + s5 * C22;
-            PT[3 * BLOCK + k] = s3 * C00 + p11 * C10 + s4 * C20;
-            PT[4 * BLOCK + k] = s3 * C01 + p11 * C11 + s4 * C21;
-            PT[5 * BLOCK + k] = s3 * C02 + p11 * C12 + s4 * C22;
-            PT[6 * BLOCK + k] = s5 * C00 + s4 * C10 + p22 * C20;
-            PT[7 * BLOCK + k] = s5 * C01 + s4 * C11 + p22 * C21;
-            PT[8 * BLOCK + k] = s5 * C02 + s4 * C12 + p22 * C22;
+            kb[0][k] = k00; kb[1][k] = k01; kb[2][k] = k02;
+            kb[3][k] = k10; kb[4][k] = k11; kb[5][k] = k12;
+            kb[6][k] = k20; kb[7][k] = k21; kb[8][k] = k22;
+            wb[k] = orient[e] / 6.0;
+            vb[k] = (E00 * k00 + E01 * k01 + E02 * k02) * orient[e] / 6.0;  /* current volume */
         }
-        for (int32_t i = 0; i < 9; i++)
-            for (int32_t k = 0; k < nb; k++)
-                P[9 * (e0 + k) + i] = PT[i * BLOCK + k];
+        /* 2. radial return of the cells over their flow stress */
+        for (int32_t k = 0; k < nb; k++) {
+            if (!yb[k]) continue;
+            int32_t e = e0 + k;
+            int32_t m = (int32_t)mat[e];
+            const double *p = params + (int64_t)m * N_PARAMS;
+            if ((int)p[KIND] == ELASTIC) continue;
+            double q = qb[k], sy, Tn;
+            double d = radial_return(q, eps_p[e], temp[e], dt, G_m[m], p, &sy, &Tn);
+            if (!(d > 0.0)) continue;
+            double scale = sy / q;
+            for (int32_t i = 0; i < 6; i++) sb[i][k] *= scale;
+            eps_p[e] += d;
+            temp[e] = Tn;
+            sy0[e] = yield_stress(eps_p[e], 0.0, Tn, p);
+            double V = vb[k];
+            plastic += sy * d * V;
+            if (p[THERMAL_ON] > 0.0) heat += p[BETA] * sy * d * V;
+            if (d > dmax) dmax = d;
+            n_yield++;
+        }
+        /* 3. the stress stored, the nodal forces f_j = (orient / 6) sigma cof(E) e_{j-1}, f_0 = -sum */
+#pragma omp simd
+        for (int32_t k = 0; k < nb; k++) {
+            int32_t e = e0 + k;
+            int32_t live = mat[e] >= 0;
+            double s0 = sb[0][k], s1 = sb[1][k], s2 = sb[2][k], s3 = sb[3][k], s4 = sb[4][k], s5 = sb[5][k];
+            s[0 * n + e] = s0; s[1 * n + e] = s1; s[2 * n + e] = s2;
+            s[3 * n + e] = s3; s[4 * n + e] = s4; s[5 * n + e] = s5;
+            double w = wb[k], pm = pb[k];
+            double p00 = (s0 + pm) * w, p11 = (s1 + pm) * w, p22 = (s2 + pm) * w;
+            double p01 = s3 * w, p12 = s4 * w, p02 = s5 * w;
+            double k00 = kb[0][k], k01 = kb[1][k], k02 = kb[2][k];
+            double k10 = kb[3][k], k11 = kb[4][k], k12 = kb[5][k];
+            double k20 = kb[6][k], k21 = kb[7][k], k22 = kb[8][k];
+            double f10 = p00 * k00 + p01 * k10 + p02 * k20;
+            double f11 = p01 * k00 + p11 * k10 + p12 * k20;
+            double f12 = p02 * k00 + p12 * k10 + p22 * k20;
+            double f20 = p00 * k01 + p01 * k11 + p02 * k21;
+            double f21 = p01 * k01 + p11 * k11 + p12 * k21;
+            double f22 = p02 * k01 + p12 * k11 + p22 * k21;
+            double f30 = p00 * k02 + p01 * k12 + p02 * k22;
+            double f31 = p01 * k02 + p11 * k12 + p12 * k22;
+            double f32 = p02 * k02 + p12 * k12 + p22 * k22;
+            Fb[0][k] = live ? -(f10 + f20 + f30) : 0.0;
+            Fb[1][k] = live ? -(f11 + f21 + f31) : 0.0;
+            Fb[2][k] = live ? -(f12 + f22 + f32) : 0.0;
+            Fb[3][k] = live ? f10 : 0.0; Fb[4][k] = live ? f11 : 0.0; Fb[5][k] = live ? f12 : 0.0;
+            Fb[6][k] = live ? f20 : 0.0; Fb[7][k] = live ? f21 : 0.0; Fb[8][k] = live ? f22 : 0.0;
+            Fb[9][k] = live ? f30 : 0.0; Fb[10][k] = live ? f31 : 0.0; Fb[11][k] = live ? f32 : 0.0;
+        }
         for (int32_t k = 0; k < nb; k++)
-            if (excess[k] > 0.0)
-                yielding[n_yield++] = e0 + k;
+            for (int32_t i = 0; i < 12; i++)
+                Fc[12 * (e0 + k) + i] = Fb[i][k];
     }
+    totals[0] = plastic;
+    totals[1] = heat;
+    totals[2] = 0.0;
+    totals[3] = dmax;
     return n_yield;
 }

@@ -1,5 +1,7 @@
-"""The C trial pass of the stress update (fepen/solver/cell_kernel.c), built once per machine and called
-with ctypes; the numba kernel (fepen.solver.kernels.stress_update) stays the reference (docs/theory.md §3.3)."""
+"""The deformable step in C (fepen/solver/cell_kernel.c), built once per machine and called with ctypes: the
+node update, the kinematics pass, the nodal pressure and the fused stress-and-force pass. The numba kernels
+(fepen.solver.kernels: volumes_and_step, stress_update, internal_force) stay the reference
+(docs/theory.md §3.3)."""
 
 from __future__ import annotations
 
@@ -12,6 +14,10 @@ import numpy as np
 from fepen import native
 
 SOURCE = Path(__file__).with_name("cell_kernel.c")
+#: no fused multiply-adds: gcc contracts a vector loop's body and its scalar remainder differently, so a cell
+#: would round otherwise by where it falls in its block, and a run would depend on the partition
+#: (docs/theory.md §3.4)
+CONTRACT = ("-ffp-contract=off",)
 
 _lib = None
 _why_not = None
@@ -25,13 +31,25 @@ def library():
     if os.environ.get("FEPEN_KERNEL", "").lower() == "numba":
         _why_not = "FEPEN_KERNEL=numba"
         return None
-    lib, why = native.load(SOURCE)
+    lib, why = native.load(SOURCE, CONTRACT)
     if lib is None:
         _why_not = why
         return None
     vp, i32, dbl = ctypes.c_void_p, ctypes.c_int32, ctypes.c_double
-    lib.trial_pass.argtypes = [i32, vp, vp, vp, dbl, vp, vp, vp, vp, vp, i32, vp, vp, vp, vp]
-    lib.trial_pass.restype = i32
+    lib.update_begin.argtypes = [i32, i32, dbl, dbl, vp, vp, vp, vp, vp, vp, vp, vp, vp]
+    lib.update_begin.restype = None
+    lib.update_end.argtypes = [i32, vp, vp, vp, vp, vp, vp, vp]
+    lib.update_end.restype = None
+    lib.nodal_pressure.argtypes = [i32, vp, vp, vp, i32, vp]
+    lib.nodal_pressure.restype = None
+    lib.scatter_volumes.argtypes = [i32, vp, vp, vp, i32, i32, vp]
+    lib.scatter_volumes.restype = None
+    lib.scatter_forces.argtypes = [i32, vp, vp, i32, vp]
+    lib.scatter_forces.restype = None
+    lib.kinematics_pass.argtypes = [i32, vp, vp, vp, vp, vp, vp, i32, vp, vp, vp]
+    lib.kinematics_pass.restype = None
+    lib.cell_pass.argtypes = [i32, vp, vp, dbl, vp, vp, vp, i32, vp, vp, vp, vp, vp, vp, vp, vp, vp]
+    lib.cell_pass.restype = i32
     _lib = lib
     return lib
 
@@ -42,47 +60,100 @@ def why_not() -> str | None:
     return _why_not
 
 
-class TrialPass:
-    """The C trial pass bound to a solver's arrays (their addresses are taken once: the arrays must live
-    as long as this object and never be reallocated).
+def _addr(a: np.ndarray, dtype=np.float64) -> int:
+    """The address of a C-contiguous array of the given dtype (AssertionError if it is not one)."""
+    assert a.dtype == dtype and a.flags.c_contiguous, (a.dtype, a.flags.c_contiguous)
+    return a.ctypes.data
+
+
+class CellPasses:
+    """The C cell passes bound to a body's arrays (their addresses are taken once: the arrays must live as
+    long as this object and be changed only in place — erosion and a receding surface do so).
 
     Args:
-        x, v, X: current positions, velocities and reference positions of the nodes (n_nodes, 3),
-            C-contiguous float64.
-        dofs: (n_cells, 4) node indices; mat: (n_cells,) material index.
-        det_R: (n_cells,) det of the reference edge matrix (X1 − X0, X2 − X0, X3 − X0) = ±6 V0.
-        G_m: shear modulus per material (Pa); nodal_p: (n_nodes, n_materials) nodal mean stress.
-        sT: (6, n_cells) deviatoric stress, component-major (updated in place).
-        sy0: (n_cells,) static flow stress. P_out: (≥ n_cells, 9) the packed coefficient of the form.
+        x, v: current positions and velocities of the nodes (n_nodes, 3).
+        dofs: (n_cells, 4) node indices (copied as int32: never changed); mat: (n_cells,) int64 material
+            index, −1 for an eroded cell (read live).
+        orient: (n_cells,) ±1, the sign of the reference edge determinant; vol0: (n_cells,) reference volume.
+        speed: dilatational wave speed per material; params: (n_materials, N_PARAMS) material parameters;
+            G_m: shear modulus per material (Pa).
+        nodal_p: (n_nodes, n_materials) nodal mean stress.
+        sT: (6, n_cells) deviatoric stress, component-major; eps_p, temp, sy0: (n_cells,) cell state.
+        cvol: (n_cells,) output of the current cell volumes; cell_dt: (n_cells,) output of h/c per cell.
+        Fc: (n_cells, 4, 3) output of each cell's internal force on its four nodes.
+        totals: (4,) output: plastic work, heat, 0, largest plastic increment of the last cell pass.
+
+    All float arrays float64 and C-contiguous.
     """
 
-    def __init__(self, x, v, X, dofs, mat, det_R, G_m, nodal_p, sT, sy0, P_out):
+    def __init__(self, x, v, dofs, mat, orient, vol0, speed, params, G_m, nodal_p, sT, eps_p, temp, sy0,
+                 cvol, cell_dt, Fc, totals):
         lib = library()
         if lib is None:
             raise RuntimeError(why_not())
         n = len(mat)
         self.n = n
         self._dofs = np.ascontiguousarray(dofs, dtype=np.int32)
-        self._mat = np.ascontiguousarray(mat, dtype=np.int32)
-        self._inv_det = 1.0 / np.asarray(det_R, dtype=float)
-        self.yielding = np.zeros(n, dtype=np.int32)
-        for a in (x, v, X, G_m, nodal_p, sT, sy0, P_out):
-            assert a.dtype == np.float64 and a.flags.c_contiguous
-        assert sT.shape == (6, n) and P_out.shape[1] == 9 and x.shape == X.shape == v.shape
-        self._keep = (x, v, X, G_m, nodal_p, sT, sy0, P_out)
-        addr = lambda a: a.ctypes.data  # noqa: E731
-        self._head = (n, addr(x), addr(v), addr(X))
-        self._tail = (addr(self._dofs), addr(self._inv_det), addr(self._mat), addr(G_m), addr(nodal_p),
-                      nodal_p.shape[1], addr(sT), addr(sy0), addr(P_out), addr(self.yielding))
+        assert sT.shape == (6, n) and Fc.shape == (n, 4, 3) and x.shape == v.shape
+        self._out = np.zeros(4)
+        self._keep = (x, v, mat, orient, vol0, speed, params, G_m, nodal_p, sT, eps_p, temp, sy0, cvol,
+                      cell_dt, Fc, totals)
+        a = _addr
+        self._kin = (n, a(x), a(self._dofs, np.int32), a(mat, np.int64), a(orient), a(vol0), a(speed))
+        self._kin_out = (a(cvol), a(cell_dt), a(self._out))
+        self._cell_x = (n, a(x), a(v))
+        self._cell_rest = (a(self._dofs, np.int32), a(mat, np.int64), a(orient), params.shape[0], a(params), a(G_m),
+                           a(nodal_p), a(sT), a(eps_p), a(temp), a(sy0), a(Fc), a(totals))
         self._lib = lib
 
-    def refresh(self, mat: np.ndarray, det_R: np.ndarray) -> None:
-        """Take the cells' new materials (−1: eroded) and reference edge determinants, in place (after an
-        erosion or a surface recession changed them)."""
-        self._mat[:] = mat
-        np.divide(1.0, det_R, out=self._inv_det)
+    def kinematics(self, with_step: bool) -> tuple[float, int, float, int]:
+        """Current volumes into cvol (and, with_step, h/c per cell into cell_dt).
 
-    def __call__(self, dt: float) -> np.ndarray:
-        """Trial state of every cell over a step dt; returns the cells over their flow stress."""
-        k = self._lib.trial_pass(*self._head, dt, *self._tail)
-        return self.yielding[:k]
+        Returns:
+            (smallest J over live cells (NaN if any is NaN), its cell, smallest h/c (inf unless with_step),
+            its cell); cells −1 for none.
+        """
+        self._lib.kinematics_pass(*self._kin, int(with_step), *self._kin_out)
+        o = self._out
+        return float(o[0]), int(o[1]), float(o[2]), int(o[3])
+
+    def cells(self, dt: float) -> int:
+        """The fused pass over a step dt: stress, return, plastic work, Fc. Returns how many cells yielded."""
+        return self._lib.cell_pass(*self._cell_x, dt, *self._cell_rest)
+
+
+class NodePasses:
+    """The C node passes (central-difference update, nodal pressure, the plain cell-to-node sums), on
+    arrays passed at each call (addresses checked and taken each time: a few microseconds)."""
+
+    def __init__(self):
+        lib = library()
+        if lib is None:
+            raise RuntimeError(why_not())
+        self._lib = lib
+
+    def update_begin(self, h: float, dt: float, n_owned: int, acc, vel, u, X, x, du, fint, fext, work) -> None:
+        """v += h a, du = dt v, u += du, x = X + u (all rows); each owned node's du·f_int / 2 and du·f_ext / 2
+        added into work (n_nodes, 2)."""
+        self._lib.update_begin(len(u), n_owned, h, dt, _addr(acc), _addr(vel), _addr(u), _addr(X), _addr(x),
+                               _addr(du), _addr(fint), _addr(fext), _addr(work))
+
+    def update_end(self, n_owned: int, fint, fext, mass, fixed, du, acc, work) -> None:
+        """a = (f_ext − f_int) / m on owned rows (0 where fixed: (n, 3) bool or None); each owned node's half
+        of the new forces' work added into work (n_nodes, 2)."""
+        fx = None if fixed is None else _addr(fixed, np.bool_)
+        self._lib.update_end(n_owned, _addr(fint), _addr(fext), _addr(mass), fx, _addr(du), _addr(acc),
+                             _addr(work))
+
+    def nodal_pressure(self, vol, vol0, bulk, out) -> None:
+        """p = K ln J / J per node and material (0 where no reference volume)."""
+        self._lib.nodal_pressure(vol.shape[0], _addr(vol), _addr(vol0), _addr(bulk), vol.shape[1], _addr(out))
+
+    def scatter_volumes(self, dofs32, mat, cvol, out) -> None:
+        """out (n_rows, n_materials) = Σ over live cells of cvol / 4 on each node, in cell order."""
+        self._lib.scatter_volumes(len(cvol), _addr(dofs32, np.int32), _addr(mat, np.int64), _addr(cvol),
+                                  out.shape[1], out.shape[0], _addr(out))
+
+    def scatter_forces(self, dofs32, Fc, out) -> None:
+        """out (n_rows, 3) = Σ over cells of Fc on their nodes, in cell order."""
+        self._lib.scatter_forces(len(Fc), _addr(dofs32, np.int32), _addr(Fc), out.shape[0], _addr(out))

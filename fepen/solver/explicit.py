@@ -83,8 +83,10 @@ class ExplicitSolver:
         safety: stable-step safety factor f in Δt = f min(h/c).
         nodal_pressure: averaged nodal pressure (True) or the plain tetrahedron (False).
         external: a Load (adds external nodal forces into ``solver.fext``), or None.
-        kernel: the stress update: "C" (the C trial pass and the numba return), "numba" (the numba kernel
-            alone, the reference), or None: C where it can be built (always numba for the plain element).
+        kernel: the step's kernels: "C" (the C passes, fepen/solver/cell_kernel.c: kinematics, one fused
+            stress-return-force pass, node update), "numba" (the numba kernels, the reference), or None: C
+            where it can be built (always numba for the plain element). The C passes do not write
+            ``P_packed`` (the form's coefficient; only the numba path and assemble_internal_force use it).
 
     ``interface``: an Interface set after construction (fepen.solver.shell_charge), called once a^n is
     known and Δt_{n+1/2} chosen, to add constraint forces of the coming step to ``acc``.
@@ -155,58 +157,13 @@ class ExplicitSolver:
         return self.safety * self.step_gain * self.comm.allreduce(h_c, op=MPI.MIN)
 
     def calibrate_step(self, iterations: int = 400, rtol: float = 1e-5) -> tuple[float, float]:
-        """The critical step 2/ω_max of the undeformed, unstressed body, by power iteration on M⁻¹K.
-
-        K d is the internal force of a tiny displacement ε d from the reference state (the solver's own
-        element, nodal pressure included), so ω_max is that of the discrete system actually integrated.
-        Sets ``step_gain`` = (2/ω_max) / min(h/c) (rounded down to a multiple of GAIN_QUANTUM), by which the
-        altitude estimate is multiplied from then
-        on (it keeps tracking the deformed mesh). Call before set_initial: the state is zeroed after.
-        The start vector is a smooth-free oscillating field of the reference positions, the same on any
-        partition. The Rayleigh quotient approaches ω_max² from below, so the safety factor keeps a margin.
+        """The critical step of the undeformed body by power iteration; sets ``step_gain`` (module function
+        calibrate_step: the method's documentation).
 
         Returns:
             (critical step of the undeformed body (s), step_gain).
         """
-        n = self.n_owned
-        X = self.X
-        L = float(np.ptp(X, axis=0).max())
-        d = np.stack([np.sin(X @ np.array(w) / L * 977.0 + k) for k, w in
-                      enumerate(([1.0, 0.31, 0.57], [0.23, 1.0, 0.71], [0.61, 0.43, 1.0]))], axis=1)
-        external, self.external = self.external, None
-        eps = 1e-9 * L
-        lam = lam_prev = 0.0
-        for it in range(iterations):
-            if self.fixed is not None:
-                d[self.fixed] = 0.0
-            norm = np.sqrt(self.comm.allreduce(float(np.sum(self.mass[:n, None] * d[:n] ** 2)), op=MPI.SUM))
-            d /= norm
-            self.U[:] = eps * d
-            self.Vel[:] = eps * d
-            self.s[:] = 0.0
-            self._forces(1.0)  # increment v dt = eps d from the reference: f_int = K eps d
-            Kd = self.fint[:n] / eps
-            lam = self.comm.allreduce(float(np.sum(d[:n] * Kd)), op=MPI.SUM)
-            self.Vel[:n] = Kd / self.mass[:n, None]
-            self.v.x.scatter_forward()
-            d = self.Vel.copy()
-            if it > 30 and abs(lam - lam_prev) < rtol * lam:
-                break
-            lam_prev = lam
-        self.external = external
-        for a in (self.U, self.Vel, self.s, self.fint, self.fext, self.acc):
-            a[:] = 0.0
-        self.eps_p[:] = 0.0
-        _, _, h_c, _ = kernels.volumes_and_step(self.positions(), self.dofs, self.orient, self.vol0, self.mat,
-                                                   self.speed, np.empty(self.n_cells))
-        h_c = self.comm.allreduce(h_c, op=MPI.MIN)
-        dt_crit = 2.0 / np.sqrt(lam)
-        # rounded down to a multiple of GAIN_QUANTUM: the Rayleigh quotient of a 1e-9 L displacement carries
-        # round-off of ~1e-6 that depends on the partition; rounded, the step is the same on any number of
-        # ranks (unless the gain falls within ~1e-6 of a multiple), and at most GAIN_QUANTUM / 2 smaller
-        self.step_gain = max(math.floor(dt_crit / h_c / GAIN_QUANTUM) * GAIN_QUANTUM, GAIN_QUANTUM)
-        self.dt = self.dt0 = self.dt_min = self.stable_step()
-        return dt_crit, self.step_gain
+        return calibrate_step(self, iterations, rtol)
 
     def set_initial(self, displacement=None, velocity=None) -> None:
         """Initial displacement (a rigid placement of the stress-free body) and velocity, as callables of
@@ -239,9 +196,12 @@ class ExplicitSolver:
         return self.Vel + 0.5 * self.dt_prev * self.acc
 
     # ------------------------------------------------------------------------------------------------
-    def _forces(self, dt: float) -> float:
+    def _forces(self, dt: float, x_ready: bool = False) -> float:
         """Internal and external forces at the current positions; returns the new stable-step estimate
-        (h/c over the current mesh, before the safety factor) on this rank."""
+        (h/c over the current mesh, before the safety factor) on this rank. x_ready: ``self._x`` already
+        holds X + U (the C update pass wrote it)."""
+        if self._cells is not None:
+            return self._forces_c(dt, x_ready)
         t0 = perf_counter()
         x = np.add(self.X, self.U, out=self._x)
         with_step = self.step_count % STEP_EVERY == 0
@@ -262,27 +222,59 @@ class ExplicitSolver:
         t2 = perf_counter()
         self.assemble_internal_force()
         t3 = perf_counter()
+        self._external_forces()
+        self._times(t0, t1, t2, t3)
+        return h_c
+
+    def _forces_c(self, dt: float, x_ready: bool) -> float:
+        """_forces through the C passes (fepen/solver/cell_kernel.c): the kinematics pass (cvol, J, h/c),
+        the nodal volumes and pressures, the fused stress-and-force pass (Fc), the nodal forces."""
+        t0 = perf_counter()
+        x = self._x if x_ready else np.add(self.X, self.U, out=self._x)
+        with_step = self.step_count % STEP_EVERY == 0
+        cells = self._cells
+        jmin, worst, h_c, self._step_cell = cells.kinematics(with_step)
+        if self._any_inverted(jmin):
+            if self.on_inverted is None or not self.on_inverted(x):
+                failures.inverted(self, x, jmin, worst)
+            jmin, worst, h_c, self._step_cell = cells.kinematics(with_step)  # the inverted cells eroded
+            if self._any_inverted(jmin):
+                failures.inverted(self, x, jmin, worst)
+        self._volumes_to_nodes(self.cvol, self._nvol)
+        t1 = perf_counter()
+        self._nodes.nodal_pressure(self.nodal_vol, self.nodal_vol0, self.bulk, self.nodal_p)
+        cells.cells(dt)
+        self._plastic += self._totals[0]
+        self._heat += self._totals[1]
+        t2 = perf_counter()
+        self._cells_to_nodes(self.Fc, self.fint)
+        t3 = perf_counter()
+        self._external_forces()
+        self._times(t0, t1, t2, t3)
+        return h_c
+
+    def _external_forces(self) -> None:
+        """fext from the external load (zero without one)."""
         self.fext[:] = 0.0
         if self.external is not None:
             self.external(self, self.dt)
+
+    def _times(self, t0: float, t1: float, t2: float, t3: float) -> None:
+        """Add a force evaluation's parts (kinematics t0–t1, material t1–t2, assembly t2–t3, boundary
+        t3–now) to ``times``."""
         t4 = perf_counter()
         tm = self.times
         tm.kinematics += t1 - t0
         tm.material += t2 - t1
         tm.assembly += t3 - t2
         tm.boundary += t4 - t3
-        return h_c
 
     def _stress_update(self, x: np.ndarray, dt: float) -> None:
-        """Every cell's stress over the step and P into the packed coefficient; plastic work and heat."""
-        if self._trial is not None:
-            yielding = self._trial(dt)
-            kernels.plastic_pass(x, dt, self.dofs, self.grad0, self.vol0, self.mat, self.params, self.s,
-                                 self.eps_p, self.temp, self.sy0, self.P_packed, yielding, self._totals)
-        else:
-            kernels.stress_update(x, self.Vel, dt, self.dofs, self.grad0, self.vol0, self.mat, self.params,
-                                  self.nodal_p, self.nodal, self.s, self.eps_p, self.temp, self.sy0,
-                                  self.P_packed, self._totals)
+        """Every cell's stress over the step and P into the packed coefficient; plastic work and heat (the
+        numba reference)."""
+        kernels.stress_update(x, self.Vel, dt, self.dofs, self.grad0, self.vol0, self.mat, self.params,
+                              self.nodal_p, self.nodal, self.s, self.eps_p, self.temp, self.sy0,
+                              self.P_packed, self._totals)
         self._plastic += self._totals[0]
         self._heat += self._totals[1]
 
@@ -306,22 +298,29 @@ class ExplicitSolver:
     def step(self) -> None:
         """Advance one central-difference step."""
         dt = self.dt
-        t0 = perf_counter()
-        self.Vel += (0.5 * (self.dt_prev + dt)) * self.acc
-        du = dt * self.Vel
-        self.U += du
-        self.fint_old[:] = self.fint
-        self.fext_old[:] = self.fext
-        self.times.update += perf_counter() - t0
-        h_c = self._forces(dt)
-        t0 = perf_counter()
         n = self.n_owned
-        f = self.fext[:n] - self.fint[:n]
-        self.acc[:n] = f / self._mass_div[:n, None]
-        if self.fixed is not None:
-            self.acc[self.fixed] = 0.0
+        t0 = perf_counter()
+        h = 0.5 * (self.dt_prev + dt)
+        if self._nodes is not None:  # the C node passes: x = X + U written too
+            self._nodes.update_begin(h, dt, n, self.acc, self.Vel, self.U, self.X, self._x, self._du, self.fint,
+                                     self.fext, self._work)
+        else:
+            self.Vel += h * self.acc
+            du = np.multiply(dt, self.Vel, out=self._du)
+            self.U += du
+            kernels.work_halves(du, self.fint, self.fext, n, self._work)
+        self.times.update += perf_counter() - t0
+        h_c = self._forces(dt, x_ready=self._nodes is not None)
+        t0 = perf_counter()
+        du = self._du
+        if self._nodes is not None:
+            self._nodes.update_end(n, self.fint, self.fext, self._mass_div, self.fixed, du, self.acc, self._work)
+        else:
+            self.acc[:n] = (self.fext[:n] - self.fint[:n]) / self._mass_div[:n, None]
+            if self.fixed is not None:
+                self.acc[self.fixed] = 0.0
+            kernels.work_halves(du, self.fint, self.fext, n, self._work)
         self.a_fn.x.scatter_forward()
-        kernels.work_increments(du, self.fint_old, self.fint, self.fext_old, self.fext, n, self._work)
         self.t += dt
         self.step_count += 1
         self.dt_prev = dt
@@ -371,6 +370,61 @@ class ExplicitSolver:
         """Add this rank's share of the interface forces' work over the step (J)."""
         self._w_if_n += normal
         self._w_if_t += tangential
+
+
+def calibrate_step(s: ExplicitSolver, iterations: int = 400, rtol: float = 1e-5) -> tuple[float, float]:
+    """The critical step 2/ω_max of the undeformed, unstressed body, by power iteration on M⁻¹K.
+
+    K d is the internal force of a tiny displacement ε d from the reference state (the solver's own
+    element, nodal pressure included), so ω_max is that of the discrete system actually integrated.
+    Sets ``step_gain`` = (2/ω_max) / min(h/c) (rounded down to a multiple of GAIN_QUANTUM), by which the
+    altitude estimate is multiplied from then
+    on (it keeps tracking the deformed mesh). Call before set_initial: the state is zeroed after.
+    The start vector is a smooth-free oscillating field of the reference positions, the same on any
+    partition. The Rayleigh quotient approaches ω_max² from below, so the safety factor keeps a margin.
+
+    Returns:
+        (critical step of the undeformed body (s), step_gain).
+    """
+    n = s.n_owned
+    X = s.X
+    L = float(np.ptp(X, axis=0).max())
+    d = np.stack([np.sin(X @ np.array(w) / L * 977.0 + k) for k, w in
+                  enumerate(([1.0, 0.31, 0.57], [0.23, 1.0, 0.71], [0.61, 0.43, 1.0]))], axis=1)
+    external, s.external = s.external, None
+    eps = 1e-9 * L
+    lam = lam_prev = 0.0
+    for it in range(iterations):
+        if s.fixed is not None:
+            d[s.fixed] = 0.0
+        norm = np.sqrt(s.comm.allreduce(float(np.sum(s.mass[:n, None] * d[:n] ** 2)), op=MPI.SUM))
+        d /= norm
+        s.U[:] = eps * d
+        s.Vel[:] = eps * d
+        s.s[:] = 0.0
+        s._forces(1.0)  # increment v dt = eps d from the reference: f_int = K eps d
+        Kd = s.fint[:n] / eps
+        lam = s.comm.allreduce(float(np.sum(d[:n] * Kd)), op=MPI.SUM)
+        s.Vel[:n] = Kd / s.mass[:n, None]
+        s.v.x.scatter_forward()
+        d = s.Vel.copy()
+        if it > 30 and abs(lam - lam_prev) < rtol * lam:
+            break
+        lam_prev = lam
+    s.external = external
+    for a in (s.U, s.Vel, s.s, s.fint, s.fext, s.acc):
+        a[:] = 0.0
+    s.eps_p[:] = 0.0
+    _, _, h_c, _ = kernels.volumes_and_step(s.positions(), s.dofs, s.orient, s.vol0, s.mat,
+                                               s.speed, np.empty(s.n_cells))
+    h_c = s.comm.allreduce(h_c, op=MPI.MIN)
+    dt_crit = 2.0 / np.sqrt(lam)
+    # rounded down to a multiple of GAIN_QUANTUM: the Rayleigh quotient of a 1e-9 L displacement carries
+    # round-off of ~1e-6 that depends on the partition; rounded, the step is the same on any number of
+    # ranks (unless the gain falls within ~1e-6 of a multiple), and at most GAIN_QUANTUM / 2 smaller
+    s.step_gain = max(math.floor(dt_crit / h_c / GAIN_QUANTUM) * GAIN_QUANTUM, GAIN_QUANTUM)
+    s.dt = s.dt0 = s.dt_min = s.stable_step()
+    return dt_crit, s.step_gain
 
 
 def _per_material_to_nodes(s: ExplicitSolver, cell_values: np.ndarray, vec) -> None:
@@ -476,10 +530,9 @@ def _nodal_arrays(s: ExplicitSolver, V, imap, nm: int) -> None:
     s.a_fn = fem.Function(V, name="acceleration")
     s.acc = s.a_fn.x.array.reshape(-1, 3)
     s.fint = s.fint_fn.x.array.reshape(-1, 3)
-    s.fint_old = np.zeros_like(s.fint)
+    s._du = np.zeros_like(s.fint)  # the displacement increment of the step (for the work of the forces)
     s.fixed = None  # (n_nodes, 3) bool: velocity components held at zero (symmetry planes)
     s.fext = np.zeros((s.n_nodes, 3))
-    s.fext_old = np.zeros_like(s.fext)
     s._nvol = la.vector(imap, bs=nm)
     s._nvol0 = la.vector(imap, bs=nm)
     s.nodal_vol = s._nvol.array.reshape(-1, nm)
@@ -503,18 +556,20 @@ def _internal_force_form(s: ExplicitSolver, V, Q) -> None:
 
 
 def _stress_kernel(s: ExplicitSolver, kernel: str | None) -> None:
-    """The stress update: the C trial pass + numba radial return, or the numba kernel alone (the
-    reference; also the plain element's)."""
+    """The step's kernels: the C passes (fepen.solver.ckernel: kinematics, fused stress and force, node
+    update), or the numba kernels alone (the reference; also the plain element's)."""
     materials = s.materials
     s._x = np.empty((s.n_nodes, 3))  # current positions X + U of the last force evaluation (the kernels')
     s._flag = np.zeros(1)
-    s._trial = None
+    s._cells = s._nodes = None
     if kernel not in (None, "C", "numba"):
         raise ValueError(f"kernel must be 'C', 'numba' or None, not {kernel!r}")
     if kernel == "C" and (not s.nodal or ckernel.library() is None):
         raise RuntimeError(f"the C kernel is not available: {ckernel.why_not() or 'plain element'}")
     if s.nodal and kernel != "numba" and ckernel.library() is not None:
         s.G_m = np.array([m.shear_modulus for m in materials])
-        s._trial = ckernel.TrialPass(s._x, s.Vel, s.X, s.dofs, s.mat, 6.0 * s.vol0 * s.orient, s.G_m,
-                                     s.nodal_p, s._sT, s.sy0, s.P_packed)
-    s.kernel = "C" if s._trial is not None else "numba"
+        s._cells = ckernel.CellPasses(s._x, s.Vel, s.dofs, s.mat, s.orient, s.vol0, s.speed, s.params, s.G_m,
+                                      s.nodal_p, s._sT, s.eps_p, s.temp, s.sy0, s.cvol, s.cell_dt, s.Fc,
+                                      s._totals)
+        s._nodes = ckernel.NodePasses()
+    s.kernel = "C" if s._cells is not None else "numba"

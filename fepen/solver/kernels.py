@@ -98,10 +98,9 @@ def volumes_and_step(x, dofs, orient, vol0, mat, speed, cvol, with_step=True, ce
             continue
         # J = det(x1 - x0, x2 - x0, x3 - x0) / (6 V0): needs the positions only, not the gradients
         J = _six_volume(x, dofs, e) / (6.0 * vol0[e]) * orient[e]
-        if not (J > jmin):
-            if not (J >= jmin):  # also catches NaN
-                jmin = J
-                worst = e
+        if not (J >= jmin) and jmin == jmin:  # smaller, or the first NaN (kept: a later cell must not hide it)
+            jmin = J
+            worst = e
         V = J * vol0[e]
         cvol[e] = V
         if not with_step:
@@ -423,17 +422,14 @@ def internal_force_cells(P, dofs, grad0, vol0, Fc):
 
 
 @numba.njit(cache=True, error_model="numpy")
-def work_increments(du, f_old, f, g_old, g, n, work):
-    """Each owned node's work over a step by the trapezoidal rule, ½ Δu·(f_old + f) for the internal forces
-    f and the external forces g, added into work (n_nodes, 2) (its sums: ExplicitSolver.work_sums)."""
+def work_halves(du, f, g, n, work):
+    """Half of each owned node's work over a step, du·f / 2 and du·g / 2 for the internal forces f and the
+    external forces g, added into work (n_nodes, 2): called with the old forces and again with the new ones
+    (the trapezoidal rule; the arithmetic of the C node passes), each node's running sum the same on any
+    partition (their sum: diagnostics.work_sums)."""
     for a in range(n):
-        wi = 0.0
-        we = 0.0
-        for k in range(3):
-            wi += du[a, k] * (f_old[a, k] + f[a, k])
-            we += du[a, k] * (g_old[a, k] + g[a, k])
-        work[a, 0] += 0.5 * wi
-        work[a, 1] += 0.5 * we
+        work[a, 0] += 0.5 * (du[a, 0] * f[a, 0] + du[a, 1] * f[a, 1] + du[a, 2] * f[a, 2])
+        work[a, 1] += 0.5 * (du[a, 0] * g[a, 0] + du[a, 1] * g[a, 1] + du[a, 2] * g[a, 2])
 
 
 @numba.njit(cache=True, fastmath=_FAST, error_model="numpy")

@@ -52,8 +52,6 @@ def rebuild(solver, cells: np.ndarray) -> None:
         s.grad0[cells], s.vol0[cells], s.orient[cells] = g, v, o
         if s.geometry_x is not None:
             s.geometry_x[s._geometry_node, :3] = s.X
-    if s._trial is not None:
-        s._trial.refresh(s.mat, 6.0 * s.vol0 * s.orient)
     old = s.mass.copy()
     v = s.velocity_at_step()
     kernels.volumes_and_step(s.X, s.dofs, s.orient, s.vol0, s.mat, s.speed, s.cvol, False)

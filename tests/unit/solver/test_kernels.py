@@ -40,19 +40,23 @@ def test_gradients_reproduce_linear_fields():
     assert np.all(v0 > 0)
 
 
-def nodal_volumes(x, dofs, orient, v0, mat, speed, out):
-    """The nodal volumes Σ V_e / 4 (one material) from volumes_and_step's cell volumes."""
+def nodal_volumes(x, dofs, orient, v0, mat, speed, out, with_step=True, cell_dt=None):
+    """The nodal volumes per material Σ V_e / 4 (out (n_nodes, n_materials)) from volumes_and_step's cell
+    volumes (a plain scatter); returns volumes_and_step's results."""
     cvol = np.empty(len(dofs))
-    K.volumes_and_step(x, dofs, orient, v0, mat, speed, cvol)
+    kin = K.volumes_and_step(x, dofs, orient, v0, mat, speed, cvol, with_step, cell_dt)
     out[:] = 0.0
-    np.add.at(out[:, 0], dofs.ravel(), np.repeat(0.25 * cvol, 4))
+    live = mat >= 0
+    np.add.at(out, (dofs[live].ravel(), np.repeat(mat[live], 4)), np.repeat(0.25 * cvol[live], 4))
+    return kin
 
 
 def run_motion(X, dofs, positions, dt, s0, material, nodal=True, kernel="numba", full=False):
     """Drive the stress update through a prescribed sequence of node positions.
 
-    kernel: "numba" (fepen.kinematics.stress_update) or "C" (fepen.solver.ckernel trial pass + plastic_pass).
-    Returns (s, P, eps_p), or with full=True also (T, plastic work summed over the steps)."""
+    kernel: "numba" (kernels.stress_update) or "C" (the fused C cell pass of fepen.solver.ckernel).
+    Returns (s, P, eps_p), or with full=True also (T, plastic work summed over the steps); for "C", P is
+    recovered from the pass's per-cell nodal forces (fused_P)."""
     g, v0, orient = K.reference_gradients(X, dofs)
     n = len(dofs)
     mat = np.zeros(n, dtype=np.int64)
@@ -70,19 +74,31 @@ def run_motion(X, dofs, positions, dt, s0, material, nodal=True, kernel="numba",
     nodal_volumes(X, dofs, orient, v0, mat, speed, nv0)
     xb, vb = np.empty_like(X), np.empty_like(X)
     if kernel == "C":
-        trial = ckernel.TrialPass(xb, vb, np.ascontiguousarray(X), dofs, mat, 6.0 * v0 * orient,
-                                  np.array([material.shear_modulus]), npres, sT, sy0, P)
+        Fc = np.zeros((n, 4, 3))
+        cells = ckernel.CellPasses(xb, vb, dofs, mat, orient, v0, speed, params,
+                                   np.array([material.shear_modulus]), npres, sT, ep, T, sy0, np.zeros(n),
+                                   np.full(n, np.inf), Fc, tot)
     for a, b in zip(positions[:-1], positions[1:]):
         xb[:] = b
         vb[:] = (b - a) / dt
         nodal_volumes(xb, dofs, orient, v0, mat, speed, nv)
         K.nodal_pressures(nv, nv0, np.array([material.bulk_modulus]), npres)
         if kernel == "C":
-            K.plastic_pass(xb, dt, dofs, g, v0, mat, params, s, ep, T, sy0, P, trial(dt), tot)
+            cells.cells(dt)
         else:
             K.stress_update(xb, vb, dt, dofs, g, v0, mat, params, npres, nodal, s, ep, T, sy0, P, tot)
         work += tot[0]
+    if kernel == "C":
+        P = fused_P(Fc, g, v0)
     return (s, P, ep, T, work) if full else (s, P, ep)
+
+
+def fused_P(Fc, grad0, vol0):
+    """P of each cell back from its nodal forces F_j = V0 P g_j (j = 1..3, g_j = grad0[:, j], the rows of
+    R^-1 with R the reference edge matrix): the columns [F_1 F_2 F_3] = V0 P (R^-1)^T, so P = [F] R^T / V0."""
+    R = np.linalg.inv(grad0[:, 1:, :])
+    Fm = np.swapaxes(Fc[:, 1:, :], 1, 2) / vol0[:, None, None]
+    return (Fm @ np.swapaxes(R, 1, 2)).reshape(-1, 9)
 
 
 @pytest.mark.parametrize("kernel", KERNELS)
@@ -152,3 +168,131 @@ def test_c_trial_pass_matches_the_numba_kernel():
     for a, b in zip(ref[:4], got[:4]):
         assert np.max(np.abs(a - b)) <= 1e-11 * np.max(np.abs(a))
     assert abs(ref[4] - got[4]) <= 1e-11 * abs(ref[4])
+
+
+@pytest.mark.skipif(ckernel.library() is None, reason=str(ckernel.why_not()))
+@pytest.mark.parametrize("seed", [0, 1])
+def test_fused_pass_matches_the_numba_kernels_on_mixed_cells(seed):
+    """One step of random deformation of pre-stressed cells of two materials (Johnson-Cook, bilinear), some
+    yielding and some not, some eroded (material -1): the C kinematics and fused cell pass give the numba
+    kernels' volumes, smallest J, h/c, stresses, plastic strains, temperatures, flow stresses, plastic work,
+    heat and nodal forces (kernels.internal_force of their P) to round-off."""
+    X, dofs = tets(10 + seed, 60)
+    rng = np.random.default_rng(seed)
+    n = len(dofs)
+    g, v0, orient = K.reference_gradients(X, dofs)
+    jc = M.johnson_cook(200e9, 0.29, 7850.0, 792e6, 510e6, 0.26, 0.014, 1.03, 1793.0, 294.0, 1.0, 477.0, 0.9)
+    bl = M.bilinear(70e9, 0.33, 2700.0, 300e6, 1e9)
+    mats = [jc, bl]
+    params = np.stack([m.params for m in mats])
+    G_m = np.array([m.shear_modulus for m in mats])
+    bulk = np.array([m.bulk_modulus for m in mats])
+    speed = np.array([5900.0, 6300.0])
+    mat = rng.integers(0, 2, n).astype(np.int64)
+    mat[rng.choice(n, 6, replace=False)] = -1
+    live = mat >= 0
+    dt = 1e-7
+    x = X @ (np.eye(3) + 4e-3 * rng.standard_normal((3, 3))).T + 2e-3 * rng.standard_normal(X.shape)
+    v = 50.0 * rng.standard_normal(X.shape)
+    s0 = rng.standard_normal((n, 6)) * 250e6
+    s0[:, :3] -= s0[:, :3].mean(axis=1, keepdims=True)
+    s0[~live] = 0.0
+    ep0 = np.where(rng.random(n) < 0.5, 0.0, 0.05 * rng.random(n))
+    T0 = 294.0 + 200.0 * rng.random(n)
+
+    def state():
+        sT = np.ascontiguousarray(s0.T.copy())
+        ep, T = ep0.copy(), T0.copy()
+        sy0 = np.empty(n)
+        K.static_flow_stress(mat, params, ep, T, sy0)
+        return sT, ep, T, sy0
+
+    nv0, nv, npres = np.zeros((len(X), 2)), np.zeros((len(X), 2)), np.zeros((len(X), 2))
+    nodal_volumes(X, dofs, orient, v0, mat, speed, nv0)
+    cdt_ref = np.full(n, np.inf)
+    kin_ref = nodal_volumes(x, dofs, orient, v0, mat, speed, nv, True, cdt_ref)
+    K.nodal_pressures(nv, nv0, bulk, npres)
+    # the numba reference
+    sT, ep, T, sy0 = state()
+    P = np.zeros((n, 9))
+    tot_ref = np.zeros(4)
+    K.stress_update(x, v, dt, dofs, g, v0, mat, params, npres, True, sT.T, ep, T, sy0, P, tot_ref)
+    f_ref = np.zeros_like(X)
+    K.internal_force(P, dofs, g, v0, f_ref)
+    ref = (sT, ep, T, sy0)
+    # the C passes
+    sT, ep, T, sy0 = state()
+    cvol, cdt, Fc, tot = np.zeros(n), np.full(n, np.inf), np.zeros((n, 4, 3)), np.zeros(4)
+    cells = ckernel.CellPasses(x, v, dofs, mat, orient, v0, speed, params, G_m, npres, sT, ep, T, sy0, cvol,
+                               cdt, Fc, tot)
+    kin = cells.kinematics(True)
+    nodes = ckernel.NodePasses()
+    nv_c, np_c = np.zeros_like(nv), np.zeros_like(npres)
+    nodes.scatter_volumes(cells._dofs, mat, cvol, nv_c)
+    nodes.nodal_pressure(nv_c, nv0, bulk, np_c)
+    assert np.allclose(nv_c, nv, rtol=1e-13, atol=0) and np.allclose(np_c, npres, rtol=1e-11, atol=1e-3)
+    assert kin[1] == kin_ref[1] and kin[3] == kin_ref[3]
+    assert kin[0] == pytest.approx(kin_ref[0], rel=1e-13) and kin[2] == pytest.approx(kin_ref[2], rel=1e-13)
+    assert np.allclose(cdt, cdt_ref, rtol=1e-13) and np.all(cvol[~live] == 0.0)
+    yielded = cells.cells(dt)
+    assert 5 < yielded < live.sum() - 5  # both kinds of cells
+    got = (sT, ep, T, sy0)
+    for a, b in zip(ref, got):
+        assert np.all(np.isfinite(a) == np.isfinite(b))
+        ok = np.isfinite(a)
+        assert np.max(np.abs(a[ok] - b[ok])) <= 1e-11 * np.max(np.abs(a[ok]))
+    assert np.allclose(tot, tot_ref, rtol=1e-11, atol=0)
+    assert np.all(Fc[~live] == 0.0) and np.all(sT[:, ~live] == 0.0)
+    f = np.zeros_like(X)
+    nodes.scatter_forces(cells._dofs, Fc, f)
+    assert np.max(np.abs(f - f_ref)) <= 1e-11 * np.max(np.abs(f_ref))
+    assert np.allclose(Fc.sum(axis=1), 0.0, atol=1e-12 * np.abs(Fc).max())  # each cell's forces balance
+
+
+@pytest.mark.skipif(ckernel.library() is None, reason=str(ckernel.why_not()))
+def test_c_kinematics_reports_inverted_and_nan_cells():
+    """The kinematics passes (C and numba) find an inverted cell's negative J, and a NaN position's NaN J
+    (no fast-math), even when later cells are sound."""
+    X, dofs = tets(4, 8)
+    g, v0, orient = K.reference_gradients(X, dofs)
+    n = len(dofs)
+    mat = np.zeros(n, dtype=np.int64)
+    args = (np.zeros((6, n)), np.zeros(n), np.zeros(n), np.zeros(n), np.zeros(n), np.zeros(n),
+            np.zeros((n, 4, 3)), np.zeros(4))
+    for bad, check in ((-1.0, lambda J: J < 0.0), (np.nan, np.isnan)):
+        x = X.copy()
+        p = dofs[3]
+        x[p[0]] = x[p[1:]].mean(axis=0) + bad * (X[p[0]] - X[p[1:]].mean(axis=0))  # mirrored, or NaN
+        cells = ckernel.CellPasses(x, np.zeros_like(x), dofs, mat, orient, v0, np.array([6000.0]),
+                                   M.elastic(2e11, 0.3, 7800.0).params[None], np.array([8e10]),
+                                   np.zeros((len(X), 1)), *args)
+        J, worst, _, _ = cells.kinematics(False)
+        assert check(J) and worst == 3
+        J, worst, _, _ = K.volumes_and_step(x, dofs, orient, v0, mat, np.array([6000.0]), np.zeros(n))
+        assert check(J) and worst == 3
+
+
+@pytest.mark.skipif(ckernel.library() is None, reason=str(ckernel.why_not()))
+def test_c_update_passes_are_central_differences():
+    """update_begin / update_end: v += h a, du = dt v, u += du, x = X + u; a = (f_ext - f_int) / m with fixed
+    components held at 0; each owned node's two halves of the trapezoidal work."""
+    rng = np.random.default_rng(3)
+    nn, own = 50, 40
+    a, v, u, X = (rng.standard_normal((nn, 3)) for _ in range(4))
+    fi, fe = rng.standard_normal((nn, 3)), rng.standard_normal((nn, 3))
+    m = 1.0 + rng.random(nn)
+    x, du = np.empty((nn, 3)), np.empty((nn, 3))
+    v_ref = v + 0.7 * a
+    u_ref = u + 0.3 * v_ref
+    nodes = ckernel.NodePasses()
+    work = np.zeros((nn, 2))
+    nodes.update_begin(0.7, 0.3, own, a, v, u, X, x, du, fi, fe, work)
+    assert np.allclose(v, v_ref, rtol=1e-15) and np.allclose(u, u_ref, rtol=1e-15) and np.allclose(x, X + u)
+    half = 0.5 * np.stack([np.sum(du * fi, axis=1), np.sum(du * fe, axis=1)], axis=1)
+    assert np.allclose(work[:own], half[:own], rtol=1e-13, atol=0) and np.all(work[own:] == 0.0)
+    fixed = rng.random((nn, 3)) < 0.2
+    acc = np.zeros((nn, 3))
+    nodes.update_end(own, fi, fe, m, fixed, du, acc, work)
+    want = np.where(fixed, 0.0, (fe - fi) / m[:, None])
+    assert np.allclose(acc[:own], want[:own], rtol=1e-15) and np.all(acc[own:] == 0.0)
+    assert np.allclose(work[:own], 2.0 * half[:own], rtol=1e-13, atol=0)  # the same forces: twice the half
