@@ -104,16 +104,34 @@ class NodalSum:
             self._graph = comm.Create_dist_graph_adjacent([int(r) for r in sources], [int(d) for d in dests],
                                                           reorder=False)
             assert np.all((remote_node >= 0) & (remote_node < n_owned))
-        # every owned node's terms: local slots (src ≥ 0) and received ones (src = −1 − position), by key
-        node = np.concatenate([flat[own], remote_node])
-        src = np.concatenate([slots[own], -1 - np.arange(len(remote_node), dtype=np.int64)])
-        allkeys = np.concatenate([slot_keys[own], remote_keys])
+        # Nodes all of whose contributors are on this rank: a scatter over the contributors sorted by key adds
+        # each node's terms in key order (the contributors' values are read in that order, the nodal sums
+        # written in place). Nodes with terms from other ranks (the interface): their local and received
+        # terms are merged by key into a node-major list (_place), and each node's run summed in order.
+        self._conn = np.ascontiguousarray(conn)
+        self._order = np.lexsort(tuple(keys[:, j] for j in range(keys.shape[1] - 1, -1, -1)))
+        interface = np.zeros(n_owned, dtype=bool)
+        interface[remote_node] = True
+        mine = own.copy()
+        mine[own] = interface[flat[own]]
+        node = np.concatenate([flat[mine], remote_node])
+        allkeys = np.concatenate([slot_keys[mine], remote_keys])
         order = np.lexsort(tuple(allkeys[:, j] for j in range(allkeys.shape[1] - 1, -1, -1)) + (node,))
-        self._src = np.ascontiguousarray(src[order])
-        self._ptr = np.zeros(n_owned + 1, dtype=np.int64)
-        np.add.at(self._ptr, node[order] + 1, 1)
-        np.cumsum(self._ptr, out=self._ptr)
+        self._run_node = np.flatnonzero(interface)
+        counts = np.bincount(node, minlength=n_owned)[self._run_node]
+        self._ptr = np.zeros(len(self._run_node) + 1, dtype=np.int64)
+        np.cumsum(counts, out=self._ptr[1:])
+        # where each interface term goes: local slot s at _pos[s] (−1: not an interface term), received term r
+        # at _pos_recv[r]
+        where = np.empty(len(order), dtype=np.int64)
+        where[order] = np.arange(len(order))
+        n_local = int(mine.sum())
+        self._pos = np.full(len(flat), -1, dtype=np.int64)
+        self._pos[slots[mine]] = where[:n_local]
+        self._pos_recv = where[n_local:]
+        self.n_terms = len(order)
         self.n_recv = len(remote_node)
+        self._terms = {}
 
     def __call__(self, values: np.ndarray, out: np.ndarray) -> np.ndarray:
         """Write the owned nodes' sums of ``values`` into ``out`` (see the class); returns out."""
@@ -121,14 +139,21 @@ class NodalSum:
         per_node = values.ndim == 3
         bs = values.shape[-1]
         flat = values.reshape(-1, bs)
-        div = 1 if per_node else self.k
         recv = np.empty((self.n_recv, bs))
         if self._graph is not None:
-            send = np.ascontiguousarray(flat[self._send // div])
+            send = np.ascontiguousarray(flat[self._send if per_node else self._send // self.k])
             sc, rc = self._send_counts * bs, self._recv_counts * bs
             self._graph.Neighbor_alltoallv([send, (sc, _displs(sc)), MPI.DOUBLE],
                                            [recv, (rc, _displs(rc)), MPI.DOUBLE])
-        _gather(self._ptr, self._src, div, flat, recv, out.reshape(len(out), -1))
+        out2 = out.reshape(len(out), -1)
+        _sorted_scatter(self._order, self._conn, flat, per_node, self.n_owned, out2)
+        if self.n_terms:
+            terms = self._terms.get(bs)
+            if terms is None:
+                terms = self._terms[bs] = np.empty((self.n_terms, bs))
+            _place(flat, self.k, per_node, self._pos, terms)
+            terms[self._pos_recv] = recv
+            _run_sums(self._ptr, self._run_node, terms, out2)
         return out
 
 
@@ -140,23 +165,73 @@ def _displs(counts: np.ndarray) -> np.ndarray:
 
 
 @numba.njit(cache=True)
-def _gather(ptr, src, div, local, remote, out):
-    bs = local.shape[1]
-    acc = np.empty(bs)
-    for a in range(len(ptr) - 1):
-        acc[:] = 0.0
-        for q in range(ptr[a], ptr[a + 1]):
-            i = src[q]
-            if i >= 0:
-                r = i // div
-                for j in range(bs):
-                    acc[j] += local[r, j]
+def _sorted_scatter(order, conn, values, per_node, n_owned, out):
+    """out[:n_owned] = Σ over the contributors c in ``order`` of their values at their owned nodes (values
+    (n_c k, bs) per node if per_node, else (n_c, bs) per contributor); ghost rows untouched."""
+    bs = values.shape[1]
+    k = conn.shape[1]
+    out[:n_owned] = 0.0
+    for i in range(len(order)):
+        c = order[i]
+        for j in range(k):
+            a = conn[c, j]
+            if a >= n_owned:
+                continue
+            r = c * k + j if per_node else c
+            if bs == 3:
+                out[a, 0] += values[r, 0]
+                out[a, 1] += values[r, 1]
+                out[a, 2] += values[r, 2]
             else:
-                r = -1 - i
-                for j in range(bs):
-                    acc[j] += remote[r, j]
+                for q in range(bs):
+                    out[a, q] += values[r, q]
+
+
+@numba.njit(cache=True)
+def _place(values, k, per_node, pos, terms):
+    """terms[pos[s]] = the value of slot s = c k + j (values[s] if per_node, else values[c]) for every slot
+    with pos[s] ≥ 0."""
+    bs = values.shape[1]
+    n_c = len(pos) // k
+    for c in range(n_c):
+        for j in range(k):
+            s = c * k + j
+            q = pos[s]
+            if q < 0:
+                continue
+            r = s if per_node else c
+            if bs == 3:
+                terms[q, 0] = values[r, 0]
+                terms[q, 1] = values[r, 1]
+                terms[q, 2] = values[r, 2]
+            else:
+                for i in range(bs):
+                    terms[q, i] = values[r, i]
+
+
+@numba.njit(cache=True)
+def _run_sums(ptr, run_node, terms, out):
+    """out[run_node[r]] = Σ terms[ptr[r]:ptr[r + 1]], added in order."""
+    bs = terms.shape[1]
+    if bs == 3:
+        for r in range(len(ptr) - 1):
+            s0 = s1 = s2 = 0.0
+            for q in range(ptr[r], ptr[r + 1]):
+                s0 += terms[q, 0]
+                s1 += terms[q, 1]
+                s2 += terms[q, 2]
+            a = run_node[r]
+            out[a, 0] = s0
+            out[a, 1] = s1
+            out[a, 2] = s2
+        return
+    for r in range(len(ptr) - 1):
+        a = run_node[r]
         for j in range(bs):
-            out[a, j] = acc[j]
+            acc = 0.0
+            for q in range(ptr[r], ptr[r + 1]):
+                acc += terms[q, j]
+            out[a, j] = acc
 
 
 # ------------------------------------------------------------------------------------------------------

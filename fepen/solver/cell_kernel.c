@@ -5,12 +5,12 @@
      update_begin     nodes: v += (dt_prev + dt)/2 a, du = dt v, u += du, x = X + u; the work of the old forces
      kinematics_pass  cells: current volume cvol (the nodal volumes are summed from it by the solver), the
                       smallest J (inverted or NaN cells), and every STEP_EVERY steps h/c per cell
-     scatter_volumes  cells -> nodes: nodal volume per material (a plain sum in cell order; replaceable)
+     scatter_volumes  cells -> nodes: nodal volume per material (terms on a grid: exact sums, any order)
      nodal_pressure   nodes: p_a = K ln(J_a) / J_a per material
      cell_pass        cells, ONE fused pass: elastic trial stress (Hughes-Winget), the radial return of the
                       cells over their flow stress (inline, in the same block), and the cell's internal force
                       on its four nodes, Fc
-     scatter_forces   cells -> nodes: f_int = sum of Fc (a plain sum in cell order; replaceable)
+     scatter_forces   cells -> nodes: f_int = sum of Fc (terms on a grid: exact sums, any order)
      update_end       nodes: a = (f_ext - f_int) / m, the work of the new forces
 
    The arithmetic is that of the numba reference, fepen.solver.kernels.stress_update (and, for the return,
@@ -211,31 +211,36 @@ void nodal_pressure(int32_t n_rows, const double *restrict vol, const double *re
 /* ------------------------------------------------------------------------------------------------------
    Cell -> node sums (plain, in cell order; the solver may replace them by a canonical-order gather) */
 
-/* vol (n_rows, nmat) = 0, then vol[dofs[e, j], mat[e]] += cvol[e] / 4 over the live cells */
+/* vol (n_rows, nmat) = 0, then vol[dofs[e, j], mat[e]] += cvol[e] / 4 over the live cells, each term rounded
+   to a multiple of the quantum q (a power of two): the sums of such terms are exact while below 2^53 q, so
+   they do not depend on the order of the cells nor on the partition (docs/theory.md §3.4) */
 void scatter_volumes(int32_t n, const int32_t *restrict dofs, const int64_t *restrict mat,
-                     const double *restrict cvol, int32_t nmat, int32_t n_rows, double *restrict vol)
+                     const double *restrict cvol, double q, int32_t nmat, int32_t n_rows, double *restrict vol)
 {
+    double iq = 1.0 / q;
     for (int32_t i = 0; i < n_rows * nmat; i++) vol[i] = 0.0;
     for (int32_t e = 0; e < n; e++) {
         int64_t m = mat[e];
         if (m < 0) continue;
-        double q = 0.25 * cvol[e];
-        for (int32_t j = 0; j < 4; j++) vol[dofs[4 * e + j] * nmat + m] += q;
+        double c = nearbyint(0.25 * cvol[e] * iq) * q;
+        for (int32_t j = 0; j < 4; j++) vol[dofs[4 * e + j] * nmat + m] += c;
     }
 }
 
-/* f (n_rows, 3) = 0, then f[dofs[e, j]] += Fc[e, j] */
-void scatter_forces(int32_t n, const int32_t *restrict dofs, const double *restrict Fc, int32_t n_rows,
+/* f (n_rows, 3) = 0, then f[dofs[e, j]] += Fc[e, j] rounded to a multiple of the quantum q (a power of two):
+   exact sums, the same in any order and on any partition (see scatter_volumes) */
+void scatter_forces(int32_t n, const int32_t *restrict dofs, const double *restrict Fc, double q, int32_t n_rows,
                     double *restrict f)
 {
+    double iq = 1.0 / q;
     for (int32_t i = 0; i < 3 * n_rows; i++) f[i] = 0.0;
     for (int32_t e = 0; e < n; e++)
         for (int32_t j = 0; j < 4; j++) {
             double *fn = f + 3 * dofs[4 * e + j];
             const double *c = Fc + 12 * e + 3 * j;
-            fn[0] += c[0];
-            fn[1] += c[1];
-            fn[2] += c[2];
+            fn[0] += nearbyint(c[0] * iq) * q;
+            fn[1] += nearbyint(c[1] * iq) * q;
+            fn[2] += nearbyint(c[2] * iq) * q;
         }
 }
 

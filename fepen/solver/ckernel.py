@@ -42,9 +42,9 @@ def library():
     lib.update_end.restype = None
     lib.nodal_pressure.argtypes = [i32, vp, vp, vp, i32, vp]
     lib.nodal_pressure.restype = None
-    lib.scatter_volumes.argtypes = [i32, vp, vp, vp, i32, i32, vp]
+    lib.scatter_volumes.argtypes = [i32, vp, vp, vp, dbl, i32, i32, vp]
     lib.scatter_volumes.restype = None
-    lib.scatter_forces.argtypes = [i32, vp, vp, i32, vp]
+    lib.scatter_forces.argtypes = [i32, vp, vp, dbl, i32, vp]
     lib.scatter_forces.restype = None
     lib.kinematics_pass.argtypes = [i32, vp, vp, vp, vp, vp, vp, i32, vp, vp, vp]
     lib.kinematics_pass.restype = None
@@ -149,11 +149,13 @@ class NodePasses:
         """p = K ln J / J per node and material (0 where no reference volume)."""
         self._lib.nodal_pressure(vol.shape[0], _addr(vol), _addr(vol0), _addr(bulk), vol.shape[1], _addr(out))
 
-    def scatter_volumes(self, dofs32, mat, cvol, out) -> None:
-        """out (n_rows, n_materials) = Σ over live cells of cvol / 4 on each node, in cell order."""
+    def scatter_volumes(self, dofs32, mat, cvol, quantum: float, out) -> None:
+        """out (n_rows, n_materials) = Σ over live cells of cvol / 4 on each node, each term rounded to a
+        multiple of ``quantum`` (a power of two: exact sums, the same in any order)."""
         self._lib.scatter_volumes(len(cvol), _addr(dofs32, np.int32), _addr(mat, np.int64), _addr(cvol),
-                                  out.shape[1], out.shape[0], _addr(out))
+                                  quantum, out.shape[1], out.shape[0], _addr(out))
 
-    def scatter_forces(self, dofs32, Fc, out) -> None:
-        """out (n_rows, 3) = Σ over cells of Fc on their nodes, in cell order."""
-        self._lib.scatter_forces(len(Fc), _addr(dofs32, np.int32), _addr(Fc), out.shape[0], _addr(out))
+    def scatter_forces(self, dofs32, Fc, quantum: float, out) -> None:
+        """out (n_rows, 3) = Σ over cells of Fc on their nodes, each term rounded to a multiple of ``quantum``
+        (a power of two: exact sums, the same in any order)."""
+        self._lib.scatter_forces(len(Fc), _addr(dofs32, np.int32), _addr(Fc), quantum, out.shape[0], _addr(out))

@@ -138,12 +138,23 @@ class ExplicitSolver:
         vec.scatter_forward()
 
     def _volumes_to_nodes(self, cvol: np.ndarray, vec) -> None:
-        """Nodal volumes per material (vector vec), Σ V_e / 4 over live cells, ghosts refreshed."""
-        _per_material_to_nodes(self, 0.25 * cvol, vec)
+        """Nodal volumes per material (the vector vec), Σ V_e / 4 over live cells, the terms on the volume
+        grid (exact sums: the same on any partition), ghosts summed and refreshed."""
+        arr = vec.array.reshape(-1, len(self.materials))
+        if self._nodes is not None:
+            self._nodes.scatter_volumes(self._cells._dofs, self.mat, cvol, self.volume_quantum, arr)
+        else:
+            kernels.grid_scatter(self.dofs, self.mat, cvol.reshape(-1, 1, 1), False, self.volume_quantum, arr)
+        self._ghost_sum(vec)
 
     def _cells_to_nodes(self, Fc: np.ndarray, out: np.ndarray) -> None:
-        """The cells' nodal forces Fc (n_cells, 4, 3) summed into the owned rows of out (ghosts stale)."""
-        self._cell_sum(Fc, out)
+        """The cells' nodal forces Fc (n_cells, 4, 3) summed into out (n_nodes, 3), the terms on the force
+        grid (exact sums: the same on any partition), ghost terms summed to their owners (ghost rows stale)."""
+        if self._nodes is not None:
+            self._nodes.scatter_forces(self._cells._dofs, Fc, self.force_quantum, out)
+        else:
+            kernels.grid_scatter(self.dofs, self.mat, Fc, True, self.force_quantum, out)
+        self.fint_fn.x.scatter_reverse(la.ScatterMode.add)
 
     def positions(self) -> np.ndarray:
         """Current node positions (n_nodes, 3), ghosts included."""
@@ -427,6 +438,25 @@ def calibrate_step(s: ExplicitSolver, iterations: int = 400, rtol: float = 1e-5)
     return dt_crit, s.step_gain
 
 
+#: the grids' ranges: a nodal sum is exact while its partial sums stay below 2^53 quanta, here FORCE_RANGE x
+#: the largest reference face area x the stiffest bulk modulus (forces of a stress of 4 K: far beyond what the
+#: solver survives; the force quantum is then ~1e-13 of a typical nodal force) and VOLUME_RANGE x the largest
+#: reference cell volume; past them the sums are still accurate, only no longer exact
+FORCE_RANGE = 4.0
+VOLUME_RANGE = 64.0
+
+
+def _grids(s: ExplicitSolver) -> tuple[float, float]:
+    """The quanta (powers of two) that the cells' nodal forces and volumes are rounded to before they are
+    summed at the nodes (docs/theory.md §3.4): the same on every rank (a maximum over all of them) and over
+    the run, from the reference body."""
+    area = 3.0 * s.vol0[:, None] * np.linalg.norm(s.grad0, axis=2) if s.n_cells else np.zeros((0, 4))
+    local = np.array([float(area.max(initial=0.0)) * float(s.bulk.max()), float(s.vol0.max(initial=0.0))])
+    top = local.copy()
+    s.comm.Allreduce(local, top, op=MPI.MAX)
+    return tuple(2.0 ** (math.ceil(math.log2(r * v)) - 52) for r, v in zip((FORCE_RANGE, VOLUME_RANGE), top))
+
+
 def _per_material_to_nodes(s: ExplicitSolver, cell_values: np.ndarray, vec) -> None:
     """Each live cell's value (n_cells,) to each of its four nodes, in its material's column of the vector
     ``vec`` (bs = number of materials), summed in the partition-independent order (assembly.NodalSum),
@@ -473,6 +503,7 @@ def _reference_body(s: ExplicitSolver, mesh) -> None:
     s._cell_sum = assembly.NodalSum(s.comm, imap, s.dofs, assembly.input_keys(s.dofs, s.input_index))
     s.cvol = np.zeros(n_cells)  # each cell's current volume
     s._cvol4 = np.zeros((n_cells, 1))
+    s._cells = s._nodes = None  # the C passes (_stress_kernel)
     s.Fc = np.zeros((n_cells, 4, 3))  # each cell's internal forces on its nodes
 
 
@@ -489,6 +520,7 @@ def _material_tables(s: ExplicitSolver, materials: list[M.Material], cell_materi
     s.speed = np.array([float(np.sqrt((m.bulk_modulus + 4.0 * m.shear_modulus / 3.0) / m.density))
                         for m in materials])
     s.bulk = np.array([m.bulk_modulus for m in materials])
+    s.force_quantum, s.volume_quantum = _grids(s)
 
 
 def _cell_state(s: ExplicitSolver) -> None:

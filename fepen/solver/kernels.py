@@ -422,6 +422,30 @@ def internal_force_cells(P, dofs, grad0, vol0, Fc):
 
 
 @numba.njit(cache=True, error_model="numpy")
+def grid_scatter(dofs, mat, values, per_node, quantum, out):
+    """out = 0, then each live cell's value at each of its nodes added, rounded to a multiple of quantum (a
+    power of two), so that the sums are exact (while below 2^53 quantum): the same in any order and on any
+    partition (docs/theory.md §3.4). values (n_cells, 4, bs) per node if per_node (into out (n, bs)), else
+    (n_cells,) per cell, into its material's column of out (n, n_materials). The arithmetic of the C
+    kernel's scatter_forces and scatter_volumes."""
+    out[:] = 0.0
+    iq = 1.0 / quantum
+    for e in range(dofs.shape[0]):
+        m = mat[e]
+        if m < 0:
+            continue
+        if per_node:
+            for a in range(4):
+                nd = dofs[e, a]
+                for k in range(values.shape[2]):
+                    out[nd, k] += np.rint(values[e, a, k] * iq) * quantum
+        else:
+            c = np.rint(0.25 * values[e, 0, 0] * iq) * quantum
+            for a in range(4):
+                out[dofs[e, a], m] += c
+
+
+@numba.njit(cache=True, error_model="numpy")
 def work_halves(du, f, g, n, work):
     """Half of each owned node's work over a step, du·f / 2 and du·g / 2 for the internal forces f and the
     external forces g, added into work (n_nodes, 2): called with the old forces and again with the new ones

@@ -40,6 +40,52 @@ def test_gradients_reproduce_linear_fields():
     assert np.all(v0 > 0)
 
 
+#: a grid so fine that rounding to it changes nothing (the plain sums, for comparisons with the references)
+FINE = 2.0 ** -200
+
+
+@pytest.mark.skipif(ckernel.library() is None, reason=str(ckernel.why_not()))
+def test_grid_sums_do_not_depend_on_the_order_of_the_cells():
+    """Terms rounded to a power-of-two grid sum exactly: the nodal forces and volumes of the cells in reverse
+    order are the same bits, in C and in numba alike, and within half a quantum per term of the plain sums;
+    on the finest grid they are the plain sums."""
+    rng = np.random.default_rng(11)
+    n_nodes, n = 300, 2000
+    dofs = np.array([rng.choice(n_nodes, 4, replace=False) for _ in range(n)], dtype=np.int64)
+    mat = rng.integers(0, 2, n).astype(np.int64)
+    mat[:7] = -1
+    Fc = rng.standard_normal((n, 4, 3)) * 10.0 ** rng.integers(-2, 4, (n, 1, 1))
+    Fc[mat < 0] = 0.0
+    cvol = rng.random(n) * 1e-9
+    cvol[mat < 0] = 0.0
+    q_f, q_v = 2.0 ** -30, 2.0 ** -80
+    nodes = ckernel.NodePasses()
+    back = np.arange(n)[::-1].copy()
+    out = {}
+    for name, order in (("forward", np.arange(n)), ("back", back)):
+        d32 = np.ascontiguousarray(dofs[order], dtype=np.int32)
+        f_c, v_c = np.zeros((n_nodes, 3)), np.zeros((n_nodes, 2))
+        nodes.scatter_forces(d32, np.ascontiguousarray(Fc[order]), q_f, f_c)
+        nodes.scatter_volumes(d32, np.ascontiguousarray(mat[order]), np.ascontiguousarray(cvol[order]), q_v, v_c)
+        f_n, v_n = np.zeros((n_nodes, 3)), np.zeros((n_nodes, 2))
+        K.grid_scatter(dofs[order], mat[order], np.ascontiguousarray(Fc[order]), True, q_f, f_n)
+        K.grid_scatter(dofs[order], mat[order], cvol[order].reshape(-1, 1, 1), False, q_v, v_n)
+        assert np.array_equal(f_c, f_n) and np.array_equal(v_c, v_n)
+        out[name] = (f_c, v_c)
+    assert np.array_equal(out["forward"][0], out["back"][0]) and np.array_equal(out["forward"][1], out["back"][1])
+    plain = np.zeros((n_nodes, 3))
+    np.add.at(plain, dofs.ravel(), Fc.reshape(-1, 3))
+    terms = np.bincount(dofs.ravel(), minlength=n_nodes)[:, None]
+    assert np.all(np.abs(out["forward"][0] - plain) <= 0.5 * q_f * terms + 1e-15 * np.abs(Fc).max())
+    fine = np.zeros((n_nodes, 3))
+    nodes.scatter_forces(np.ascontiguousarray(dofs, dtype=np.int32), Fc, FINE, fine)
+    ref = np.zeros((n_nodes, 3))
+    for e in range(n):
+        for a in range(4):
+            ref[dofs[e, a]] += Fc[e, a]
+    assert np.array_equal(fine, ref)
+
+
 def nodal_volumes(x, dofs, orient, v0, mat, speed, out, with_step=True, cell_dt=None):
     """The nodal volumes per material Σ V_e / 4 (out (n_nodes, n_materials)) from volumes_and_step's cell
     volumes (a plain scatter); returns volumes_and_step's results."""
@@ -228,7 +274,7 @@ def test_fused_pass_matches_the_numba_kernels_on_mixed_cells(seed):
     kin = cells.kinematics(True)
     nodes = ckernel.NodePasses()
     nv_c, np_c = np.zeros_like(nv), np.zeros_like(npres)
-    nodes.scatter_volumes(cells._dofs, mat, cvol, nv_c)
+    nodes.scatter_volumes(cells._dofs, mat, cvol, FINE, nv_c)
     nodes.nodal_pressure(nv_c, nv0, bulk, np_c)
     assert np.allclose(nv_c, nv, rtol=1e-13, atol=0) and np.allclose(np_c, npres, rtol=1e-11, atol=1e-3)
     assert kin[1] == kin_ref[1] and kin[3] == kin_ref[3]
@@ -244,7 +290,7 @@ def test_fused_pass_matches_the_numba_kernels_on_mixed_cells(seed):
     assert np.allclose(tot, tot_ref, rtol=1e-11, atol=0)
     assert np.all(Fc[~live] == 0.0) and np.all(sT[:, ~live] == 0.0)
     f = np.zeros_like(X)
-    nodes.scatter_forces(cells._dofs, Fc, f)
+    nodes.scatter_forces(cells._dofs, Fc, FINE, f)
     assert np.max(np.abs(f - f_ref)) <= 1e-11 * np.max(np.abs(f_ref))
     assert np.allclose(Fc.sum(axis=1), 0.0, atol=1e-12 * np.abs(Fc).max())  # each cell's forces balance
 
