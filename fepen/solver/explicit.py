@@ -33,6 +33,13 @@ class StepTimes:
     update: float = 0.0
     target_comm: float = 0.0  #: of boundary: the target load's broadcasts, reductions and ghost sum
 
+    def add(self, t0: float, t1: float, t2: float, t3: float, t4: float) -> None:
+        """Add a force evaluation's parts: kinematics t0–t1, material t1–t2, assembly t2–t3, boundary t3–t4."""
+        self.kinematics += t1 - t0
+        self.material += t2 - t1
+        self.assembly += t3 - t2
+        self.boundary += t4 - t3
+
 
 #: steps between two evaluations of the stable step
 STEP_EVERY = 4
@@ -234,7 +241,7 @@ class ExplicitSolver:
         self.assemble_internal_force()
         t3 = perf_counter()
         self._external_forces()
-        self._times(t0, t1, t2, t3)
+        self.times.add(t0, t1, t2, t3, perf_counter())
         return h_c
 
     def _forces_c(self, dt: float, x_ready: bool) -> float:
@@ -261,7 +268,7 @@ class ExplicitSolver:
         self._cells_to_nodes(self.Fc, self.fint)
         t3 = perf_counter()
         self._external_forces()
-        self._times(t0, t1, t2, t3)
+        self.times.add(t0, t1, t2, t3, perf_counter())
         return h_c
 
     def _external_forces(self) -> None:
@@ -269,16 +276,6 @@ class ExplicitSolver:
         self.fext[:] = 0.0
         if self.external is not None:
             self.external(self, self.dt)
-
-    def _times(self, t0: float, t1: float, t2: float, t3: float) -> None:
-        """Add a force evaluation's parts (kinematics t0–t1, material t1–t2, assembly t2–t3, boundary
-        t3–now) to ``times``."""
-        t4 = perf_counter()
-        tm = self.times
-        tm.kinematics += t1 - t0
-        tm.material += t2 - t1
-        tm.assembly += t3 - t2
-        tm.boundary += t4 - t3
 
     def _stress_update(self, x: np.ndarray, dt: float) -> None:
         """Every cell's stress over the step and P into the packed coefficient; plastic work and heat (the
