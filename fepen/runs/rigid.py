@@ -24,7 +24,6 @@ from fepen.laws.rigid_body import (
     RigidState,
     inertia_about_centre,
     matrix_to_quat,
-    quat_to_matrix,
     tet_mass_properties,
 )
 from fepen.runs import setup, shot
@@ -145,6 +144,7 @@ class RigidRun(Run):
         self.dt = sh.rigid_step or min(STEP_FRACTION * sh.nominal_diameter / self.v0, t_stop / STOP_STEPS)
         self.tip_ref = np.zeros(3)
         self.tail_ref = np.array([0.0, self.shape.length, 0.0])
+        self.tip_arm = self.tip_ref - self.body.centre0  # the tip about the centre, body frame
         self.w_ext = 0.0
         self.ke0 = self.body.kinetic_energy(self.state)
         self.loaded = 0
@@ -159,7 +159,7 @@ class RigidRun(Run):
         """Target forces on the load points (zero outside the target)."""
         g = self.pts
         R = self.body.frame[0]  # s's rotation (RigidBody.derivative)
-        tip = s.c + R @ (self.tip_ref - self.body.centre0)
+        tip = s.c + R @ self.tip_arm
         load = tg.load_on_points(self.law, x, v, n, g["area0"], g["radius"], g["R_meridian"], g["sin_phi0"],
                                  -R[:, 1], self.crater, -tip[1])
         self.loaded, self.area = load.loaded, load.area
@@ -169,7 +169,7 @@ class RigidRun(Run):
 
     def axis(self, s: RigidState) -> np.ndarray:
         """World unit vector of the projectile axis, tail to nose."""
-        return quat_to_matrix(s.q) @ np.array([0.0, -1.0, 0.0])
+        return self.body.at(s)[1] @ np.array([0.0, -1.0, 0.0])
 
     def step(self) -> None:
         """One RK4 step (the force kept for the history is the step's start's), then the wear."""
