@@ -235,10 +235,17 @@ def path_area(path: list[Segment]) -> float:
 
 
 def radius_at(path: list[Segment], z):
-    """Largest r of the path at axial positions z (nan where the path has none)."""
+    """Largest r of the path at axial positions z (nan where the path has none).
+
+    A segment whose z range holds none of the z (or that has no z extent) gives only nan, which leaves the
+    result as it is: it is skipped (the mass rule's bisections ask one z, or a span, among many segments)."""
     z = np.asarray(z, dtype=float)
     out = np.full(z.shape, np.nan)
+    zmin, zmax = (float(z.min()), float(z.max())) if z.size else (math.inf, -math.inf)
     for seg in path:
+        z0, z1 = seg.p0[1], seg.p1[1]
+        if z0 == z1 or (zmin > max(z0, z1) or zmax < min(z0, z1)):  # false with a nan z: no skipping
+            continue
         r = seg.r_at_z(z)
         out = np.where(np.isnan(out), r, np.where(np.isnan(r), out, np.maximum(out, r)))
     return out
