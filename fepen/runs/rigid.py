@@ -194,6 +194,7 @@ class RigidRun(Run):
         if self.wear is not None:
             s = self.wear.step(self.body, s, self.dt)
             self.tip_ref[1] = self.wear.shortening
+            self.tip_arm = self.tip_ref - self.body.centre0  # the worn nose's tip (force_fn's crater depth)
         self.state = s
         self.t += self.dt
         self.step_count += 1
@@ -313,4 +314,5 @@ class Wear:
                                                  contraction)
         body.r0[:] = X - body.centre0
         body.N0[:] = N
+        body._last = None  # the cached load points of the last state are the uncontracted nose's
         g["X"][:], g["N"][:], g["area0"][:], g["sin_phi0"][:], g["R_meridian"][:] = X, N, A, sphi, Rm
