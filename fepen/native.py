@@ -37,30 +37,32 @@ def cache_dir() -> Path:
     return Path(base) / "fepen"
 
 
-def _build(source: Path, cc: str) -> Path:
+def _build(source: Path, cc: str, extra: tuple = ()) -> Path:
+    flags = [*FLAGS, *extra]
     version = subprocess.run([cc, "--version"], capture_output=True, text=True, check=True).stdout
-    key = hashlib.sha256(source.read_bytes() + " ".join(FLAGS).encode() + version.encode() + _cpu_flags().encode())
+    key = hashlib.sha256(source.read_bytes() + " ".join(flags).encode() + version.encode() + _cpu_flags().encode())
     out = cache_dir() / f"{source.stem}-{key.hexdigest()[:16]}.so"
     if out.exists():
         return out
     out.parent.mkdir(parents=True, exist_ok=True)
     with replacing(out, ".so") as tmp:
-        subprocess.run([cc, *FLAGS, str(source), "-lm", "-o", str(tmp)], capture_output=True, text=True,
+        subprocess.run([cc, *flags, str(source), "-lm", "-o", str(tmp)], capture_output=True, text=True,
                        check=True)
     return out
 
 
-def load(source: Path) -> tuple[ctypes.CDLL | None, str | None]:
+def load(source: Path, extra: tuple = ()) -> tuple[ctypes.CDLL | None, str | None]:
     """Build (once) and load a C source.
 
     Args:
-        source: the .c file.
+        source: the .c file. extra: compiler flags after FLAGS (e.g. "-ffp-contract=off" for a kernel that
+            must round as numpy does, one operation at a time).
 
     Returns:
         (the library, None), or (None, why it could not be built or loaded).
     """
     try:
-        return ctypes.CDLL(str(_build(source, os.environ.get("CC", "cc")))), None
+        return ctypes.CDLL(str(_build(source, os.environ.get("CC", "cc"), tuple(extra)))), None
     except (OSError, subprocess.CalledProcessError) as err:
         detail = (getattr(err, "stderr", "") or str(err)).strip()
         return None, f"{source.name} not built ({detail.splitlines()[-1] if detail else err})"
