@@ -1,22 +1,118 @@
 /* Many rigid shots of one projectile in one call (fepen/runs/batch.py, docs/theory.md §9): each shot's RK4
  * loop, stop rules and history maxima as fepen.runs.rigid.RigidRun advances it, with no Python per stage.
- * The load points, the force sums and the target law are the single path's own compiled functions
- * (rigid_kernel.c's rigid_points and force_moment, target_kernel.c's point_forces), passed in as function
- * pointers; the glue between them (quaternions, omega, the crater scale, the stage states, the work, the stop
- * rules) repeats the single path's numpy and Python expressions operation by operation, in their order, and
- * is built without contracting a * b + c into one rounding (-ffp-contract=off), so that a shot's trajectory
- * is bitwise the single path's. tests/unit/runs/test_batch.py holds the two together. */
+ * The load points and the force sums are the single path's own compiled functions (rigid_kernel.c's
+ * rigid_points and force_moment, passed in as function pointers and called on all the points: they are
+ * vectorised, so a point's rounding depends on its place in the array); the target law is target_kernel.c's
+ * point_forces, included and built as that file is built (a * b + c contracted alike), with three shortcuts
+ * that change no bit (law_points). The glue between them (quaternions, omega, the crater scale, the stage
+ * states, the work, the stop rules, the history rows' depth and energy error) repeats the single path's numpy
+ * and Python expressions operation by operation, in their order, built without contracting a * b + c into
+ * one rounding (-ffp-contract=off, fepen.runs.batch), so that a shot's trajectory is bitwise the single
+ * path's. tests/unit/runs/test_batch.py holds the two together. */
 #include <math.h>
 #include <stdint.h>
 #include <stdlib.h>
 #include <string.h>
 
+/* The law's parameter enum, clip01 and cavity_stress, and the law below, built as the single path builds
+ * target_kernel.c (a * b + c contracted as there) */
+#pragma GCC push_options
+#pragma GCC optimize("fp-contract=fast")
+#include "target_kernel.c"
+
+static inline double mx(double a, double b) { return a > b ? a : b; }
+static inline double mn(double a, double b) { return a < b ? a : b; }
+
+/* point_forces on k points, with the same operations on every loaded point, and three shortcuts that change no
+ * bit: ell = sqrt(area) given; the free-surface stress where the plastic zone is whole (ca = c/a) computed
+ * once; the forces of the points it loads (their indices into idx, in order) the only ones summed (the others
+ * are zero). f is written only at those points. Returns how many. */
+__attribute__((noinline)) static int32_t law_points(int32_t k, const double *x, const double *v, const double *n,
+                                                    const double *area, const double *ell, const double *radius,
+                                                    const double *Rm, const double *sphi0, const double *axis,
+                                                    const double *p, const double *gauss, int32_t ng, double *f,
+                                                    int32_t *idx, double *sums) {
+    const double thk = p[P_THICKNESS], sin_min = sin(p[P_PHI_MIN]), sin_onset = sin(p[P_ONSET]);
+    const double ref = p[P_FREE_SURFACE] != 0.0 ? cavity_stress(p, p[P_C_OVER_A]) : 1.0;
+    const double whole = p[P_GIVEN_SIGMA_S] != 0.0 ? p[P_SIGMA_S] * ref / ref : ref;
+    const double mu_s = p[P_MU], mu_d = p[P_MU_DYNAMIC], decay = p[P_MU_DECAY];
+    int32_t m = 0;
+    for (int j = 0; j < 5; ++j) sums[j] = 0.0;
+    for (int32_t i = 0; i < k; ++i) {
+        const double *xi = x + 3 * i, *vi = v + 3 * i, *ni = n + 3 * i;
+        double y = xi[1];
+        double frac = clip01(0.5 - (y + p[P_TOP]) / ell[i]);
+        if (p[P_LOWER] >= 0.0) frac *= clip01(0.5 + (y + p[P_LOWER]) / ell[i]);
+        if (!(frac > 0.0)) continue;
+        double vn = vi[0] * ni[0] + vi[1] * ni[1] + vi[2] * ni[2];
+        double speed = sqrt(vi[0] * vi[0] + vi[1] * vi[1] + vi[2] * vi[2]);
+        double sin_phi = speed > 0.0 ? vn / mx(speed, 1e-300) : 0.0;
+        int loaded = sin_phi > SIN_TOL;
+        if (axis) loaded = loaded && (vi[0] * axis[0] + vi[1] * axis[1] + vi[2] * axis[2] > 0.0);
+        if (p[P_SEPARATION] != 0.0) loaded = loaded && sin_phi > sin_min;
+        if (!loaded || !(vn > 0.0)) continue;
+        double depth = mx(-y, 0.0), Le = thk >= 0.0 ? mn(depth, mx(thk - depth, 0.0)) : depth;
+        double s = p[P_SIGMA_S];
+        if (p[P_FREE_SURFACE] != 0.0) {
+            double ca = fmin(p[P_C_OVER_A], 1.0 + Le / (p[P_SURFACE_RANGE] * mx(radius[i], 1e-12)));
+            if (ca == p[P_C_OVER_A]) s = whole;
+            else s = p[P_GIVEN_SIGMA_S] != 0.0 ? p[P_SIGMA_S] * cavity_stress(p, ca) / ref : cavity_stress(p, ca);
+        }
+        if (p[P_ONSET] > 0.0) s *= mn(sin_phi / sin_onset, 1.0);
+        double sg = (s + p[P_B] * p[P_DENSITY] * vn * vn) * frac;
+        if (p[P_CRATER] == 2.0 && -y < p[P_K] * p[P_D]) {
+            double rho = mx(radius[i], 1e-12), l = (p[P_C_OVER_A] - 1.0) * rho, integral = 0.0;
+            for (int32_t g = 0; g < ng; ++g) {
+                double w = 0.5 * l * (gauss[g] + 1.0), q = rho / (rho + w);
+                integral += 0.5 * l * gauss[ng + g] * (1.0 + w / Rm[i]) * (1.0 + w * sphi0[i] / rho) * q * q * q * q;
+            }
+            double e_kin = 0.5 * p[P_LOCK_DENSITY] * vn * vn * integral;
+            double e_str = p[P_CRUSH_STRAIN] * p[P_Y] * (2.0 * rho * Le + Le * Le) / rho;
+            if (e_kin - e_str >= 0.0) sg = 0.0;
+        }
+        double pa = sg * area[i], *fi = f + 3 * i;
+        fi[0] = -pa * ni[0];
+        fi[1] = -pa * ni[1];
+        fi[2] = -pa * ni[2];
+        if (p[P_FRICTION] != 0.0 && mu_s > 0.0) {
+            double vt[3] = {vi[0] - vn * ni[0], vi[1] - vn * ni[1], vi[2] - vn * ni[2]};
+            double st = sqrt(vt[0] * vt[0] + vt[1] * vt[1] + vt[2] * vt[2]);
+            if (st > 1e-9) {
+                double mu = (decay == 0.0 || mu_d == mu_s) ? mu_s : mu_d + (mu_s - mu_d) * exp(-decay * st);
+                double c = mu * pa / st;
+                fi[0] -= c * vt[0];
+                fi[1] -= c * vt[1];
+                fi[2] -= c * vt[2];
+            }
+        }
+        if (sg > 0.0) {
+            sums[3] += 1.0;
+            sums[4] += area[i];
+        }
+        idx[m++] = i;
+    }
+    for (int32_t j = 0; j < m; ++j) {
+        const double *fi = f + 3 * idx[j];
+        sums[0] += fi[0];
+        sums[1] += fi[1];
+        sums[2] += fi[2];
+    }
+    return m;
+}
+
+#pragma GCC pop_options
+
 typedef void (*points_fn)(int32_t, const double *, const double *, const double *, const double *,
                           const double *, const double *, double *, double *, double *, double *);
 typedef void (*moment_fn)(int32_t, const double *, const double *, double *);
-typedef int32_t (*law_fn)(int32_t, const double *, const double *, const double *, const double *,
-                          const double *, const double *, const double *, const double *, const double *,
-                          const double *, int32_t, double *, double *, double *);
+
+/* rigid_kernel.c's force_moment on all k points (f zero outside idx: the function is vectorised, a point's
+ * rounding depends on its place in the array, so the points are not gathered), then f zeroed again at idx */
+static void moment_points(moment_fn moment, int32_t k, int32_t m, const int32_t *idx, const double *arm, double *f,
+                          double *FM) {
+    moment(k, arm, f, FM);
+    for (int32_t j = 0; j < m; ++j) memset(f + 3 * idx[j], 0, 3 * sizeof(double));
+}
 
 /* per-shot numbers, in this order (fepen/runs/batch.py SHOT_NUMBERS) */
 enum { S_MASS, S_DT, S_HARD_END, S_THICKNESS /* < 0: none */, S_UNTIL_STOPPED, S_HISTORY /* <= 0: none */,
@@ -29,11 +125,11 @@ enum { R_T, R_STEPS, R_OUTCOME /* 0 ended, 1 perforated, 2 ricochet, 3 embedded 
 
 typedef struct {
     int32_t k, ng;
-    const double *r0, *N0, *area, *radius, *Rm, *sphi0, *gauss;
+    const double *r0, *N0, *area, *ell, *radius, *Rm, *sphi0, *gauss;
     points_fn points;
     moment_fn moment;
-    law_fn law;
-    double *x, *v, *n, *arm, *f, *sig; /* scratch */
+    double *x, *v, *n, *arm, *f; /* scratch (f zero outside the points a law call loads) */
+    int32_t *idx;
 } Body;
 
 /* numpy's dot of two 3- or 4-vectors: from 0, left to right */
@@ -86,16 +182,19 @@ static void derivative(Body *b, const double *sp, const double *law, const doubl
     matvec(R, sp + S_TIP, tip);
     for (int j = 0; j < 3; ++j) tip[j] = y[j] + tip[j];
     for (int j = 0; j < 3; ++j) axis[j] = -R[3 * j + 1];
-    b->law(b->k, b->x, b->v, b->n, b->area, b->radius, b->Rm, b->sphi0, axis, law, b->gauss, b->ng, b->f, b->sig,
-           sums);
+    int32_t m = law_points(b->k, b->x, b->v, b->n, b->area, b->ell, b->radius, b->Rm, b->sphi0, axis, law,
+                           b->gauss, b->ng, b->f, b->idx, sums);
     if (sp[S_CRATER] != 0.0) { /* ForrestalCrater.scale(-tip[1], -(total . axis)) */
         double depth = -tip[1], axial = -dot3(sums, axis), scale = 1.0;
         if (!(depth >= sp[S_CRATER_KD] || axial <= 0.0)) scale = fmax(depth, 0.0) * sp[S_CRATER_C] / axial;
-        for (int32_t i = 0; i < 3 * b->k; ++i) b->f[i] *= scale;
+        for (int32_t j = 0; j < m; ++j) {
+            double *fi = b->f + 3 * b->idx[j];
+            fi[0] *= scale; fi[1] *= scale; fi[2] *= scale;
+        }
     }
     *loaded = sums[3];
     *area = sums[4];
-    b->moment(b->k, b->arm, b->f, FM);
+    moment_points(b->moment, b->k, m, b->idx, b->arm, b->f, FM);
     double q[4] = {y[3], y[4], y[5], y[6]};
     double w1 = 0.0, x1 = w[0], y1 = w[1], z1 = w[2], w2 = q[0], x2 = q[1], y2 = q[2], z2 = q[3];
     for (int j = 0; j < 3; ++j) dy[j] = y[7 + j];
@@ -218,21 +317,41 @@ static void one_shot(Body *b, const double *sp, const double *law, double *y, do
     res[R_STATUS] = status;
 }
 
-/* n shots sharing k load points (r0, N0: body-frame arms and normals; area, radius, Rm, sphi0: the law's
- * per-point constants; gauss: ng nodes then ng weights). Per shot: sp (n, S_COUNT), law (n, nlaw) the
- * TargetLaw's numbers, y (n, 13) the initial state, overwritten by the final one; res (n, R_COUNT).
- * Returns S_COUNT * 100 + R_COUNT (the caller checks the layout), or -1 when the scratch is not allocated. */
-int32_t rigid_batch(int32_t n, int32_t k, const double *r0, const double *N0, const double *area,
+/* n shots sharing k load points (r0, N0: body-frame arms and normals; area, ell = sqrt(area), radius, Rm,
+ * sphi0: the law's per-point constants; gauss: ng nodes then ng weights; points, moment: rigid_kernel.c's
+ * rigid_points and force_moment). Per shot: sp (n, S_COUNT), laws (n, nlaw) the TargetLaw's numbers (P_COUNT of them), y (n, 13)
+ * the initial state, overwritten by the final one; res (n, R_COUNT). Returns S_COUNT * 10000 + R_COUNT * 100 +
+ * P_COUNT (the caller checks the layouts), or -1 when the scratch is not allocated. */
+int32_t rigid_batch(int32_t n, int32_t k, const double *r0, const double *N0, const double *area, const double *ell,
                     const double *radius, const double *Rm, const double *sphi0, const double *gauss, int32_t ng,
-                    void *points, void *moment, void *law, const double *sp, const double *laws, int32_t nlaw,
-                    double *y, double *res) {
-    Body b = {k, ng, r0, N0, area, radius, Rm, sphi0, gauss, (points_fn)points, (moment_fn)moment, (law_fn)law,
-              NULL, NULL, NULL, NULL, NULL, NULL};
-    double *scratch = malloc(sizeof(double) * (size_t)(16 * (k > 0 ? k : 1)));
-    if (!scratch) return -1;
-    b.x = scratch; b.v = b.x + 3 * k; b.n = b.v + 3 * k; b.arm = b.n + 3 * k; b.f = b.arm + 3 * k; b.sig = b.f + 3 * k;
+                    void *points, void *moment, const double *sp, const double *laws, int32_t nlaw, double *y,
+                    double *res) {
+    Body b = {k, ng, r0, N0, area, ell, radius, Rm, sphi0, gauss, (points_fn)points, (moment_fn)moment, NULL, NULL,
+              NULL, NULL, NULL, NULL};
+    size_t kk = (size_t)(k > 0 ? k : 1);
+    double *scratch = calloc(15 * kk, sizeof(double));
+    int32_t *idx = malloc(sizeof(int32_t) * kk);
+    if (!scratch || !idx || nlaw != P_COUNT) {
+        free(scratch);
+        free(idx);
+        return -1;
+    }
+    b.x = scratch; b.v = b.x + 3 * k; b.n = b.v + 3 * k; b.arm = b.n + 3 * k; b.f = b.arm + 3 * k; b.idx = idx;
     for (int32_t s = 0; s < n; ++s)
         one_shot(&b, sp + (size_t)s * S_COUNT, laws + (size_t)s * nlaw, y + (size_t)s * 13, res + (size_t)s * R_COUNT);
     free(scratch);
-    return S_COUNT * 100 + R_COUNT;
+    free(idx);
+    return S_COUNT * 10000 + R_COUNT * 100 + P_COUNT;
+}
+
+/* The batch's law on one set of points, for the tests against point_forces: f (k, 3) (zero where not loaded)
+ * and sums (5) as point_forces gives them. */
+void batch_law(int32_t k, const double *x, const double *v, const double *n, const double *area, const double *ell,
+               const double *radius, const double *Rm, const double *sphi0, const double *axis, const double *p,
+               const double *gauss, int32_t ng, double *f, double *sums) {
+    int32_t *idx = malloc(sizeof(int32_t) * (size_t)(k > 0 ? k : 1));
+    if (!idx) return;
+    for (int32_t i = 0; i < 3 * k; ++i) f[i] = 0.0;
+    law_points(k, x, v, n, area, ell, radius, Rm, sphi0, axis, p, gauss, ng, f, idx, sums);
+    free(idx);
 }

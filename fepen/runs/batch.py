@@ -45,8 +45,8 @@ _KERNEL: dict = {}
 
 
 def kernel():
-    """(rigid_batch, the addresses of rigid_points, force_moment and point_forces, the Gauss rule) when every C
-    kernel builds and FEPEN_KERNEL is not numpy, else None."""
+    """(the rigid_batch library, the addresses of rigid_kernel.c's rigid_points and force_moment, the Gauss rule
+    of the law) when the C kernels build and FEPEN_KERNEL is not numpy, else None."""
     if "fn" not in _KERNEL:
         _KERNEL["fn"] = None
         from fepen import native
@@ -57,14 +57,14 @@ def kernel():
             return None
         lib, _KERNEL["why_not"] = native.load(Path(__file__).parents[1] / "laws" / "rigid_batch.c",
                                               ("-ffp-contract=off",))
-        target, _ = native.load(Path(tg.__file__).with_name("target_kernel.c"))  # the single path's library
-        if lib is None or target is None:
+        if lib is None:
             return None
         vp, i32 = ctypes.c_void_p, ctypes.c_int32
-        lib.rigid_batch.argtypes = [i32, i32, *[vp] * 7, i32, vp, vp, vp, vp, vp, i32, vp, vp]
+        lib.rigid_batch.argtypes = [i32, i32, *[vp] * 8, i32, vp, vp, vp, vp, i32, vp, vp]
         lib.rigid_batch.restype = i32
-        addr = [ctypes.cast(f, vp).value for f in (body.rigid_points, body.force_moment, target.point_forces)]
-        _KERNEL["fn"] = (lib, addr, law.gauss, target)
+        lib.batch_law.argtypes = [i32, *[vp] * 11, i32, vp, vp]
+        lib.batch_law.restype = None
+        _KERNEL["fn"] = (lib, [ctypes.cast(f, vp).value for f in (body.rigid_points, body.force_moment)], law.gauss)
     return _KERNEL["fn"]
 
 
@@ -136,23 +136,23 @@ def _integrate(runs: list) -> list:
     """The summaries of runs that share their load points (None for a shot the single path must run)."""
     from fepen.io import results
 
-    lib, (points, moment, law_fn), gauss, _ = kernel()
+    lib, (points, moment), gauss = kernel()
     g, body = runs[0].pts, runs[0].body
     n, k = len(runs), len(body.r0)
-    const = [np.ascontiguousarray(a, dtype=float) for a in (body.r0, body.N0, g["area0"], g["radius"],
-                                                              g["R_meridian"], g["sin_phi0"])]
+    const = [np.ascontiguousarray(a, dtype=float) for a in (body.r0, body.N0, g["area0"], np.sqrt(g["area0"]),
+                                                              g["radius"], g["R_meridian"], g["sin_phi0"])]
     sp = np.ascontiguousarray([_shot_numbers(r) for r in runs], dtype=float)
     laws = np.ascontiguousarray([tg._law_numbers(r.law) for r in runs], dtype=float)
     y = np.ascontiguousarray([r.state.as_array() for r in runs], dtype=float)
     res = np.zeros((n, len(RESULTS)))
     t0 = time.perf_counter()
-    check = lib.rigid_batch(n, k, *[a.ctypes.data for a in const], gauss.ctypes.data, len(gauss) // 2, points,
-                            moment, law_fn, sp.ctypes.data, laws.ctypes.data, laws.shape[1], y.ctypes.data,
-                            res.ctypes.data)
+    check = lib.rigid_batch(n, k, *[a.ctypes.data for a in const], gauss.ctypes.data, len(gauss) // 2, points, moment,
+                            sp.ctypes.data, laws.ctypes.data, laws.shape[1], y.ctypes.data, res.ctypes.data)
     loop_s = (time.perf_counter() - t0) / n
     if check < 0:
-        raise MemoryError("rigid_batch: no memory for its scratch arrays")
-    assert check == len(SHOT_NUMBERS) * 100 + len(RESULTS), "rigid_batch.c and fepen.runs.batch disagree"
+        raise MemoryError("rigid_batch: no memory for its scratch arrays (or a law of another length)")
+    assert check == len(SHOT_NUMBERS) * 10000 + len(RESULTS) * 100 + laws.shape[1], \
+        "rigid_batch.c and fepen.runs.batch (or target.py's _law_numbers) disagree on a layout"
     from fepen.laws.rigid_body import RigidState
 
     out = []
