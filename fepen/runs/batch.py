@@ -112,7 +112,7 @@ def summaries(scenes, comm=None, history: bool = True) -> list:
             continue
         groups.setdefault((id(run.pts), run.body.centre0.tobytes(), run.body.r0.shape), []).append((i, run))
     for members in groups.values():
-        for (i, run), summary in zip(members, _integrate([run for _, run in members])):
+        for (i, _run), summary in zip(members, _integrate([run for _, run in members])):
             out[i] = summary if summary is not None else _single(RigidRun(scenes[i], None, comm, history=history))
     return out
 
