@@ -128,6 +128,7 @@ typedef struct {
     const double *r0, *N0, *area, *ell, *radius, *Rm, *sphi0, *gauss;
     points_fn points;
     moment_fn moment;
+    double at[13], R[9], w[3]; /* the state whose points x, v, n, arm hold (at[3] = 2: none), its R and omega */
     double *x, *v, *n, *arm, *f; /* scratch (f zero outside the points a law call loads) */
     int32_t *idx;
 } Body;
@@ -162,8 +163,14 @@ static double norm4(const double *q) {
     return sqrt((((0.0 + q[0] * q[0]) + q[1] * q[1]) + q[2] * q[2]) + q[3] * q[3]);
 }
 
-/* the load points of state y (x, v, n, arm into the body's scratch), R and omega */
+/* the load points of state y (x, v, n, arm into the body's scratch), R and omega; kept for the next call with
+ * the same state (a step's end state: the stop rules', then the next step's first stage, as RigidBody.at) */
 static void points_at(Body *b, const double *sp, const double *y, double *R, double *w) {
+    if (memcmp(b->at, y, sizeof b->at) == 0) {
+        memcpy(R, b->R, sizeof b->R);
+        memcpy(w, b->w, sizeof b->w);
+        return;
+    }
     quat_to_matrix(y + 3, R);
     omega_of(R, sp + S_IINV, y + 10, w);
     double small[18];
@@ -172,6 +179,9 @@ static void points_at(Body *b, const double *sp, const double *y, double *R, dou
     memcpy(small + 12, y + 7, 3 * sizeof(double));
     memcpy(small + 15, w, 3 * sizeof(double));
     b->points(b->k, b->r0, b->N0, small, small + 9, small + 12, small + 15, b->x, b->v, b->n, b->arm);
+    memcpy(b->at, y, sizeof b->at);
+    memcpy(b->R, R, sizeof b->R);
+    memcpy(b->w, w, sizeof b->w);
 }
 
 /* RigidBody.derivative with RigidRun.force_fn: dy (13), the force and moment, the power; loaded, area */
@@ -258,6 +268,7 @@ static int finite13(const double *y) {
 
 /* One shot from y (13) at t = 0 to its end or stop; y becomes the final state. */
 static void one_shot(Body *b, const double *sp, const double *law, double *y, double *res) {
+    b->at[3] = 2.0; /* no unit quaternion: nothing kept from the last shot (another inertia) */
     double t = 0.0, work = 0.0, next = 0.0, prev[13], R[9], w[3];
     double max_nose = -INFINITY, max_error = -INFINITY, rows = 0.0;
     int64_t steps = 0;
@@ -326,8 +337,8 @@ int32_t rigid_batch(int32_t n, int32_t k, const double *r0, const double *N0, co
                     const double *radius, const double *Rm, const double *sphi0, const double *gauss, int32_t ng,
                     void *points, void *moment, const double *sp, const double *laws, int32_t nlaw, double *y,
                     double *res) {
-    Body b = {k, ng, r0, N0, area, ell, radius, Rm, sphi0, gauss, (points_fn)points, (moment_fn)moment, NULL, NULL,
-              NULL, NULL, NULL, NULL};
+    Body b = {k, ng, r0, N0, area, ell, radius, Rm, sphi0, gauss, (points_fn)points, (moment_fn)moment, {0}, {0},
+              {0}, NULL, NULL, NULL, NULL, NULL, NULL};
     size_t kk = (size_t)(k > 0 ? k : 1);
     double *scratch = calloc(15 * kk, sizeof(double));
     int32_t *idx = malloc(sizeof(int32_t) * kk);

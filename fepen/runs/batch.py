@@ -96,6 +96,7 @@ def summaries(scenes, comm=None, history: bool = True) -> list:
     Returns:
         One item per shot, in order: its summary, or the InputError or SimulationError it raised.
     """
+    from fepen.runs import shot
     from fepen.runs.rigid import RigidRun
 
     comm = MPI.COMM_SELF if comm is None else comm
@@ -103,7 +104,8 @@ def summaries(scenes, comm=None, history: bool = True) -> list:
     groups: dict = {}
     for i, sc in enumerate(scenes):
         try:
-            run = RigidRun(sc, None, comm, history=history)
+            sh = sc if isinstance(sc, shot.Shot) else shot.resolve(sc, toml=False)  # no results directory
+            run = RigidRun(sh, None, comm, history=history)
         except (InputError, SimulationError) as err:
             out[i] = err
             continue

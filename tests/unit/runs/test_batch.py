@@ -13,7 +13,7 @@ from hypothesis import strategies as st
 from mpi4py import MPI
 
 from fepen import scene
-from fepen.errors import InputError
+from fepen.errors import InputError, SimulationError
 from fepen.laws import target as tg
 from fepen.laws.rigid_body import RigidState
 from fepen.runs import batch
@@ -54,7 +54,7 @@ def assert_same(ref: dict, got: dict, rtol: float = 1e-12):
 def single(sc, history=True):
     try:
         return RigidRun(sc, None, MPI.COMM_SELF, history=history).run()
-    except InputError as err:
+    except (InputError, SimulationError) as err:
         return err
 
 
@@ -106,6 +106,7 @@ def test_a_batch_gives_the_single_paths_summaries(sets):
     assert_same(single(sc), batch.summaries([sc])[0])
 
 
+@pytest.mark.filterwarnings("ignore:overflow:RuntimeWarning", "ignore:invalid value:RuntimeWarning")
 @settings(max_examples=12, deadline=None, suppress_health_check=[HealthCheck.too_slow])
 @given(shots=st.lists(st.tuples(st.floats(150.0, 1200.0), st.floats(0.0, 60.0), st.floats(-4.0, 4.0),
                                 st.floats(15e6, 90e6), st.sampled_from([None, 0.15, 0.3, 0.6]),
@@ -152,6 +153,17 @@ gap = 0.2
 [[target.layers]]
 material = "concrete"
 """
+
+
+@pytest.mark.filterwarnings("ignore:overflow:RuntimeWarning", "ignore:invalid value:RuntimeWarning")
+def test_a_non_finite_state_falls_back_to_the_single_paths_error():
+    """A shot whose state turns non-finite (a slow oblique shot into strong concrete under the linear crater) is
+    run again by the single path, which stops it with its own error."""
+    sc = rigid("impact.velocity=183.0", "impact.obliquity_deg=50.0", "impact.attack_deg=0.0",
+               "target.compressive_strength=85584548.0", "effects.crater=linear")
+    ref, got = single(sc), batch.summaries([sc, rigid()])
+    assert isinstance(ref, SimulationError) and type(got[0]) is SimulationError and str(got[0]) == str(ref)
+    assert isinstance(got[1], dict)
 
 
 def test_bad_input_comes_back_as_its_error():
