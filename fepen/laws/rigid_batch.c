@@ -217,8 +217,8 @@ static void derivative(Body *b, const double *sp, const double *law, const doubl
     *power = dot3(FM, y + 7) + dot3(FM + 3, w);
 }
 
-/* RigidBody.rk4_step: y advanced by dt in place; the work of the step */
-static double rk4(Body *b, const double *sp, const double *law, double *y, double dt) {
+/* RigidBody.rk4_step: y advanced by dt in place; the work of the step; F0: the force at its start */
+static double rk4(Body *b, const double *sp, const double *law, double *y, double dt, double *F0) {
     double k[4][13], s[13], FM[6], P, loaded, area, work = 0.0;
     static const double c[4] = {0.0, 0.5, 0.5, 1.0}, wt[4] = {1.0, 2.0, 2.0, 1.0};
     for (int i = 0; i < 4; ++i) {
@@ -229,6 +229,7 @@ static double rk4(Body *b, const double *sp, const double *law, double *y, doubl
             memcpy(s, y, sizeof s);
         }
         derivative(b, sp, law, s, k[i], FM, &P, &loaded, &area);
+        if (i == 0) memcpy(F0, FM, 3 * sizeof(double));
         work += wt[i] * P;
     }
     double h = dt / 6.0;
@@ -274,18 +275,26 @@ static void one_shot(Body *b, const double *sp, const double *law, double *y, do
     int64_t steps = 0;
     int outcome = 0, entered = 0, status = 0;
     const double dt = sp[S_DT], interval = sp[S_HISTORY], thk = sp[S_THICKNESS];
+    double F[3] = {0.0, 0.0, 0.0}; /* a row's force: at the start of the last step (at t = 0 the initial one) */
+    if (interval > 0.0) {
+        double dy[13], FM[6], P, loaded, area;
+        derivative(b, sp, law, y, dy, FM, &P, &loaded, &area);
+        memcpy(F, FM, sizeof F);
+    }
     while (outcome == 0 && t < sp[S_HARD_END]) {
         if (interval > 0.0 && t >= next) { /* History.write: a row, then the clock */
             double nose, error;
             row_of(sp, y, work, &nose, &error);
-            if (!isfinite(nose) || !isfinite(error)) { status = 1; break; }
+            /* Results.finite_row of the row: what of it is not finite when these are */
+            if (!isfinite(nose) || !isfinite(error) || !isfinite(work) || !isfinite(F[0]) || !isfinite(F[1]) ||
+                !isfinite(F[2])) { status = 1; break; }
             if (rows == 0.0 || nose > max_nose) max_nose = nose;
             if (rows == 0.0 || error > max_error) max_error = error;
             rows += 1.0;
             while (next <= t) next += interval;
         }
         memcpy(prev, y, sizeof prev);
-        work += rk4(b, sp, law, y, dt);
+        work += rk4(b, sp, law, y, dt, F);
         t += dt;
         steps += 1;
         if (!finite13(y)) { status = 1; break; }

@@ -14,7 +14,8 @@ automatically, for what the kernel does not cover:
 - wear (``effects.wear``) and layered targets (``fepen.laws.layers``): the single path runs the shot;
 - a results directory (the batch writes no history.csv), a target that is not a ``TargetLaw``;
 - FEPEN_KERNEL=numpy or a machine where the C kernels do not build;
-- a shot whose state turns non-finite (the single path runs it again and raises its own error).
+- a shot whose state or history row turns non-finite (the single path runs it again and stops it with its own
+  error).
 """
 
 from __future__ import annotations
@@ -165,7 +166,11 @@ def _integrate(runs: list) -> list:
         run.state = RigidState.from_array(yi)
         run.t, run.step_count, run.w_ext = float(ri[_R["t"]]), int(ri[_R["steps"]]), float(ri[_R["work"]])
         run.rules.entered = bool(ri[_R["entered"]])
-        run.finish_loop()  # the final row, with the force at the final state, as the single path makes it
+        try:
+            run.finish_loop()  # the final row, with the force at the final state, as the single path makes it
+        except SimulationError:  # a non-finite final row: the single path stops the shot with its own error
+            out.append(None)
+            continue
         if ri[_R["rows"]] > 0:  # the recorded rows' largest depth and energy error, as one row before it
             top = list(run.rows[-1])
             top[results.COL["nose_y_mm"]] = float(ri[_R["max_nose_mm"]])
