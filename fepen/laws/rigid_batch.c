@@ -106,11 +106,15 @@ typedef void (*points_fn)(int32_t, const double *, const double *, const double 
                           const double *, const double *, double *, double *, double *, double *);
 typedef void (*moment_fn)(int32_t, const double *, const double *, double *);
 
-/* rigid_kernel.c's force_moment on all k points (f zero outside idx: the function is vectorised, a point's
- * rounding depends on its place in the array, so the points are not gathered), then f zeroed again at idx */
+/* rigid_kernel.c's force_moment on the points up to the last one loaded (idx is increasing), rounded up to a
+ * multiple of 16 (or all k): the function is vectorised by blocks of points from the first (8 doubles wide at
+ * most), and a point's rounding depends on its place in its block, so every point keeps its place, and the
+ * points left out carry zero forces, whose terms change no sum. Then f zeroed again at idx. */
 static void moment_points(moment_fn moment, int32_t k, int32_t m, const int32_t *idx, const double *arm, double *f,
                           double *FM) {
-    moment(k, arm, f, FM);
+    int32_t n = m > 0 ? idx[m - 1] + 1 : 0;
+    n = (n + 15) / 16 * 16;
+    moment(n < k ? n : k, arm, f, FM);
     for (int32_t j = 0; j < m; ++j) memset(f + 3 * idx[j], 0, 3 * sizeof(double));
 }
 
