@@ -48,8 +48,12 @@ def front_limit(shape: Shape, radius: float) -> float:
     for _ in range(80):
         mid = 0.5 * (lo + hi)
         if shape.outer_radius(mid) < need:
+            if mid == lo:  # nothing moved: every further step is this one (the same bisection, sooner)
+                break
             lo = mid
         else:
+            if mid == hi:
+                break
             hi = mid
     return max(hi, min_wall(shape))
 
@@ -70,10 +74,10 @@ def fits(shape: Shape, cavity_length: float) -> bool:
     return True
 
 
-@functools.lru_cache(maxsize=64)
 def max_cavity_length(shape: Shape) -> float:
     """Longest cavity that fits with the minimum wall everywhere: bisection on the total length (the sections
-    move forward into the nose as it grows; the rear one must fit any boat-tail). Cached per shape.
+    move forward into the nose as it grows; the rear one must fit any boat-tail). Cached per shape but for
+    its cavity length, which it ignores (the mass rule asks of a shape, then checks it with the length found).
 
     Args:
         shape: the exact geometry (its cavity sections; its cavity length is ignored).
@@ -81,6 +85,11 @@ def max_cavity_length(shape: Shape) -> float:
     Returns:
         The longest total cavity length (m); 0 when not even the forward sections fit.
     """
+    return _max_cavity_length(replace(shape, cavity_length=0.0) if shape.cavity_length else shape)
+
+
+@functools.lru_cache(maxsize=64)
+def _max_cavity_length(shape: Shape) -> float:
     z_rear = shape.length - shape.base_thickness
     lo = shape.fore_length() + 1e-9 * shape.length
     if not fits(shape, lo):
@@ -91,8 +100,12 @@ def max_cavity_length(shape: Shape) -> float:
     for _ in range(60):
         mid = 0.5 * (lo + hi)
         if fits(shape, mid):
+            if mid == lo:  # nothing moved: every further step is this one (the same bisection, sooner)
+                break
             lo = mid
         else:
+            if mid == hi:
+                break
             hi = mid
     return lo
 

@@ -10,6 +10,7 @@ in each segment's own parameter, so that an arc is integrated as exactly as a li
 
 from __future__ import annotations
 
+import functools
 import math
 from dataclasses import dataclass
 
@@ -94,7 +95,7 @@ class Segment:
             return math.hypot(self.p1[0] - self.p0[0], self.p1[1] - self.p0[1])
         if self.is_circle:
             return self.ar * abs(self.t1 - self.t0)
-        x, w = _gauss(GAUSS)
+        x, w = gauss(GAUSS)
         u = 0.5 * (x + 1.0)
         dr, dz = self.derivative(u)
         return float(0.5 * w @ np.hypot(dr, dz))
@@ -189,8 +190,15 @@ class Segment:
             zhi, max(self.p0[1], self.p1[1]), abs_tol=1e-15)
 
 
-def _gauss(n: int):
-    return np.polynomial.legendre.leggauss(n)
+@functools.lru_cache(maxsize=16)
+def gauss(n: int) -> tuple[np.ndarray, np.ndarray]:
+    """Gauss-Legendre points and weights on [-1, 1] (numpy's leggauss), computed once per n and read-only:
+    leggauss solves an eigenproblem each call, a millisecond that the mass rule paid hundreds of times per
+    projectile (the values are the same ones, so nothing moves by round-off)."""
+    x, w = np.polynomial.legendre.leggauss(n)
+    x.setflags(write=False)
+    w.setflags(write=False)
+    return x, w
 
 
 def path_integrals(path: list[Segment]) -> np.ndarray:
@@ -201,7 +209,7 @@ def path_integrals(path: list[Segment]) -> np.ndarray:
     Returns:
         array [V, ∫ π r² z dz, ∫ π r² z² dz, ∫ π r⁴ dz].
     """
-    x, w = _gauss(GAUSS)
+    x, w = gauss(GAUSS)
     u = 0.5 * (x + 1.0)
     out = np.zeros(4)
     for seg in path:
@@ -216,7 +224,7 @@ def path_integrals(path: list[Segment]) -> np.ndarray:
 
 def path_area(path: list[Segment]) -> float:
     """Area of the surface of revolution of a path, ∫ 2π r ds (m²)."""
-    x, w = _gauss(GAUSS)
+    x, w = gauss(GAUSS)
     u = 0.5 * (x + 1.0)
     total = 0.0
     for seg in path:
@@ -227,10 +235,17 @@ def path_area(path: list[Segment]) -> float:
 
 
 def radius_at(path: list[Segment], z):
-    """Largest r of the path at axial positions z (nan where the path has none)."""
+    """Largest r of the path at axial positions z (nan where the path has none).
+
+    A segment whose z range holds none of the z (or that has no z extent) gives only nan, which leaves the
+    result as it is: it is skipped (the mass rule's bisections ask one z, or a span, among many segments)."""
     z = np.asarray(z, dtype=float)
     out = np.full(z.shape, np.nan)
+    zmin, zmax = (float(z.min()), float(z.max())) if z.size else (math.inf, -math.inf)
     for seg in path:
+        z0, z1 = seg.p0[1], seg.p1[1]
+        if z0 == z1 or (zmin > max(z0, z1) or zmax < min(z0, z1)):  # false with a nan z: no skipping
+            continue
         r = seg.r_at_z(z)
         out = np.where(np.isnan(out), r, np.where(np.isnan(r), out, np.maximum(out, r)))
     return out

@@ -54,7 +54,7 @@ def load_points(shape: Shape, size: float, n_theta: int | None = None, n_gauss: 
     a = shape.radius
     if n_theta is None:
         n_theta = max(8, 4 * math.ceil(2.0 * math.pi * a / size / 4.0))
-    xg, wg = np.polynomial.legendre.leggauss(n_gauss)
+    xg, wg = profile.gauss(n_gauss)
     rings = []  # arrays per segment: y, r, n_r, n_y, ring area, R_meridian, sin_phi0
     for seg in shape.outer_path:
         n = max(1, math.ceil(seg.length() / size))

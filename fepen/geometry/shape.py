@@ -238,7 +238,7 @@ class Shape:
             # nose), so that the cavity sized to the mass, the mesh and Table 1 do not move by round-off
             ln, a, s = self.nose_length, self.radius, self.ogive_radius
             vol = math.pi * a**2 * (self.length - ln)
-            x, w = np.polynomial.legendre.leggauss(64)
+            x, w = P.gauss(64)
             z = 0.5 * ln * (x + 1.0)
             r = np.sqrt(np.maximum(s * s - (ln - np.minimum(z, ln)) ** 2, 0.0)) - (s - a)
             return vol + 0.5 * ln * float(np.sum(w * math.pi * r**2))
@@ -280,7 +280,7 @@ class Shape:
         """N* of the nose: (1/(π a²)) ∫ (−n_y)³ dA over the surface facing forward, so that a rigid nose moving
         along its axis at V against σ_n = σ_s + ρ (v·n)² feels π a² (σ_s + N* ρ V²) (frictionless):
         (8ψ − 1)/(24ψ²) for a tangent ogive, 1/2 for a hemisphere, 1 flat."""
-        x, w = np.polynomial.legendre.leggauss(P.GAUSS)
+        x, w = P.gauss(P.GAUSS)
         u = 0.5 * (x + 1.0)
         total = 0.0
         for seg in self.outer_path:

@@ -61,8 +61,9 @@ def inertia_about_centre(mass: float, first: np.ndarray, second: np.ndarray):
 
 
 def quat_to_matrix(q: np.ndarray) -> np.ndarray:
-    """Rotation matrix of a unit quaternion (w, x, y, z)."""
-    w, x, y, z = q
+    """Rotation matrix of a unit quaternion (w, x, y, z) (its entries as Python floats: the same IEEE double
+    arithmetic as numpy's scalars, at a fraction of the cost)."""
+    w, x, y, z = q.tolist() if isinstance(q, np.ndarray) else q
     return np.array([[1 - 2 * (y * y + z * z), 2 * (x * y - w * z), 2 * (x * z + w * y)],
                      [2 * (x * y + w * z), 1 - 2 * (x * x + z * z), 2 * (y * z - w * x)],
                      [2 * (x * z - w * y), 2 * (y * z + w * x), 1 - 2 * (x * x + y * y)]])
@@ -89,9 +90,9 @@ def matrix_to_quat(R: np.ndarray) -> np.ndarray:
 
 
 def quat_mul(a: np.ndarray, b: np.ndarray) -> np.ndarray:
-    """Hamilton product a ⊗ b."""
-    w1, x1, y1, z1 = a
-    w2, x2, y2, z2 = b
+    """Hamilton product a ⊗ b (on Python floats, as quat_to_matrix)."""
+    w1, x1, y1, z1 = a.tolist() if isinstance(a, np.ndarray) else a
+    w2, x2, y2, z2 = b.tolist() if isinstance(b, np.ndarray) else b
     return np.array([w1 * w2 - x1 * x2 - y1 * y2 - z1 * z2, w1 * x2 + x1 * w2 + y1 * z2 - z1 * y2,
                      w1 * y2 - x1 * z2 + y1 * w2 + z1 * x2, w1 * z2 + x1 * y2 - y1 * x2 + z1 * w2])
 
@@ -133,17 +134,42 @@ class RigidBody:
         self._r0_at, self._N0_at = self.r0.ctypes.data, self.N0.ctypes.data  # the arrays live as long as self
         #: (R, ω) of the state last passed to derivative (force functions may use them)
         self.frame: tuple[np.ndarray, np.ndarray] | None = None
+        self._last: list | None = None  # [state's bytes, R, ω, points or None] of the last state asked (at)
+
+    def at(self, s: RigidState) -> list:
+        """[key, R, ω, points or None] of state s, kept for the last state asked: a step's end state is asked
+        by the stop rules, then by the history row, then by the next step's first stage, which so compute its
+        rotation, angular velocity and load points once instead of three times (the same expressions on the
+        same numbers: bitwise the same values). Keyed on the state's numbers, not on the object."""
+        key = s.c.tobytes() + s.q.tobytes() + s.V.tobytes() + s.L.tobytes()
+        last = self._last
+        if last is not None and last[0] == key:
+            return last
+        R = quat_to_matrix(s.q)
+        self._last = last = [key, R, self._omega(s.L, R), None]
+        return last
+
+    def _omega(self, L: np.ndarray, R: np.ndarray) -> np.ndarray:
+        return R @ (self.I_body_inv @ (R.T @ L))
 
     def omega(self, s: RigidState, R: np.ndarray | None = None) -> np.ndarray:
         """World angular velocity ω = R I_b^{-1} R^T L."""
-        R = quat_to_matrix(s.q) if R is None else R
-        return R @ (self.I_body_inv @ (R.T @ s.L))
+        return self.at(s)[2] if R is None else self._omega(s.L, R)
 
     def points(self, s: RigidState, R: np.ndarray | None = None, w: np.ndarray | None = None):
         """World positions, velocities and normals of the load points, and their arms about the centre
-        (R, w: the state's rotation and angular velocity when already known)."""
+        (R, w: the state's rotation and angular velocity when already known; the arrays are shared with the
+        cache of ``at``: read them, never write)."""
+        if R is None and w is None:
+            last = self.at(s)
+            if last[3] is None:
+                last[3] = self._points(s, last[1], last[2])
+            return last[3]
         R = quat_to_matrix(s.q) if R is None else R
         w = self.omega(s, R) if w is None else w
+        return self._points(s, R, w)
+
+    def _points(self, s: RigidState, R: np.ndarray, w: np.ndarray):
         if self.lib is not None:
             k = len(self.r0)
             out = np.empty((4, k, 3))
@@ -172,18 +198,17 @@ class RigidBody:
 
     def to_world(self, s: RigidState, X: np.ndarray) -> np.ndarray:
         """World position of reference points X (k, 3)."""
-        return s.c + (np.asarray(X, float) - self.centre0) @ quat_to_matrix(s.q).T
+        return s.c + (np.asarray(X, float) - self.centre0) @ self.at(s)[1].T
 
     def derivative(self, s: RigidState, force_fn):
         """Time derivative of the state, and the force and moment; force_fn(s, x, v, n) -> forces (k, 3) on
         the load points at world positions x, velocities v, normals n (self.frame holds the state's rotation
         and angular velocity meanwhile)."""
-        R = quat_to_matrix(s.q)
-        w = self.omega(s, R)
+        x, v, n, arm = self.points(s)
+        _, R, w, _ = self._last
         self.frame = (R, w)
-        x, v, n, arm = self.points(s, R, w)
         F, M = self.force_moment(arm, force_fn(s, x, v, n))
-        dq = 0.5 * quat_mul(np.array([0.0, *w]), s.q)
+        dq = 0.5 * quat_mul([0.0, *w.tolist()], s.q)
         return np.concatenate([s.V, dq, F / self.mass, M]), F, M
 
     def power(self, s: RigidState, F: np.ndarray, M: np.ndarray, w: np.ndarray | None = None) -> float:
@@ -227,6 +252,7 @@ class RigidBody:
         self.mass -= dm
         self.I_body = self.I_body * f
         self.I_body_inv = self.I_body_inv / f
+        self._last = None  # ω of every state changed
         new = RigidState(s.c.copy(), s.q.copy(), s.V.copy(), s.L * f)
         return new, ke - self.kinetic_energy(new)
 

@@ -4,6 +4,7 @@
     setup        the builders of every law, shape and mesh from a scene (used by shot)
     run          the Run skeleton both fidelities share: loop, stop, summary, history rows
     rigid        RigidRun: the rigid body (no mesh by default)
+    batch        rigid shots in batches: one compiled call per projectile, bitwise RigidRun's summaries
     model        the deformable model: mesh, solver, target, contact, wear, erosion
     deformable   DeformableRun: the explicit solver's time loop, its outputs and checkpoints
     closing      the closing analyses of a completed deformable run
@@ -21,8 +22,8 @@ from fepen.runs import setup, shot
 from fepen.runs.rigid import RigidRun
 from fepen.runs.shot import Shot, resolve
 
-__all__ = ["shot", "setup", "run", "rigid", "model", "deformable", "closing", "events", "outputs", "checkpoint",
-           "interrupts", "run_scene", "run_in_directory", "expected_end", "resolve", "Shot", "RigidRun"]
+__all__ = ["shot", "setup", "run", "rigid", "batch", "model", "deformable", "closing", "events", "outputs",
+           "checkpoint", "interrupts", "run_scene", "run_in_directory", "expected_end", "resolve", "Shot", "RigidRun"]
 
 
 def expected_end(scene, sh: Shot) -> float:

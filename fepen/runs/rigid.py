@@ -17,6 +17,7 @@ from fepen.errors import Interrupted
 from fepen.geometry import mesh as fmesh
 from fepen.geometry import revolution, tags
 from fepen.geometry.cad import CadBody
+from fepen.io import results
 from fepen.laws import energy, wear
 from fepen.laws import target as tg
 from fepen.laws.rigid_body import (
@@ -24,7 +25,6 @@ from fepen.laws.rigid_body import (
     RigidState,
     inertia_about_centre,
     matrix_to_quat,
-    quat_to_matrix,
     tet_mass_properties,
 )
 from fepen.runs import setup, shot
@@ -112,14 +112,20 @@ class RigidRun(Run):
             the exact surface (ring_points); "mesh": the volume mesh's outer facets and its mass properties
             (mesh_points).
         mass_properties: (mass, centre, inertia); default: the exact solid of revolution's.
+        history: False keeps only the final state's history row (a study that reads the final depth alone,
+            fepen.studies.depth: the trajectory is the same, the summary's maxima are that row's, and every
+            step's state is checked finite instead).
     """
 
     fidelity = "rigid"
 
     def __init__(self, shot_, out, comm=MPI.COMM_WORLD, points: dict | None = None,
-                 mass_properties: tuple | None = None):
+                 mass_properties: tuple | None = None, history: bool = True):
         sh = shot.of(shot_)
         super().__init__(sh, out, comm)
+        if not history:
+            self.history.clock.interval = 0.0  # never due: finish_loop records the final row
+        self.check_finite = not history
         self.cells = 0  # no volume mesh unless asked for
         if points is None and mass_properties is None and not isinstance(sh.built.shape, CadBody):
             points, mass_properties = default_body(sh)
@@ -145,6 +151,7 @@ class RigidRun(Run):
         self.dt = sh.rigid_step or min(STEP_FRACTION * sh.nominal_diameter / self.v0, t_stop / STOP_STEPS)
         self.tip_ref = np.zeros(3)
         self.tail_ref = np.array([0.0, self.shape.length, 0.0])
+        self.tip_arm = self.tip_ref - self.body.centre0  # the tip about the centre, body frame
         self.w_ext = 0.0
         self.ke0 = self.body.kinetic_energy(self.state)
         self.loaded = 0
@@ -167,7 +174,7 @@ class RigidRun(Run):
         """Target forces on the load points (zero outside the target)."""
         g = self.pts
         R = self.body.frame[0]  # s's rotation (RigidBody.derivative)
-        tip = s.c + R @ (self.tip_ref - self.body.centre0)
+        tip = s.c + R @ self.tip_arm
         load = tg.load_on_points(self.law, x, v, n, g["area0"], g["radius"], g["R_meridian"], g["sin_phi0"],
                                  -R[:, 1], self.crater, -tip[1])
         self.loaded, self.area = load.loaded, load.area
@@ -177,7 +184,7 @@ class RigidRun(Run):
 
     def axis(self, s: RigidState) -> np.ndarray:
         """World unit vector of the projectile axis, tail to nose."""
-        return quat_to_matrix(s.q) @ np.array([0.0, -1.0, 0.0])
+        return self.body.at(s)[1] @ np.array([0.0, -1.0, 0.0])
 
     def step(self) -> None:
         """One RK4 step (the force kept for the history is the step's start's), then the wear."""
@@ -187,9 +194,12 @@ class RigidRun(Run):
         if self.wear is not None:
             s = self.wear.step(self.body, s, self.dt)
             self.tip_ref[1] = self.wear.shortening
+            self.tip_arm = self.tip_ref - self.body.centre0  # the worn nose's tip (force_fn's crater depth)
         self.state = s
         self.t += self.dt
         self.step_count += 1
+        if self.check_finite:  # what the history rows would have caught
+            results.finite_row(s.as_array().tolist(), self.step_count, self.t)
 
     def extent(self):
         s = self.state
@@ -304,4 +314,5 @@ class Wear:
                                                  contraction)
         body.r0[:] = X - body.centre0
         body.N0[:] = N
+        body._last = None  # the cached load points of the last state are the uncontracted nose's
         g["X"][:], g["N"][:], g["area0"][:], g["sin_phi0"][:], g["R_meridian"][:] = X, N, A, sphi, Rm

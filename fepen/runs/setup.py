@@ -128,14 +128,39 @@ CAVITY_KEYS = ("projectile.cavity_diameter", "projectile.cavity_length", "projec
                "projectile.cavity_step_length", "projectile.cavity_sections")
 
 
+#: the projectiles built so far in this process, by _built_key: a sweep's, a depth study's or a calibration's
+#: shots of one projectile build it once (the mass rule's bisections are most of a rigid shot's set-up)
+_BUILT: dict = {}
+#: keys that name files the projectile is read from: such a projectile is built anew every time
+FILE_KEYS = ("projectile.cad", "projectile.profile", "projectile.inner_profile")
+
+
 def projectile(scene) -> Built:
-    """See _projectile; a cavity given as projectile.cavity_sections is named so in errors."""
+    """See _projectile (built once per projectile in a process: a Built is frozen, share it); a cavity given
+    as projectile.cavity_sections is named so in errors."""
+    key = _built_key(scene)
+    hit = _BUILT.get(key) if key is not None else None
+    if hit is not None:
+        return hit
     try:
-        return _projectile(scene)
+        built = _projectile(scene)
     except InputError as err:
         if scene.get("projectile.cavity_sections") and err.key in CAVITY_KEYS:
             raise InputError("projectile.cavity_sections", err.message) from None
         raise
+    if key is not None:
+        if len(_BUILT) >= 64:
+            _BUILT.clear()
+        _BUILT[key] = built
+    return built
+
+
+def _built_key(scene) -> tuple | None:
+    """What _projectile reads of a scene: its body_key and which projectile keys were given (a given cavity is
+    only sized); None for a projectile read from files (they may change between two runs)."""
+    if any(scene.get(k) for k in FILE_KEYS):
+        return None
+    return body_key(scene), tuple(sorted(k for k in scene.explicit if k.startswith("projectile.")))
 
 
 def _cad_projectile(scene) -> Built:

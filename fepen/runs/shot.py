@@ -167,11 +167,13 @@ def _outputs(scene) -> OutputSettings:
                           r.checkpoint_interval, r.acceleration_filter_hz)
 
 
-def resolve(scene) -> Shot:
+def resolve(scene, toml: bool = True) -> Shot:
     """The Shot of a resolved Scene (InputError on what this version cannot simulate, before any mesh).
 
     Args:
         scene: a resolved fepen.Scene.
+        toml: False leaves scene_toml empty, for a shot that writes no results directory (fepen.runs.batch:
+            the text costs a rigid shot's set-up a third).
 
     Returns:
         The frozen Shot.
@@ -192,7 +194,7 @@ def resolve(scene) -> Shot:
         charge_friction=scene.charge.friction, rigid_step=scene.get("run.rigid_step"),
         nominal_diameter=scene.projectile.diameter,
         experiment=scene.get("impact.shot"), scene=scene.as_dict(), body_key=setup.body_key(scene),
-        scene_toml=to_toml(scene))
+        scene_toml=to_toml(scene) if toml else "")
 
 
 def of(shot_or_scene) -> Shot:

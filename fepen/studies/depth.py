@@ -124,7 +124,7 @@ def rigid_depth(row: Row, sets=()) -> float:
     from fepen.runs.rigid import RigidRun
 
     sc = scene.load(None, [*scene_sets(row), *sets])
-    return RigidRun(sc, None, MPI.COMM_SELF).run()["Hy_mm"] / 1e3
+    return RigidRun(sc, None, MPI.COMM_SELF, history=False).run()["Hy_mm"] / 1e3  # the final row alone
 
 
 def closed_form_depth(row: Row, S: float | None = None, k: float = 2.0) -> float:
@@ -164,39 +164,67 @@ METHODS = {"default": [], "forrestal-S": ["target.strength_model=forrestal-S"], 
 def predict_sets(sets: dict[str, list[Row]], extra=(), workers: int = 1) -> dict[str, list[dict]]:
     """Every shot of every set by every METHODS entry.
 
+    A shot's methods run together, in one process: its projectile is built once (fepen.runs.setup.projectile)
+    and its load points made once (fepen.runs.rigid.default_body). With workers > 1, a pool of processes that
+    import fepen and build the C kernels once each (_warm) takes the shots one at a time.
+
     Args:
         sets: name -> rows. extra: --set lines added to every rigid run. workers: processes at once.
 
     Returns:
         name -> list of per-shot dicts (the row's fields, measured and predicted depths in m).
     """
-    jobs = [(name, i, row, method) for name, rows in sets.items() for i, row in enumerate(rows)
-            for method in METHODS]
-    if workers > 1:
+    shots = [(name, i, row) for name, rows in sets.items() for i, row in enumerate(rows)]
+    jobs = [(row, tuple(extra)) for _, _, row in shots]
+    if workers > 1 and len(jobs) > 1:
         from concurrent.futures import ProcessPoolExecutor
 
-        with ProcessPoolExecutor(workers) as pool:
-            depths = list(pool.map(_predict_one, [(row, method, tuple(extra)) for _, _, row, method in jobs],
-                                   chunksize=4))
+        with ProcessPoolExecutor(min(workers, len(jobs)), initializer=_warm) as pool:
+            depths = list(pool.map(_predict_shot, jobs))
     else:
-        depths = [_predict_one((row, method, tuple(extra))) for _, _, row, method in jobs]
+        depths = [_predict_shot(job) for job in jobs]
     out: dict[str, list[dict]] = {name: [dict(row.__dict__) for row in rows] for name, rows in sets.items()}
-    for (name, i, _, method), p in zip(jobs, depths):
-        out[name][i][method] = p
+    for (name, i, _), d in zip(shots, depths):
+        out[name][i].update(d)
     return out
 
 
-def _predict_one(job) -> float:
-    from fepen.errors import InputError
+def _warm() -> None:
+    """A worker's start: the imports and the C kernels of a rigid run, once."""
+    from mpi4py import MPI  # noqa: F401
 
-    row, method, extra = job
-    sets = METHODS[method]
-    if sets is None:
-        return closed_form_depth(row)
-    try:
-        return rigid_depth(row, [*sets, *extra])
-    except InputError:  # a shot fepen cannot build (e.g. an impossible mass): left out of the errors
-        return math.nan
+    from fepen.laws import rigid_body
+    from fepen.runs import batch, rigid  # noqa: F401
+
+    rigid_body._kernel()
+    tg._point_kernel()
+    batch.kernel()
+
+
+def _predict_shot(job) -> dict[str, float]:
+    """One shot by every METHODS entry: method -> depth (m). The rigid methods run together (fepen.runs.batch:
+    one compiled call, the depths bitwise those of rigid_depth); a shot fepen cannot build is NaN."""
+    from fepen import scene
+    from fepen.errors import InputError
+    from fepen.runs import batch
+
+    row, extra = job
+    out = {method: closed_form_depth(row) for method, sets in METHODS.items() if sets is None}
+    scenes = {}
+    for method, sets in METHODS.items():
+        if sets is not None:
+            try:
+                scenes[method] = scene.load(None, [*scene_sets(row), *sets, *extra])
+            except InputError:  # a shot fepen cannot build (e.g. an impossible mass): left out of the errors
+                out[method] = math.nan
+    for method, s in zip(scenes, batch.summaries(list(scenes.values()), history=False)):  # the final row alone
+        if isinstance(s, InputError):
+            out[method] = math.nan
+        elif isinstance(s, Exception):
+            raise s
+        else:
+            out[method] = s["Hy_mm"] / 1e3
+    return {method: out[method] for method in METHODS}
 
 
 def gather_sets(paths=(), shipped: bool = True) -> dict[str, list[Row]]:

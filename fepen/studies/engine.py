@@ -8,6 +8,10 @@ with its next request: a dynamic queue, since shots differ in cost. On rank 0 a 
 each record to OUT/shots.jsonl as it arrives (one JSON line, flushed; synced every second), so a killed study starts
 again where it stopped and never runs a finished shot twice. Records do not depend on which group ran a
 shot: a rigid shot is the same ODE on any group; a deformable one is the same to round-off.
+
+With ``batch`` > 1 a request hands out a run of up to that many shots: the rigid ones that keep no results
+directory are integrated together by fepen.runs.batch (one compiled call per projectile, bitwise the single
+path's summaries), the others one by one as before.
 """
 
 from __future__ import annotations
@@ -25,7 +29,8 @@ from mpi4py import MPI
 
 from fepen.errors import InputError, SimulationError
 
-__all__ = ["execute", "run_shot", "read_records", "check_directory", "check_ranks_per_shot", "RECORDS"]
+__all__ = ["execute", "run_shot", "run_shots", "read_records", "check_directory", "check_ranks_per_shot", "RECORDS",
+           "BATCH", "chunks"]
 
 RECORDS = "shots.jsonl"
 _REQUEST, _REPLY = 7101, 7102
@@ -33,6 +38,8 @@ _REQUEST, _REPLY = 7101, 7102
 POLL = 5e-4
 #: the records are synced to the disk at most this often (s)
 SYNC = 1.0
+#: shots of a request when the caller asks for batches (rigid shots: fepen.runs.batch)
+BATCH = 32
 
 
 def check_ranks_per_shot(ranks_per_shot: int, ranks: int) -> None:
@@ -134,7 +141,7 @@ def run_shot(i: int, scene, out, comm) -> dict:
     from fepen.runs.rigid import RigidRun
 
     t0 = time.perf_counter()
-    summary, status, message = None, "ok", ""
+    summary = None
     try:
         if out is None and scene.effects.fidelity == "rigid":
             summary = RigidRun(scene, None, comm).run()
@@ -143,18 +150,61 @@ def run_shot(i: int, scene, out, comm) -> dict:
             setup.announce(scene, comm, sh.built)
             summary = run_in_directory(scene, out, comm, "force", sh=sh)  # the study owns its shots' folders
             summary = json.loads(json.dumps(summary))  # as summary.json holds it (and shots.jsonl gives it back)
-    except SimulationError as err:
-        status, message = "stopped", str(err)
-    except InputError as err:
-        status, message = "bad-input", f"{err.key}: {err.message}"
-    if summary is not None:
-        summary = {k: v for k, v in summary.items() if k not in ("scene", "versions")}
-    return {"shot": i, "status": status, "message": message, "summary": summary,
-            "wall_s": time.perf_counter() - t0, "ranks": comm.size}
+    except (SimulationError, InputError) as err:
+        summary = err
+    return _record(i, summary, time.perf_counter() - t0, comm)
+
+
+def _record(i: int, result, wall: float, comm) -> dict:
+    """A shot's record from its summary or the SimulationError or InputError it raised."""
+    summary, status, message = None, "ok", ""
+    if isinstance(result, SimulationError):
+        status, message = "stopped", str(result)
+    elif isinstance(result, InputError):
+        status, message = "bad-input", f"{result.key}: {result.message}"
+    elif result is not None:
+        summary = {k: v for k, v in result.items() if k not in ("scene", "versions")}
+    return {"shot": i, "status": status, "message": message, "summary": summary, "wall_s": wall, "ranks": comm.size}
+
+
+def run_shots(indices, scene_of, out: Path, comm, keep) -> list[dict]:
+    """The records of shots ``indices`` on comm, in order: the rigid shots that keep no results directory in
+    one batch (fepen.runs.batch: each its share of the batch's wall time), the others by run_shot.
+
+    Args:
+        indices: shot indices. scene_of: index -> resolved Scene. out: the study's directory. comm: the group's
+            communicator. keep: Scene -> whether the shot writes its results directory.
+    """
+    from fepen.runs import batch
+
+    scenes = [(i, scene_of(i)) for i in indices]
+    together = [(i, sc) for i, sc in scenes if not keep(sc) and sc.effects.fidelity == "rigid"]
+    records = {}
+    if together:
+        t0 = time.perf_counter()
+        results = batch.summaries([sc for _, sc in together], comm)
+        wall = (time.perf_counter() - t0) / len(together)
+        for (i, _), result in zip(together, results):
+            records[i] = _record(i, result, wall, comm)
+    for i, sc in scenes:
+        if i not in records:
+            records[i] = run_shot(i, sc, _shot_dir(out, i) if keep(sc) else None, comm)
+    return [records[i] for i in indices]
+
+
+def chunks(pending: list, batch: int, groups: int) -> list[list]:
+    """The pending shots in runs of at most ``batch``, and at most a quarter of a group's share (so that the
+    groups still share the end of a study).
+
+    Args:
+        pending: shot indices. batch: the most shots of a run. groups: the groups sharing them.
+    """
+    size = max(1, min(batch, -(-len(pending) // (4 * groups))))
+    return [pending[j:j + size] for j in range(0, len(pending), size)]
 
 
 def execute(n: int, scene_of, out, comm=None, ranks_per_shot: int = 1, keep=None, say=None,
-            desc: str = "shots") -> tuple[dict, int]:
+            desc: str = "shots", batch: int = 1) -> tuple[dict, int]:
     """Run the shots 0 … n−1 not yet recorded in OUT/shots.jsonl.
 
     Args:
@@ -189,17 +239,18 @@ def execute(n: int, scene_of, out, comm=None, ranks_per_shot: int = 1, keep=None
     quiet.setLevel(logging.ERROR)  # the shots' notes were said once when the study was read
     interval = sys.getswitchinterval()
     try:
+        runs = chunks(pending, batch, groups)
         if comm.size == 1:
-            for i in pending:
-                sc = scene_of(i)
-                log.add(run_shot(i, sc, _shot_dir(out, i) if keep(sc) else None, comm))
+            for run in runs:
+                for r in run_shots(run, scene_of, out, comm, keep):
+                    log.add(r)
         elif MPI.Query_thread() < MPI.THREAD_MULTIPLE:  # no dispatcher thread: a fixed round robin
             if comm.rank == 0 and say is not None:
                 say(f"{desc}: this MPI has no MPI_THREAD_MULTIPLE: shots go round robin, not by a queue")
-            _round_robin(pending, scene_of, out, comm, k, keep, log)
+            _round_robin(runs, scene_of, out, comm, k, keep, log)
         else:
             sys.setswitchinterval(1e-3)  # rank 0's dispatcher answers within a millisecond or so
-            _parallel(pending, scene_of, out, comm, k, keep, log)
+            _parallel(runs, scene_of, out, comm, k, keep, log)
     finally:
         quiet.setLevel(level)
         sys.setswitchinterval(interval)
@@ -212,27 +263,26 @@ def _shot_dir(out: Path, i: int) -> Path:
     return out / "shots" / f"{i:05d}"
 
 
-def _parallel(pending, scene_of, out, comm, k, keep, log) -> None:
+def _parallel(runs, scene_of, out, comm, k, keep, log) -> None:
     group = comm.Split(comm.rank // k, comm.rank)
     queue = comm.Dup()
     groups = comm.size // k
     dispatcher = None
     if comm.rank == 0:
-        dispatcher = threading.Thread(target=_dispatch, args=(queue, list(pending), groups, log), daemon=True)
+        dispatcher = threading.Thread(target=_dispatch, args=(queue, list(runs), groups, log), daemon=True)
         dispatcher.start()
     try:
-        record = None
+        records = None
         while True:
-            i = None
+            run = None
             if group.rank == 0:
-                queue.send(record, dest=0, tag=_REQUEST)
-                i = queue.recv(source=0, tag=_REPLY)
-            i = group.bcast(i, root=0)
-            if i < 0:
+                queue.send(records, dest=0, tag=_REQUEST)
+                run = queue.recv(source=0, tag=_REPLY)
+            run = group.bcast(run, root=0)
+            if not run:
                 break
-            sc = scene_of(i)
-            r = run_shot(i, sc, _shot_dir(out, i) if keep(sc) else None, group)
-            record = r if group.rank == 0 else None
+            rs = run_shots(run, scene_of, out, group, keep)
+            records = rs if group.rank == 0 else None
     finally:
         if dispatcher is not None:
             dispatcher.join()
@@ -240,25 +290,25 @@ def _parallel(pending, scene_of, out, comm, k, keep, log) -> None:
         queue.Free()
 
 
-def _round_robin(pending, scene_of, out, comm, k, keep, log) -> None:
+def _round_robin(runs, scene_of, out, comm, k, keep, log) -> None:
     group = comm.Split(comm.rank // k, comm.rank)
     mine = []
-    for i in pending[comm.rank // k:: comm.size // k]:
-        sc = scene_of(i)
-        r = run_shot(i, sc, _shot_dir(out, i) if keep(sc) else None, group)
+    for run in runs[comm.rank // k:: comm.size // k]:
+        rs = run_shots(run, scene_of, out, group, keep)
         if comm.rank == 0:
-            log.add(r)
+            for r in rs:
+                log.add(r)
         elif group.rank == 0:
-            mine.append(r)
+            mine.extend(rs)
     for part in comm.gather(mine, root=0) or []:
         for r in part:
             log.add(r)
     group.Free()
 
 
-def _dispatch(queue, pending: list, groups: int, log) -> None:
-    """Rank 0's thread: hand out the pending shots in order to whichever leader asks, record what they send
-    back, tell each leader to stop when none is left."""
+def _dispatch(queue, runs: list, groups: int, log) -> None:
+    """Rank 0's thread: hand out the pending runs of shots in order to whichever leader asks, record what they
+    send back, tell each leader to stop (an empty run) when none is left."""
     status = MPI.Status()
     nxt, stopped = 0, 0
     while stopped < groups:
@@ -266,12 +316,12 @@ def _dispatch(queue, pending: list, groups: int, log) -> None:
             time.sleep(POLL)
             continue
         src = status.Get_source()
-        record = queue.recv(source=src, tag=_REQUEST)
-        if record is not None:
+        records = queue.recv(source=src, tag=_REQUEST)
+        for record in records or ():
             log.add(record)
-        if nxt < len(pending):
-            queue.send(pending[nxt], dest=src, tag=_REPLY)
+        if nxt < len(runs):
+            queue.send(runs[nxt], dest=src, tag=_REPLY)
             nxt += 1
         else:
-            queue.send(-1, dest=src, tag=_REPLY)
+            queue.send([], dest=src, tag=_REPLY)
             stopped += 1

@@ -49,7 +49,9 @@ def _round(out: Path, r: int, scenes: list, comm, k: int) -> list[dict]:
     if comm.rank == 0:
         d.mkdir(parents=True, exist_ok=True)
     comm.barrier()
-    records, _ = engine.execute(len(scenes), lambda i: scenes[i], d, comm, k)
+    rigid = all(sc.effects.fidelity == "rigid" for sc in scenes)
+    records, _ = engine.execute(len(scenes), lambda i: scenes[i], d, comm, k,
+                                batch=engine.BATCH if rigid else 1)  # rigid shots in batches
     recs = comm.bcast([records[i] for i in range(len(scenes))] if comm.rank == 0 else None, root=0)
     for rec in recs:
         if rec["status"] != "ok":

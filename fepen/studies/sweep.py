@@ -503,8 +503,10 @@ def run(path, out, comm=None, ranks_per_shot: int = 1, sets=(), fresh: bool = Fa
                                               "kind": sweep.kind, "keys": sweep.keys, "shots": len(sweep.shots),
                                               "base": sweep.base, "spec": sweep.spec}, MPI.COMM_SELF)
     keep = sweep.keep_results
+    rigid = sweep.base.get("effects.fidelity") == "rigid" and "effects.fidelity" not in sweep.keys and not keep
     records, ran = engine.execute(len(sweep.shots), sweep.scene, out, comm, ranks_per_shot,
-                                  keep=lambda sc: keep or sc.effects.fidelity != "rigid", say=say)
+                                  keep=lambda sc: keep or sc.effects.fidelity != "rigid", say=say,
+                                  batch=engine.BATCH if rigid else 1)  # rigid shots in batches
     wall = time.perf_counter() - t0
     statuses = {}
     if comm.rank == 0:

@@ -1,0 +1,381 @@
+/* Many rigid shots of one projectile in one call (fepen/runs/batch.py, docs/theory.md §9): each shot's RK4
+ * loop, stop rules and history maxima as fepen.runs.rigid.RigidRun advances it, with no Python per stage.
+ * The load points and the force sums are the single path's own compiled functions (rigid_kernel.c's
+ * rigid_points and force_moment, passed in as function pointers and called on all the points: they are
+ * vectorised, so a point's rounding depends on its place in the array); the target law is target_kernel.c's
+ * point_forces, included and built as that file is built (a * b + c contracted alike), with three shortcuts
+ * that change no bit (law_points). The glue between them (quaternions, omega, the crater scale, the stage
+ * states, the work, the stop rules, the history rows' depth and energy error) repeats the single path's numpy
+ * and Python expressions operation by operation, in their order, built without contracting a * b + c into
+ * one rounding (-ffp-contract=off, fepen.runs.batch), so that a shot's trajectory is bitwise the single
+ * path's. tests/unit/runs/test_batch.py holds the two together. */
+#include <math.h>
+#include <stdint.h>
+#include <stdlib.h>
+#include <string.h>
+
+/* The law's parameter enum, clip01 and cavity_stress, and the law below, built as the single path builds
+ * target_kernel.c (a * b + c contracted as there) */
+#pragma GCC push_options
+#pragma GCC optimize("fp-contract=fast")
+#include "target_kernel.c"
+
+static inline double mx(double a, double b) { return a > b ? a : b; }
+static inline double mn(double a, double b) { return a < b ? a : b; }
+
+/* point_forces on k points, with the same operations on every loaded point, and three shortcuts that change no
+ * bit: ell = sqrt(area) given; the free-surface stress where the plastic zone is whole (ca = c/a) computed
+ * once; the forces of the points it loads (their indices into idx, in order) the only ones summed (the others
+ * are zero). f is written only at those points. Returns how many. */
+__attribute__((noinline)) static int32_t law_points(int32_t k, const double *x, const double *v, const double *n,
+                                                    const double *area, const double *ell, const double *radius,
+                                                    const double *Rm, const double *sphi0, const double *axis,
+                                                    const double *p, const double *gauss, int32_t ng, double *f,
+                                                    int32_t *idx, double *sums) {
+    const double thk = p[P_THICKNESS], sin_min = sin(p[P_PHI_MIN]), sin_onset = sin(p[P_ONSET]);
+    const double ref = p[P_FREE_SURFACE] != 0.0 ? cavity_stress(p, p[P_C_OVER_A]) : 1.0;
+    const double whole = p[P_GIVEN_SIGMA_S] != 0.0 ? p[P_SIGMA_S] * ref / ref : ref;
+    const double mu_s = p[P_MU], mu_d = p[P_MU_DYNAMIC], decay = p[P_MU_DECAY];
+    int32_t m = 0;
+    for (int j = 0; j < 5; ++j) sums[j] = 0.0;
+    for (int32_t i = 0; i < k; ++i) {
+        const double *xi = x + 3 * i, *vi = v + 3 * i, *ni = n + 3 * i;
+        double y = xi[1];
+        double frac = clip01(0.5 - (y + p[P_TOP]) / ell[i]);
+        if (p[P_LOWER] >= 0.0) frac *= clip01(0.5 + (y + p[P_LOWER]) / ell[i]);
+        if (!(frac > 0.0)) continue;
+        double vn = vi[0] * ni[0] + vi[1] * ni[1] + vi[2] * ni[2];
+        double speed = sqrt(vi[0] * vi[0] + vi[1] * vi[1] + vi[2] * vi[2]);
+        double sin_phi = speed > 0.0 ? vn / mx(speed, 1e-300) : 0.0;
+        int loaded = sin_phi > SIN_TOL;
+        if (axis) loaded = loaded && (vi[0] * axis[0] + vi[1] * axis[1] + vi[2] * axis[2] > 0.0);
+        if (p[P_SEPARATION] != 0.0) loaded = loaded && sin_phi > sin_min;
+        if (!loaded || !(vn > 0.0)) continue;
+        double depth = mx(-y, 0.0), Le = thk >= 0.0 ? mn(depth, mx(thk - depth, 0.0)) : depth;
+        double s = p[P_SIGMA_S];
+        if (p[P_FREE_SURFACE] != 0.0) {
+            double ca = fmin(p[P_C_OVER_A], 1.0 + Le / (p[P_SURFACE_RANGE] * mx(radius[i], 1e-12)));
+            if (ca == p[P_C_OVER_A]) s = whole;
+            else s = p[P_GIVEN_SIGMA_S] != 0.0 ? p[P_SIGMA_S] * cavity_stress(p, ca) / ref : cavity_stress(p, ca);
+        }
+        if (p[P_ONSET] > 0.0) s *= mn(sin_phi / sin_onset, 1.0);
+        double sg = (s + p[P_B] * p[P_DENSITY] * vn * vn) * frac;
+        if (p[P_CRATER] == 2.0 && -y < p[P_K] * p[P_D]) {
+            double rho = mx(radius[i], 1e-12), l = (p[P_C_OVER_A] - 1.0) * rho, integral = 0.0;
+            for (int32_t g = 0; g < ng; ++g) {
+                double w = 0.5 * l * (gauss[g] + 1.0), q = rho / (rho + w);
+                integral += 0.5 * l * gauss[ng + g] * (1.0 + w / Rm[i]) * (1.0 + w * sphi0[i] / rho) * q * q * q * q;
+            }
+            double e_kin = 0.5 * p[P_LOCK_DENSITY] * vn * vn * integral;
+            double e_str = p[P_CRUSH_STRAIN] * p[P_Y] * (2.0 * rho * Le + Le * Le) / rho;
+            if (e_kin - e_str >= 0.0) sg = 0.0;
+        }
+        double pa = sg * area[i], *fi = f + 3 * i;
+        fi[0] = -pa * ni[0];
+        fi[1] = -pa * ni[1];
+        fi[2] = -pa * ni[2];
+        if (p[P_FRICTION] != 0.0 && mu_s > 0.0) {
+            double vt[3] = {vi[0] - vn * ni[0], vi[1] - vn * ni[1], vi[2] - vn * ni[2]};
+            double st = sqrt(vt[0] * vt[0] + vt[1] * vt[1] + vt[2] * vt[2]);
+            if (st > 1e-9) {
+                double mu = (decay == 0.0 || mu_d == mu_s) ? mu_s : mu_d + (mu_s - mu_d) * exp(-decay * st);
+                double c = mu * pa / st;
+                fi[0] -= c * vt[0];
+                fi[1] -= c * vt[1];
+                fi[2] -= c * vt[2];
+            }
+        }
+        if (sg > 0.0) {
+            sums[3] += 1.0;
+            sums[4] += area[i];
+        }
+        idx[m++] = i;
+    }
+    for (int32_t j = 0; j < m; ++j) {
+        const double *fi = f + 3 * idx[j];
+        sums[0] += fi[0];
+        sums[1] += fi[1];
+        sums[2] += fi[2];
+    }
+    return m;
+}
+
+#pragma GCC pop_options
+
+typedef void (*points_fn)(int32_t, const double *, const double *, const double *, const double *,
+                          const double *, const double *, double *, double *, double *, double *);
+typedef void (*moment_fn)(int32_t, const double *, const double *, double *);
+
+/* rigid_kernel.c's force_moment on the points up to the last one loaded (idx is increasing), rounded up to a
+ * multiple of 16 (or all k): the function is vectorised by blocks of points from the first (8 doubles wide at
+ * most), and a point's rounding depends on its place in its block, so every point keeps its place, and the
+ * points left out carry zero forces, whose terms change no sum. Then f zeroed again at idx. */
+static void moment_points(moment_fn moment, int32_t k, int32_t m, const int32_t *idx, const double *arm, double *f,
+                          double *FM) {
+    int32_t n = m > 0 ? idx[m - 1] + 1 : 0;
+    n = (n + 15) / 16 * 16;
+    moment(n < k ? n : k, arm, f, FM);
+    for (int32_t j = 0; j < m; ++j) memset(f + 3 * idx[j], 0, 3 * sizeof(double));
+}
+
+/* per-shot numbers, in this order (fepen/runs/batch.py SHOT_NUMBERS) */
+enum { S_MASS, S_DT, S_HARD_END, S_THICKNESS /* < 0: none */, S_UNTIL_STOPPED, S_HISTORY /* <= 0: none */,
+       S_CRATER /* 1: the linear crater */, S_CRATER_KD, S_CRATER_C, S_KE0, S_STOP_ENERGY,
+       S_TIP /* 3: the tip about the centre */, S_TAIL = S_TIP + 3, S_IINV = S_TAIL + 3 /* 9 */,
+       S_COUNT = S_IINV + 9 };
+/* per-shot results */
+enum { R_T, R_STEPS, R_OUTCOME /* 0 ended, 1 perforated, 2 ricochet, 3 embedded */, R_WORK, R_ENTERED,
+       R_MAX_NOSE /* mm */, R_MAX_ERROR, R_ROWS, R_STATUS /* 0 ok, 1 a non-finite state */, R_COUNT };
+
+typedef struct {
+    int32_t k, ng;
+    const double *r0, *N0, *area, *ell, *radius, *Rm, *sphi0, *gauss;
+    points_fn points;
+    moment_fn moment;
+    double at[13], R[9], w[3]; /* the state whose points x, v, n, arm hold (at[3] = 2: none), its R and omega */
+    double *x, *v, *n, *arm, *f; /* scratch (f zero outside the points a law call loads) */
+    int32_t *idx;
+} Body;
+
+/* numpy's dot of two 3- or 4-vectors: from 0, left to right */
+static double dot3(const double *a, const double *b) { return ((0.0 + a[0] * b[0]) + a[1] * b[1]) + a[2] * b[2]; }
+
+static void quat_to_matrix(const double *q, double *R) {
+    double w = q[0], x = q[1], y = q[2], z = q[3];
+    R[0] = 1 - 2 * (y * y + z * z); R[1] = 2 * (x * y - w * z); R[2] = 2 * (x * z + w * y);
+    R[3] = 2 * (x * y + w * z); R[4] = 1 - 2 * (x * x + z * z); R[5] = 2 * (y * z - w * x);
+    R[6] = 2 * (x * z - w * y); R[7] = 2 * (y * z + w * x); R[8] = 1 - 2 * (x * x + y * y);
+}
+
+/* M (3, 3) row-major times a, and its transpose times a, as numpy's matmul sums them */
+static void matvec(const double *M, const double *a, double *out) {
+    for (int i = 0; i < 3; ++i) out[i] = ((0.0 + M[3 * i] * a[0]) + M[3 * i + 1] * a[1]) + M[3 * i + 2] * a[2];
+}
+static void matTvec(const double *M, const double *a, double *out) {
+    for (int i = 0; i < 3; ++i) out[i] = ((0.0 + M[i] * a[0]) + M[3 + i] * a[1]) + M[6 + i] * a[2];
+}
+
+/* omega = R (I^-1 (R^T L)) */
+static void omega_of(const double *R, const double *Iinv, const double *L, double *w) {
+    double a[3], b[3];
+    matTvec(R, L, a);
+    matvec(Iinv, a, b);
+    matvec(R, b, w);
+}
+
+static double norm4(const double *q) {
+    return sqrt((((0.0 + q[0] * q[0]) + q[1] * q[1]) + q[2] * q[2]) + q[3] * q[3]);
+}
+
+/* the load points of state y (x, v, n, arm into the body's scratch), R and omega; kept for the next call with
+ * the same state (a step's end state: the stop rules', then the next step's first stage, as RigidBody.at) */
+static void points_at(Body *b, const double *sp, const double *y, double *R, double *w) {
+    if (memcmp(b->at, y, sizeof b->at) == 0) {
+        memcpy(R, b->R, sizeof b->R);
+        memcpy(w, b->w, sizeof b->w);
+        return;
+    }
+    quat_to_matrix(y + 3, R);
+    omega_of(R, sp + S_IINV, y + 10, w);
+    double small[18];
+    memcpy(small, R, 9 * sizeof(double));
+    memcpy(small + 9, y, 3 * sizeof(double));
+    memcpy(small + 12, y + 7, 3 * sizeof(double));
+    memcpy(small + 15, w, 3 * sizeof(double));
+    b->points(b->k, b->r0, b->N0, small, small + 9, small + 12, small + 15, b->x, b->v, b->n, b->arm);
+    memcpy(b->at, y, sizeof b->at);
+    memcpy(b->R, R, sizeof b->R);
+    memcpy(b->w, w, sizeof b->w);
+}
+
+/* RigidBody.derivative with RigidRun.force_fn: dy (13), the force and moment, the power; loaded, area */
+static void derivative(Body *b, const double *sp, const double *law, const double *y, double *dy, double *FM,
+                       double *power, double *loaded, double *area) {
+    double R[9], w[3], tip[3], axis[3], sums[5];
+    points_at(b, sp, y, R, w);
+    matvec(R, sp + S_TIP, tip);
+    for (int j = 0; j < 3; ++j) tip[j] = y[j] + tip[j];
+    for (int j = 0; j < 3; ++j) axis[j] = -R[3 * j + 1];
+    int32_t m = law_points(b->k, b->x, b->v, b->n, b->area, b->ell, b->radius, b->Rm, b->sphi0, axis, law,
+                           b->gauss, b->ng, b->f, b->idx, sums);
+    if (sp[S_CRATER] != 0.0) { /* ForrestalCrater.scale(-tip[1], -(total . axis)) */
+        double depth = -tip[1], axial = -dot3(sums, axis), scale = 1.0;
+        if (!(depth >= sp[S_CRATER_KD] || axial <= 0.0)) scale = fmax(depth, 0.0) * sp[S_CRATER_C] / axial;
+        for (int32_t j = 0; j < m; ++j) {
+            double *fi = b->f + 3 * b->idx[j];
+            fi[0] *= scale; fi[1] *= scale; fi[2] *= scale;
+        }
+    }
+    *loaded = sums[3];
+    *area = sums[4];
+    moment_points(b->moment, b->k, m, b->idx, b->arm, b->f, FM);
+    double q[4] = {y[3], y[4], y[5], y[6]};
+    double w1 = 0.0, x1 = w[0], y1 = w[1], z1 = w[2], w2 = q[0], x2 = q[1], y2 = q[2], z2 = q[3];
+    for (int j = 0; j < 3; ++j) dy[j] = y[7 + j];
+    dy[3] = 0.5 * (w1 * w2 - x1 * x2 - y1 * y2 - z1 * z2);
+    dy[4] = 0.5 * (w1 * x2 + x1 * w2 + y1 * z2 - z1 * y2);
+    dy[5] = 0.5 * (w1 * y2 - x1 * z2 + y1 * w2 + z1 * x2);
+    dy[6] = 0.5 * (w1 * z2 + x1 * y2 - y1 * x2 + z1 * w2);
+    for (int j = 0; j < 3; ++j) dy[7 + j] = FM[j] / sp[S_MASS];
+    for (int j = 0; j < 3; ++j) dy[10 + j] = FM[3 + j];
+    *power = dot3(FM, y + 7) + dot3(FM + 3, w);
+}
+
+/* RigidBody.rk4_step: y advanced by dt in place; the work of the step; F0: the force at its start */
+static double rk4(Body *b, const double *sp, const double *law, double *y, double dt, double *F0) {
+    double k[4][13], s[13], FM[6], P, loaded, area, work = 0.0;
+    static const double c[4] = {0.0, 0.5, 0.5, 1.0}, wt[4] = {1.0, 2.0, 2.0, 1.0};
+    for (int i = 0; i < 4; ++i) {
+        if (i) {
+            double cdt = c[i] * dt;
+            for (int j = 0; j < 13; ++j) s[j] = y[j] + cdt * k[i - 1][j];
+        } else {
+            memcpy(s, y, sizeof s);
+        }
+        derivative(b, sp, law, s, k[i], FM, &P, &loaded, &area);
+        if (i == 0) memcpy(F0, FM, 3 * sizeof(double));
+        work += wt[i] * P;
+    }
+    double h = dt / 6.0;
+    for (int j = 0; j < 13; ++j) y[j] = y[j] + h * (((k[0][j] + 2 * k[1][j]) + 2 * k[2][j]) + k[3][j]);
+    double nq = norm4(y + 3);
+    for (int j = 3; j < 7; ++j) y[j] /= nq;
+    return h * work;
+}
+
+/* the axis (tail to nose) of state y: R (0, -1, 0) */
+static void axis_of(const double *y, double *a) {
+    double R[9], down[3] = {0.0, -1.0, 0.0};
+    quat_to_matrix(y + 3, R);
+    matvec(R, down, a);
+}
+
+/* a history row's depth of the tip (mm) and energy error at state y (RigidRun.snapshot) */
+static void row_of(const double *sp, const double *y, double work, double *nose, double *error) {
+    double R[9], w[3], tip[3];
+    quat_to_matrix(y + 3, R);
+    omega_of(R, sp + S_IINV, y + 10, w);
+    matvec(R, sp + S_TIP, tip);
+    *nose = -(y[1] + tip[1]) * 1e3;
+    double ke = 0.5 * sp[S_MASS] * dot3(y + 7, y + 7) + 0.5 * dot3(w, y + 10), ke0 = sp[S_KE0];
+    double scale = ke0, aw = fabs(work);
+    if (aw > scale) scale = aw;
+    if (ke > scale) scale = ke;
+    if (1e-300 > scale) scale = 1e-300;
+    *error = fabs((((ke + 0.0) + 0.0) - ke0 - work) - 0.0) / scale;
+}
+
+static int finite13(const double *y) {
+    for (int j = 0; j < 13; ++j)
+        if (!isfinite(y[j])) return 0;
+    return 1;
+}
+
+/* One shot from y (13) at t = 0 to its end or stop; y becomes the final state. */
+static void one_shot(Body *b, const double *sp, const double *law, double *y, double *res) {
+    b->at[3] = 2.0; /* no unit quaternion: nothing kept from the last shot (another inertia) */
+    double t = 0.0, work = 0.0, next = 0.0, prev[13], R[9], w[3];
+    double max_nose = -INFINITY, max_error = -INFINITY, rows = 0.0;
+    int64_t steps = 0;
+    int outcome = 0, entered = 0, status = 0;
+    const double dt = sp[S_DT], interval = sp[S_HISTORY], thk = sp[S_THICKNESS];
+    double F[3] = {0.0, 0.0, 0.0}; /* a row's force: at the start of the last step (at t = 0 the initial one) */
+    if (interval > 0.0) {
+        double dy[13], FM[6], P, loaded, area;
+        derivative(b, sp, law, y, dy, FM, &P, &loaded, &area);
+        memcpy(F, FM, sizeof F);
+    }
+    while (outcome == 0 && t < sp[S_HARD_END]) {
+        if (interval > 0.0 && t >= next) { /* History.write: a row, then the clock */
+            double nose, error;
+            row_of(sp, y, work, &nose, &error);
+            /* Results.finite_row of the row: what of it is not finite when these are */
+            if (!isfinite(nose) || !isfinite(error) || !isfinite(work) || !isfinite(F[0]) || !isfinite(F[1]) ||
+                !isfinite(F[2])) { status = 1; break; }
+            if (rows == 0.0 || nose > max_nose) max_nose = nose;
+            if (rows == 0.0 || error > max_error) max_error = error;
+            rows += 1.0;
+            while (next <= t) next += interval;
+        }
+        memcpy(prev, y, sizeof prev);
+        work += rk4(b, sp, law, y, dt, F);
+        t += dt;
+        steps += 1;
+        if (!finite13(y)) { status = 1; break; }
+        /* Run.stop_rules: the extent of the load points, then StopRules.penetration */
+        points_at(b, sp, y, R, w);
+        double ymin = b->x[1], ymax = b->x[1];
+        for (int32_t i = 1; i < b->k; ++i) {
+            double yi = b->x[3 * i + 1];
+            if (yi < ymin) ymin = yi;
+            if (yi > ymax) ymax = yi;
+        }
+        entered = entered || ymin < 0.0;
+        if (!entered) continue;
+        double a[3];
+        axis_of(y, a);
+        if (thk >= 0.0 && ymax < -thk) outcome = 1;
+        else if (ymin > 0.0 && y[8] > 0.0) outcome = 2;
+        else if (sp[S_UNTIL_STOPPED] != 0.0 &&
+                 (dot3(y + 7, a) <= 0.0 || 0.5 * sp[S_MASS] * dot3(y + 7, y + 7) <= sp[S_STOP_ENERGY] * sp[S_KE0]))
+            outcome = 3;
+        if (outcome == 3 && dot3(y + 7, a) <= 0.0) { /* RigidRun.stop_rules: back to where V.a vanishes */
+            double ap[3];
+            axis_of(prev, ap);
+            double a0 = dot3(prev + 7, ap), a1 = dot3(y + 7, a);
+            double lam = a0 - a1 > 0.0 ? a0 / (a0 - a1) : 1.0;
+            for (int j = 0; j < 13; ++j) y[j] = prev[j] + lam * (y[j] - prev[j]);
+            double nq = norm4(y + 3);
+            for (int j = 3; j < 7; ++j) y[j] /= nq;
+            t -= (1.0 - lam) * dt;
+        }
+    }
+    res[R_T] = t;
+    res[R_STEPS] = (double)steps;
+    res[R_OUTCOME] = outcome;
+    res[R_WORK] = work;
+    res[R_ENTERED] = entered;
+    res[R_MAX_NOSE] = max_nose;
+    res[R_MAX_ERROR] = max_error;
+    res[R_ROWS] = rows;
+    res[R_STATUS] = status;
+}
+
+/* n shots sharing k load points (r0, N0: body-frame arms and normals; area, ell = sqrt(area), radius, Rm,
+ * sphi0: the law's per-point constants; gauss: ng nodes then ng weights; points, moment: rigid_kernel.c's
+ * rigid_points and force_moment). Per shot: sp (n, S_COUNT), laws (n, nlaw) the TargetLaw's numbers (P_COUNT of them), y (n, 13)
+ * the initial state, overwritten by the final one; res (n, R_COUNT). Returns S_COUNT * 10000 + R_COUNT * 100 +
+ * P_COUNT (the caller checks the layouts), or -1 when the scratch is not allocated. */
+int32_t rigid_batch(int32_t n, int32_t k, const double *r0, const double *N0, const double *area, const double *ell,
+                    const double *radius, const double *Rm, const double *sphi0, const double *gauss, int32_t ng,
+                    void *points, void *moment, const double *sp, const double *laws, int32_t nlaw, double *y,
+                    double *res) {
+    Body b = {k, ng, r0, N0, area, ell, radius, Rm, sphi0, gauss, (points_fn)points, (moment_fn)moment, {0}, {0},
+              {0}, NULL, NULL, NULL, NULL, NULL, NULL};
+    size_t kk = (size_t)(k > 0 ? k : 1);
+    double *scratch = calloc(15 * kk, sizeof(double));
+    int32_t *idx = malloc(sizeof(int32_t) * kk);
+    if (!scratch || !idx || nlaw != P_COUNT) {
+        free(scratch);
+        free(idx);
+        return -1;
+    }
+    b.x = scratch; b.v = b.x + 3 * k; b.n = b.v + 3 * k; b.arm = b.n + 3 * k; b.f = b.arm + 3 * k; b.idx = idx;
+    for (int32_t s = 0; s < n; ++s)
+        one_shot(&b, sp + (size_t)s * S_COUNT, laws + (size_t)s * nlaw, y + (size_t)s * 13, res + (size_t)s * R_COUNT);
+    free(scratch);
+    free(idx);
+    return S_COUNT * 10000 + R_COUNT * 100 + P_COUNT;
+}
+
+/* The batch's law on one set of points, for the tests against point_forces: f (k, 3) (zero where not loaded)
+ * and sums (5) as point_forces gives them. */
+void batch_law(int32_t k, const double *x, const double *v, const double *n, const double *area, const double *ell,
+               const double *radius, const double *Rm, const double *sphi0, const double *axis, const double *p,
+               const double *gauss, int32_t ng, double *f, double *sums) {
+    int32_t *idx = malloc(sizeof(int32_t) * (size_t)(k > 0 ? k : 1));
+    if (!idx) return;
+    for (int32_t i = 0; i < 3 * k; ++i) f[i] = 0.0;
+    law_points(k, x, v, n, area, ell, radius, Rm, sphi0, axis, p, gauss, ng, f, idx, sums);
+    free(idx);
+}

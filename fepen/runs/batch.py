@@ -1,0 +1,181 @@
+"""Rigid shots in batches: many shots of one projectile integrated by one compiled call (fepen/laws/rigid_batch.c)
+instead of one ``RigidRun.run()`` each, for the studies that run thousands of them (``fepen sweep``, the limit
+studies, ``fepen validate-depth``).
+
+Each shot is set up by ``RigidRun`` as usual (its projectile, load points, law, crater, step, initial state);
+the kernel then advances every shot of a projectile with the single path's RK4, its stop rules (perforated,
+ricochet, embedded with its interpolation back to V·a = 0, the hard end) and its history clock (the largest
+nose depth and energy error of the rows the single path would record), calling the single path's own
+compiled load-point, force-sum and target-law functions; the final row and the summary are then made by
+``RigidRun`` itself from the final state. The single path (``RigidRun.run``) stays the reference: the batch
+gives its summaries bitwise (tests/unit/runs/test_batch.py), and falls back to it, shot by shot and
+automatically, for what the kernel does not cover:
+
+- wear (``effects.wear``) and layered targets (``fepen.laws.layers``): the single path runs the shot;
+- a results directory (the batch writes no history.csv), a target that is not a ``TargetLaw``;
+- FEPEN_KERNEL=numpy or a machine where the C kernels do not build;
+- a shot whose state or history row turns non-finite (the single path runs it again and stops it with its own
+  error).
+"""
+
+from __future__ import annotations
+
+import ctypes
+import time
+from pathlib import Path
+
+import numpy as np
+from mpi4py import MPI
+
+from fepen.errors import InputError, SimulationError
+from fepen.laws import target as tg
+from fepen.runs import events
+
+__all__ = ["summaries", "reason", "kernel", "SHOT_NUMBERS", "RESULTS", "OUTCOMES"]
+
+#: the per-shot numbers the kernel reads, in its order (rigid_batch.c's S_ enum)
+SHOT_NUMBERS = ("mass", "dt", "hard_end", "thickness", "until_stopped", "history_interval", "crater",
+                "crater_kd", "crater_c", "ke0", "stop_energy", "tip_x", "tip_y", "tip_z", "tail_x", "tail_y",
+                "tail_z", *[f"I_inv_{i}{j}" for i in range(3) for j in range(3)])
+#: the per-shot results it writes (its R_ enum)
+RESULTS = ("t", "steps", "outcome", "work", "entered", "max_nose_mm", "max_error", "rows", "status")
+#: outcome codes of the kernel
+OUTCOMES = (None, "perforated", "ricochet", "embedded")
+_R = {k: i for i, k in enumerate(RESULTS)}
+_KERNEL: dict = {}
+
+
+def kernel():
+    """(the rigid_batch library, the addresses of rigid_kernel.c's rigid_points and force_moment, the Gauss rule
+    of the law) when the C kernels build and FEPEN_KERNEL is not numpy, else None."""
+    if "fn" not in _KERNEL:
+        _KERNEL["fn"] = None
+        from fepen import native
+        from fepen.laws import rigid_body
+
+        body, law = rigid_body._kernel(), tg._point_kernel()
+        if body is None or law is None:
+            return None
+        lib, _KERNEL["why_not"] = native.load(Path(__file__).parents[1] / "laws" / "rigid_batch.c",
+                                              ("-ffp-contract=off",))
+        if lib is None:
+            return None
+        vp, i32 = ctypes.c_void_p, ctypes.c_int32
+        lib.rigid_batch.argtypes = [i32, i32, *[vp] * 8, i32, vp, vp, vp, vp, i32, vp, vp]
+        lib.rigid_batch.restype = i32
+        lib.batch_law.argtypes = [i32, *[vp] * 11, i32, vp, vp]
+        lib.batch_law.restype = None
+        _KERNEL["fn"] = (lib, [ctypes.cast(f, vp).value for f in (body.rigid_points, body.force_moment)], law.gauss)
+    return _KERNEL["fn"]
+
+
+def reason(run) -> str | None:
+    """Why a RigidRun (set up, not run) cannot go in a batch, or None when it can."""
+    if kernel() is None:
+        return "the C kernels are not built"
+    if run.out is not None:
+        return "it writes a results directory"
+    if run.wear is not None:
+        return "wear"
+    if not isinstance(run.law, tg.TargetLaw):
+        return "a layered or non-concrete target"
+    if run.crossings is not None or len(run.outputs) != 1 or run.history.clock.next != 0.0:
+        return "layer crossings or outputs"
+    if run.t != 0.0 or run.step_count != 0:
+        return "not at its start"
+    return None
+
+
+def summaries(scenes, comm=None, history: bool = True) -> list:
+    """The summaries of rigid shots, as ``RigidRun(scene, None, comm, history=history).run()`` returns them:
+    in batches per projectile where the kernel covers the shot, else by the single path.
+
+    Args:
+        scenes: the shots (Scenes or resolved Shots), rigid fidelity. comm: the communicator of every shot
+            (None: COMM_SELF). history: as RigidRun's (False: the final row alone).
+
+    Returns:
+        One item per shot, in order: its summary, or the InputError or SimulationError it raised.
+    """
+    from fepen.runs import shot
+    from fepen.runs.rigid import RigidRun
+
+    comm = MPI.COMM_SELF if comm is None else comm
+    out: list = [None] * len(scenes)
+    groups: dict = {}
+    for i, sc in enumerate(scenes):
+        try:
+            sh = sc if isinstance(sc, shot.Shot) else shot.resolve(sc, toml=False)  # no results directory
+            run = RigidRun(sh, None, comm, history=history)
+        except (InputError, SimulationError) as err:
+            out[i] = err
+            continue
+        if reason(run) is not None:
+            out[i] = _single(run)
+            continue
+        groups.setdefault((id(run.pts), run.body.centre0.tobytes(), run.body.r0.shape), []).append((i, run))
+    for members in groups.values():
+        for (i, _run), summary in zip(members, _integrate([run for _, run in members])):
+            out[i] = summary if summary is not None else _single(RigidRun(scenes[i], None, comm, history=history))
+    return out
+
+
+def _single(run):
+    try:
+        return run.run()
+    except (InputError, SimulationError) as err:
+        return err
+
+
+def _shot_numbers(run) -> list[float]:
+    body, crater, law = run.body, run.crater, run.law
+    return [body.mass, run.dt, run.shot.hard_end, -1.0 if law.thickness is None else law.thickness,
+            float(run.rules.until_stopped), run.history.clock.interval, float(crater is not None),
+            crater.kd if crater is not None else 0.0, crater.c if crater is not None else 0.0, run.ke0,
+            events.STOP_ENERGY, *run.tip_arm, *(run.tail_ref - body.centre0), *body.I_body_inv.ravel()]
+
+
+def _integrate(runs: list) -> list:
+    """The summaries of runs that share their load points (None for a shot the single path must run)."""
+    from fepen.io import results
+
+    lib, (points, moment), gauss = kernel()
+    g, body = runs[0].pts, runs[0].body
+    n, k = len(runs), len(body.r0)
+    const = [np.ascontiguousarray(a, dtype=float) for a in (body.r0, body.N0, g["area0"], np.sqrt(g["area0"]),
+                                                              g["radius"], g["R_meridian"], g["sin_phi0"])]
+    sp = np.ascontiguousarray([_shot_numbers(r) for r in runs], dtype=float)
+    laws = np.ascontiguousarray([tg._law_numbers(r.law) for r in runs], dtype=float)
+    y = np.ascontiguousarray([r.state.as_array() for r in runs], dtype=float)
+    res = np.zeros((n, len(RESULTS)))
+    t0 = time.perf_counter()
+    check = lib.rigid_batch(n, k, *[a.ctypes.data for a in const], gauss.ctypes.data, len(gauss) // 2, points, moment,
+                            sp.ctypes.data, laws.ctypes.data, laws.shape[1], y.ctypes.data, res.ctypes.data)
+    loop_s = (time.perf_counter() - t0) / n
+    if check < 0:
+        raise MemoryError("rigid_batch: no memory for its scratch arrays (or a law of another length)")
+    assert check == len(SHOT_NUMBERS) * 10000 + len(RESULTS) * 100 + laws.shape[1], \
+        "rigid_batch.c and fepen.runs.batch (or target.py's _law_numbers) disagree on a layout"
+    from fepen.laws.rigid_body import RigidState
+
+    out = []
+    for run, yi, ri in zip(runs, y, res):
+        if ri[_R["status"]] != 0.0:
+            out.append(None)
+            continue
+        run.state = RigidState.from_array(yi)
+        run.t, run.step_count, run.w_ext = float(ri[_R["t"]]), int(ri[_R["steps"]]), float(ri[_R["work"]])
+        run.rules.entered = bool(ri[_R["entered"]])
+        try:
+            run.finish_loop()  # the final row, with the force at the final state, as the single path makes it
+        except SimulationError:  # a non-finite final row: the single path stops the shot with its own error
+            out.append(None)
+            continue
+        if ri[_R["rows"]] > 0:  # the recorded rows' largest depth and energy error, as one row before it
+            top = list(run.rows[-1])
+            top[results.COL["nose_y_mm"]] = float(ri[_R["max_nose_mm"]])
+            top[results.COL["energy_error"]] = float(ri[_R["max_error"]])
+            run.rows.insert(0, top)
+        outcome = OUTCOMES[int(ri[_R["outcome"]])]
+        out.append(run.write_summary(outcome or "ended", loop_s))
+    return out
