@@ -2,14 +2,19 @@
 #   make run    installs what is missing, runs the default scene (Table 1 shot C3, plastic projectile in the
 #               concrete target, default mesh) on $(NP) ranks into results/C3, the same shot with the rigid
 #               projectile into results/C3-rigid, and the mesh with its picture into results/C3-mesh
-#   make test   installs what is missing, lints, runs the fast unit lane, the system tests, then the MPI
-#               ones on 2 ranks
+#   make test   installs what is missing, lints, runs the fast unit lane, the system tests on $(WORKERS)
+#               pytest-xdist workers, then the MPI ones (marked mpi) on 2 ranks; the serial lanes leave the
+#               mpi-marked tests to that last lane (on one rank their two runs would be one run twice)
 PY := .venv/bin/python
 NP ?= 2
+# the system lane's pytest-xdist workers (one per core; tests in one xdist_group share a worker)
+WORKERS ?= 2
 # OpenMPI refuses to start as root unless told; CI and these machines run as root.
 export OMPI_ALLOW_RUN_AS_ROOT := 1
 export OMPI_ALLOW_RUN_AS_ROOT_CONFIRM := 1
 export OMPI_MCA_rmaps_base_oversubscribe := 1
+# ranks that wait yield the core (the system lane's xdist workers may run two 2-rank runs at once on 2 cores)
+export OMPI_MCA_mpi_yield_when_idle := 1
 export OMP_NUM_THREADS := 1
 
 .PHONY: setup run test lint bench clean
@@ -24,8 +29,8 @@ run: setup
 
 test: setup
 	$(PY) -m ruff check --no-cache fepen tests demos benchmarks tools
-	$(PY) -m pytest -q tests/unit
-	$(PY) -m pytest -q tests/system
+	$(PY) -m pytest -q -m "not mpi" tests/unit
+	$(PY) -m pytest -q -m "not mpi" -n $(WORKERS) --dist loadgroup tests/system
 	mpirun -n $(NP) $(PY) -m pytest -q -m mpi -p no:cacheprovider tests
 
 lint: setup

@@ -29,14 +29,18 @@ def _numba_cache_per_rank() -> None:
     numba's on-disk cache is not safe against processes compiling and writing the same entries at once
     (numba issues #4807, #10128: segmentation faults); the ranks of a run whose cache is cold or stale
     (a fresh clone, an edited kernel) would do exactly that. A serial run keeps numba's default (the
-    __pycache__ beside the sources). NUMBA_CACHE_DIR, if set, is left alone.
+    __pycache__ beside the sources). NUMBA_CACHE_DIR, if set, is left alone. Under pytest-xdist (make test's
+    system lane) two workers may each start an mpirun job at once: their ranks N would share rankN, so each
+    worker's runs get folders of their own (``~/.cache/fepen/numba/gwK/rankN``; PYTEST_XDIST_WORKER reaches
+    the ranks through the environment).
     """
     env = os.environ
     rank = env.get("OMPI_COMM_WORLD_RANK", env.get("PMI_RANK"))
     size = env.get("OMPI_COMM_WORLD_SIZE", env.get("PMI_SIZE"))
     if rank is None or size in (None, "1") or "NUMBA_CACHE_DIR" in env:
         return
-    folder = Path(env.get("XDG_CACHE_HOME") or Path.home() / ".cache") / "fepen" / "numba" / f"rank{rank}"
+    folder = Path(env.get("XDG_CACHE_HOME") or Path.home() / ".cache") / "fepen" / "numba"
+    folder = folder / env.get("PYTEST_XDIST_WORKER", "") / f"rank{rank}"
     env["NUMBA_CACHE_DIR"] = str(folder)
     if "numba" in sys.modules:  # imported before fepen: dispatchers made from now on read the config
         sys.modules["numba"].config.CACHE_DIR = str(folder)

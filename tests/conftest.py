@@ -1,4 +1,5 @@
-"""Shared test helpers. Tests marked ``mpi`` also run under ``mpirun -n 2`` (see the Makefile)."""
+"""Shared test helpers. Tests marked ``mpi`` compare 1 and 2 ranks: make test runs them under ``mpirun -n 2``
+only, and the serial lanes (``-m "not mpi"``) leave them out (see the Makefile)."""
 
 from pathlib import Path
 

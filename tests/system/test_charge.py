@@ -9,6 +9,10 @@ from mpi4py import MPI
 from fepen import scene
 from fepen.runs.deformable import DeformableRun
 
+#: one pytest-xdist worker runs this module (make test: -n 2 --dist loadgroup), so that its module-scoped
+#: runs are made once, not once per worker
+pytestmark = pytest.mark.xdist_group("test_charge")
+
 TIED = ["effects.charge=true", "charge.contact=tied", "mesh.size=0.004", "impact.velocity=800",
         "impact.obliquity_deg=0", "impact.attack_deg=0", "run.fields=false", "run.checkpoint_interval=0"]
 
@@ -22,11 +26,17 @@ def charged_run(comm, end="1.5e-4"):
     return summary, np.array(sim.rows), sim
 
 
-def test_tied_charge_accelerations_balance_the_target_force(tmp_path):
+@pytest.fixture(scope="module")
+def tied_150us():
+    """The serial tied run to 150 us, made once for the tests that read it (each reads, none changes it)."""
+    return charged_run(MPI.COMM_SELF)
+
+
+def test_tied_charge_accelerations_balance_the_target_force(tied_150us):
     """shell_acc_g and charge_acc_g: mass-weighted, they give the whole projectile's deceleration by the
     target (momentum balance, to round-off) at every recorded time; both bodies decelerate, and the charge,
     softer and lighter, oscillates about the shell's deceleration."""
-    summary, rows, sim = charged_run(MPI.COMM_SELF)
+    summary, rows, sim = tied_150us
     m_shell, m_charge = sim.solver.body_mass
     assert m_shell + m_charge == pytest.approx(0.367, abs=1e-3)  # the paper's 367 g, charge included
     assert 0.01 < m_charge < 0.05
@@ -68,12 +78,12 @@ def test_lowpass_keeps_the_pulse_and_removes_the_ringing():
     assert np.max(np.abs(lowpass(t, ring, 1e4))[inner]) < 0.01 * 2e4
 
 
-def test_charge_section_stresses_follow_the_inertia_of_the_fill():
+def test_charge_section_stresses_follow_the_inertia_of_the_fill(tied_150us):
     """charge_sections.csv: while the projectile decelerates, the charge is pushed against the front of the
     cavity: along the axis its mean axial stress is compressive and falls in magnitude from front to rear,
     and at the front it stays below the inertia of a free charge column, rho_c |a_c| L_charge (the tied
     walls carry part of it in shear), and above a tenth of it."""
-    summary, rows, sim = charged_run(MPI.COMM_SELF)
+    summary, rows, sim = tied_150us
     d = np.genfromtxt(sim.out / "charge_sections.csv", delimiter=",", names=True)
     late = d["t_s"] > 5e-5
     axial = np.array([d[f"axis{k}_axial_Pa"][late].mean() for k in range(5)])

@@ -20,6 +20,10 @@ from conftest import run_fepen
 from fepen.io import rundir
 from fepen.studies import processes
 
+#: one pytest-xdist worker runs this module (make test: -n 2 --dist loadgroup), so that its module-scoped
+#: runs are made once, not once per worker
+pytestmark = pytest.mark.xdist_group("test_faults")
+
 #: C7 on a coarse mesh for 500 us: about 1900 steps, 13 field outputs, 4 checkpoints, a few seconds
 SETS = ["--set", "mesh.size=0.004", "--set", "run.end_time=5e-4", "--set", "run.output_interval=4e-5",
         "--set", "run.checkpoint_interval=1e-4", "--set", 'impact.shot="C7"']

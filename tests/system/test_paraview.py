@@ -21,6 +21,10 @@ import numpy as np
 import pytest
 from conftest import ROOT, run_fepen
 
+#: one pytest-xdist worker runs this module (make test: -n 2 --dist loadgroup), so that its module-scoped
+#: runs are made once, not once per worker
+pytestmark = pytest.mark.xdist_group("test_paraview")
+
 HERE = Path(__file__).resolve().parent
 PVPYTHON = shutil.which("pvpython")
 XVFB = shutil.which("xvfb-run")

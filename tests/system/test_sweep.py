@@ -12,6 +12,10 @@ from conftest import run_fepen
 
 from fepen.studies import processes, sweep
 
+#: one pytest-xdist worker runs this module (make test: -n 2 --dist loadgroup), so that its module-scoped
+#: runs are made once, not once per worker
+pytestmark = pytest.mark.xdist_group("test_sweep")
+
 DEMO = processes.ROOT / "demos" / "studies" / "c3_scatter.toml"  # the shipped C3 scatter, resized
 N = 120
 
