@@ -29,7 +29,7 @@ run: setup
 
 test: setup
 	$(PY) -m ruff check --no-cache fepen tests demos benchmarks tools
-	$(PY) -m pytest -q -m "not mpi" tests/unit
+	$(PY) -m pytest -q -m "not mpi" -n $(WORKERS) tests/unit
 	$(PY) -m pytest -q -m "not mpi" -n $(WORKERS) --dist loadgroup tests/system
 	mpirun -n $(NP) $(PY) -m pytest -q -m mpi -p no:cacheprovider tests
 
