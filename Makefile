@@ -2,12 +2,12 @@
 #   make run    installs what is missing, runs the default scene (Table 1 shot C3, plastic projectile in the
 #               concrete target, default mesh) on $(NP) ranks into results/C3, the same shot with the rigid
 #               projectile into results/C3-rigid, and the mesh with its picture into results/C3-mesh
-#   make test   installs what is missing, lints, runs the fast unit lane, the system tests on $(WORKERS)
-#               pytest-xdist workers, then the MPI ones (marked mpi) on 2 ranks; the serial lanes leave the
+#   make test   installs what is missing, lints, runs the fast unit lane and the system tests on $(WORKERS)
+#               pytest-xdist workers each, then the MPI ones (marked mpi) on 2 ranks; the serial lanes leave the
 #               mpi-marked tests to that last lane (on one rank their two runs would be one run twice)
 PY := .venv/bin/python
 NP ?= 2
-# the system lane's pytest-xdist workers (one per core; tests in one xdist_group share a worker)
+# the unit and system lanes' pytest-xdist workers (one per core; tests in one xdist_group share a worker)
 WORKERS ?= 2
 # OpenMPI refuses to start as root unless told; CI and these machines run as root.
 export OMPI_ALLOW_RUN_AS_ROOT := 1
