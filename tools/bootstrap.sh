@@ -15,19 +15,35 @@ openmpi-bin libglu1-mesa libxcursor1 libxft2 libxinerama1 libgl1 libegl1 libosme
 sudo=""
 if [ "$(id -u)" -ne 0 ]; then sudo="sudo"; fi
 
-if ! /usr/bin/python3 -c "import dolfinx, h5py, numba, matplotlib, venv" >/dev/null 2>&1 \
-   || ! ldconfig -p | grep -q libOSMesa \
-   || ! command -v mpirun >/dev/null 2>&1; then
-  echo "[bootstrap] installing Debian packages (dolfinx 0.5.2 and friends)"
+# What is missing, from dpkg's own records: no pipe (under pipefail, `ldconfig -p | grep -q` failed at random when
+# grep exited at its first match and ldconfig died of SIGPIPE, so an installed machine ran apt again), and apt only
+# when a package is really absent (a user without sudo or network can run an installed machine).
+missing() {
+  local pkg status
+  for pkg in "$@"; do
+    status=$(dpkg-query -W -f='${db:Status-Status}' "$pkg" 2>/dev/null || true)
+    if [ "$status" != "installed" ]; then printf '%s ' "$pkg"; fi
+  done
+}
+
+need=$(missing $apt_pkgs)
+if [ -n "$need" ]; then
+  echo "[bootstrap] installing Debian packages: $need"
   $sudo apt-get update -qq
-  DEBIAN_FRONTEND=noninteractive $sudo apt-get install -y -qq --no-install-recommends $apt_pkgs >/dev/null
+  DEBIAN_FRONTEND=noninteractive $sudo apt-get install -y -qq --no-install-recommends $need >/dev/null
+fi
+if ! /usr/bin/python3 -c "import dolfinx, h5py, numba, matplotlib, venv" >/dev/null 2>&1; then
+  echo "[bootstrap] Debian's python3-dolfinx-real and friends are installed but do not import:" >&2
+  /usr/bin/python3 -c "import dolfinx, h5py, numba, matplotlib, venv" >&2 || true
+  exit 1
 fi
 
 # ParaView (pvpython, pvbatch) and xvfb-run: tests/system/test_paraview.py opens the fields as a user does.
 # Optional: where apt cannot install them, those tests are skipped and say why.
-if ! command -v pvpython >/dev/null 2>&1 || ! command -v xvfb-run >/dev/null 2>&1; then
+need=$(missing paraview xvfb)
+if [ -n "$need" ]; then
   echo "[bootstrap] installing ParaView and xvfb (Debian packages) for the field-reader tests"
-  { $sudo apt-get update -qq && DEBIAN_FRONTEND=noninteractive $sudo apt-get install -y -qq paraview xvfb >/dev/null; } \
+  { $sudo apt-get update -qq && DEBIAN_FRONTEND=noninteractive $sudo apt-get install -y -qq $need >/dev/null; } \
     || echo "[bootstrap] ParaView could not be installed: its tests will be skipped"
 fi
 
