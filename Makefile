@@ -17,7 +17,7 @@ export OMPI_MCA_rmaps_base_oversubscribe := 1
 export OMPI_MCA_mpi_yield_when_idle := 1
 export OMP_NUM_THREADS := 1
 
-.PHONY: setup run test lint bench clean
+.PHONY: setup run test lint bench clean notebook
 
 setup:
 	@bash tools/bootstrap.sh
@@ -32,6 +32,12 @@ test: setup
 	$(PY) -m pytest -q -m "not mpi" -n $(WORKERS) tests/unit
 	$(PY) -m pytest -q -m "not mpi" -n $(WORKERS) --dist loadgroup tests/system
 	mpirun -n $(NP) $(PY) -m pytest -q -m mpi -p no:cacheprovider tests
+
+# JupyterLab beside the kernel the set-up installs (fepen[notebook]: the pins that work with Debian's matplotlib);
+# then `.venv/bin/jupyter lab demos/` and open api_tour.py or rigid_study.py as a notebook
+notebook: setup
+	$(PY) -m pip install -q --disable-pip-version-check -c tools/constraints.txt -e ".[test,notebook]"
+	@echo "JupyterLab installed: .venv/bin/jupyter lab demos/   (right-click a .py demo: Open With > Notebook)"
 
 lint: setup
 	$(PY) -m ruff check --no-cache fepen tests demos benchmarks tools

@@ -4,7 +4,8 @@ Only the projectile is meshed (FEniCSx/dolfinx 0.5); the concrete acts through a
 resistance law applied node by node on the deformed projectile surface.
 
 The API (docs/api.md): ``fepen.Scene``, ``fepen.run(scene, out=None, comm=None) -> Result``,
-``fepen.load(results_dir) -> Result``, ``fepen.resume(results_dir)``, ``fepen.mesh(scene, out) -> dict``. The
+``fepen.load(results_dir) -> Result``, ``fepen.resume(results_dir)``, ``fepen.mesh(scene, out) -> dict``,
+``fepen.sweep(spec, out=None) -> pandas.DataFrame``. The
 layers, bottom up: ``laws`` (plain arrays), ``geometry``, ``solver`` (dolfinx), ``io``, ``post``, ``runs``, ``studies``.
 """
 
@@ -14,7 +15,7 @@ from pathlib import Path
 
 from fepen.version import __version__
 
-__all__ = ["Scene", "Result", "run", "load", "resume", "mesh", "InputError", "SimulationError", "MachineFault",
+__all__ = ["Scene", "Result", "run", "load", "resume", "mesh", "sweep", "InputError", "SimulationError", "MachineFault",
            "Interrupted", "__version__"]
 
 # numba highlights its error messages with colorama when colorama is installed (Debian's paraview brings
@@ -49,9 +50,14 @@ def _numba_cache_per_rank() -> None:
 _numba_cache_per_rank()
 
 
+def __dir__() -> list[str]:
+    """The API (``__all__``), for ``dir(fepen)`` and tab completion; not the helpers this file imports."""
+    return sorted(__all__)
+
+
 def __getattr__(name):
     """The API, imported on first use: ``import fepen`` stays cheap (no dolfinx, no MPI)."""
-    if name in ("Scene", "Result", "run", "load", "resume", "mesh"):
+    if name in ("Scene", "Result", "run", "load", "resume", "mesh", "sweep"):
         from fepen import api
 
         return getattr(api, name)

@@ -4,6 +4,7 @@
     result = fepen.run(scene, out="results/C3-rigid")
     result.summary["Hy_mm"], result.history["nose_y_mm"][-1]
     again = fepen.load("results/C3-rigid")
+    table = fepen.sweep({"base": {"effects.fidelity": "rigid"}, "grid": {"impact.velocity": [500.0, 700.0]}})
     info = fepen.mesh(scene, "results/C3-mesh")      # the mesh only, as ``fepen mesh``: info["cells"]
 
 Under ``mpirun -n N python script.py`` every rank calls ``fepen.run`` with the same arguments (or a
@@ -22,7 +23,7 @@ import numpy as np
 from fepen.errors import InputError
 from fepen.scene import Scene
 
-__all__ = ["Scene", "Result", "run", "load", "resume", "mesh"]
+__all__ = ["Scene", "Result", "run", "load", "resume", "mesh", "sweep"]
 
 
 @dataclass
@@ -103,6 +104,34 @@ def _comm(comm):
     return MPI.COMM_WORLD if comm is None else comm
 
 
+def _caller() -> str:
+    """Who called: "a Jupyter kernel", "an interactive session", or the script's path."""
+    import sys
+
+    if "ipykernel" in sys.modules:
+        return "a Jupyter kernel"
+    main = getattr(sys.modules.get("__main__"), "__file__", None)
+    return str(Path(main).resolve()) if main else "an interactive session"
+
+
+def _source(scene) -> str:
+    """How a scene was given, for run.json: a file's path, or its kind."""
+    if isinstance(scene, Scene):
+        return "a Scene"
+    if isinstance(scene, Path) or (isinstance(scene, str) and "\n" not in scene and "=" not in scene):
+        return repr(str(Path(scene).resolve()))
+    return "a dict" if isinstance(scene, dict) else "TOML text" if isinstance(scene, str) else type(scene).__name__
+
+
+def _record_call(name: str, scene, **kwargs) -> None:
+    """run.json's "command" for an API call: the call and who made it, not the interpreter's argv (a notebook
+    kernel's would say nothing); the scene itself is the results directory's scene.toml."""
+    from fepen.io import rundir
+
+    args = ", ".join([_source(scene)] + [f"{k}={v!r}" for k, v in kwargs.items()])
+    rundir.begin_command([f"fepen.{name}({args})", f"# from {_caller()}"])
+
+
 def run(scene, out=None, comm=None, progress: bool = False, force: bool = False) -> Result:
     """Run one scene, as ``fepen run`` does, and return its Result.
 
@@ -131,6 +160,7 @@ def run(scene, out=None, comm=None, progress: bool = False, force: bool = False)
     if out is None:
         out = comm.bcast(tempfile.mkdtemp(prefix="fepen-") if comm.rank == 0 else None, root=0)
     out = Path(out)
+    _record_call("run", scene, out=str(out), **({"force": True} if force else {}))
     run_in_directory(sc, out, comm, "force" if force else "new", progress=progress, sh=sh)
     return load(out)
 
@@ -147,8 +177,47 @@ def resume(results_dir, comm=None, progress: bool = False) -> Result:
     sc = Scene(out / "scene.toml")
     rigid = sc.effects.fidelity == "rigid"  # seconds to run: a stopped rigid run runs again from the start
     state = None if rigid else checkpoint.read_state(out, comm)
+    _record_call("resume", out)
     run_in_directory(sc, out, comm, "resume", progress=progress, resume=state)
     return load(out)
+
+
+def sweep(spec, out=None, comm=None, sets=(), fresh: bool = False, ranks_per_shot: int = 1, progress: bool = True):
+    """Run a sweep, as ``fepen sweep`` does on the ranks of ``comm``, and return its table (sweep.csv).
+
+    Args:
+        spec: a SWEEP.toml, or its content as a dict (docs/studies.md), e.g. ``{"base": {"effects.fidelity":
+            "rigid"}, "grid": {"impact.velocity": [500.0, 600.0, 700.0]}}``; a relative ``scene`` file is then
+            taken from the working directory.
+        out: the results directory (sweep.csv, sweep.md, figures; resumable); None: a new temporary directory.
+        comm: the communicator (None: COMM_WORLD); ranks_per_shot: ranks of each shot's group.
+        sets: ``KEY=VALUE`` overrides of the base scene. fresh: run every shot again.
+        progress: a progress bar of the shots on rank 0.
+
+    Returns:
+        A pandas DataFrame, one row per shot: ``shot``, the varied keys, ``status``, ``message`` and every
+        summary figure (docs/results.md), on every rank; ``DataFrame.attrs["out"]`` names the directory.
+
+    Raises:
+        InputError: bad input (naming the sweep or scene key), before any shot runs.
+    """
+    import pandas as pd
+
+    from fepen.studies import engine
+    from fepen.studies import sweep as fsweep
+
+    comm = _comm(comm)
+    engine.check_ranks_per_shot(ranks_per_shot, comm.size)
+    if out is None:
+        out = comm.bcast(tempfile.mkdtemp(prefix="fepen-sweep-") if comm.rank == 0 else None, root=0)
+    out = Path(out)
+    _record_call("sweep", spec, out=str(out))
+    say = (lambda *lines: print(*lines, sep="\n")) if progress and comm.rank == 0 else (lambda *lines: None)
+    fsweep.run(spec, out, comm, ranks_per_shot, sets, fresh, say=say)
+    comm.barrier()
+    table = pd.read_csv(out / "sweep.csv", keep_default_na=False, na_values=[""])
+    table.attrs["out"] = out
+    return table
 
 
 def mesh(scene, out, comm=None, force: bool = False) -> dict:

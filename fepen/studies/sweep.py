@@ -251,7 +251,9 @@ def read(path, sets=()) -> Sweep:
     """Read and check a sweep file; every shot's scene is resolved, so bad input stops here.
 
     Args:
-        path: the SWEEP.toml. sets: --set KEY=VALUE overrides of the base scene.
+        path: the SWEEP.toml, or its content as a dict (``{"base": {...}, "grid": {"impact.velocity": [...]}}``;
+            a relative ``scene`` or table ``file`` is then taken from the working directory).
+        sets: --set KEY=VALUE overrides of the base scene.
 
     Returns:
         The Sweep.
@@ -259,8 +261,11 @@ def read(path, sets=()) -> Sweep:
     Raises:
         InputError: naming the sweep key (or the shot and the scene key) and what is allowed.
     """
-    path = Path(path)
-    spec = _load(path)
+    if isinstance(path, dict):
+        spec, path = _sections(dict(path), "the sweep"), Path.cwd() / "sweep.toml"
+    else:
+        path = Path(path)
+        spec = _load(path)
     kinds = [k for k in ("grid", "monte_carlo", "table") if k in spec]
     if len(kinds) != 1:
         raise InputError("SWEEP", "give exactly one of [grid], [monte_carlo] and [table]")
@@ -296,10 +301,15 @@ def _load(path: Path) -> dict:
         raise InputError("SWEEP", f"cannot read {path}: {err.strerror}") from None
     except tomllib.TOMLDecodeError as err:
         raise InputError("SWEEP", f"{path} is not valid TOML: {err}") from None
+    return _sections(spec, str(path))
+
+
+def _sections(spec: dict, where: str) -> dict:
+    """The sweep's sections, checked by name (InputError naming an unknown one)."""
     known = {"scene", "base", "grid", "monte_carlo", "table", "output"}
     for k in spec:
         if k not in known:
-            raise InputError(k, f"not a sweep section; allowed: {', '.join(sorted(known))}")
+            raise InputError(k, f"not a sweep section of {where}; allowed: {', '.join(sorted(known))}")
     return spec
 
 
@@ -475,7 +485,8 @@ def run(path, out, comm=None, ranks_per_shot: int = 1, sets=(), fresh: bool = Fa
     """Read the sweep, run its missing shots on fepen.studies.engine, write the table, summary and figures.
 
     Args:
-        path: the SWEEP.toml. out: the results directory. comm: the communicator (None: COMM_WORLD).
+        path: the SWEEP.toml, or its content as a dict (read). out: the results directory.
+        comm: the communicator (None: COMM_WORLD).
         ranks_per_shot: ranks of each shot's group. sets: --set overrides of the base scene.
         fresh: run every shot again (the records in OUT are discarded).
         say: prints one line (rank 0).
@@ -499,7 +510,8 @@ def run(path, out, comm=None, ranks_per_shot: int = 1, sets=(), fresh: bool = Fa
         raise InputError(*err)
     out = files.prepare(out, comm)
     if comm.rank == 0:
-        files.write_json(out / "sweep.json", {"file": str(Path(path).resolve()), "digest": sweep.digest,
+        source = None if isinstance(path, dict) else str(Path(path).resolve())  # None: given as a dict
+        files.write_json(out / "sweep.json", {"file": source, "digest": sweep.digest,
                                               "kind": sweep.kind, "keys": sweep.keys, "shots": len(sweep.shots),
                                               "base": sweep.base, "spec": sweep.spec}, MPI.COMM_SELF)
     keep = sweep.keep_results

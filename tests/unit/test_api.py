@@ -93,3 +93,11 @@ def test_mesh_refuses_a_run_directory_before_meshing(tmp_path, monkeypatch):
     assert sorted(p.name for p in tmp_path.iterdir()) == ["scene.toml", "summary.json"]
     assert (tmp_path / "scene.toml").read_text() == "# the run's"
     assert "mesh" in fepen.__all__ and fepen.mesh is fepen.api.mesh
+
+
+def test_dir_lists_the_api():
+    import fepen
+
+    assert dir(fepen) == sorted(fepen.__all__)
+    assert {"run", "load", "resume", "mesh", "sweep", "Scene", "Result"} <= set(dir(fepen))
+    assert callable(fepen.sweep)
