@@ -86,11 +86,13 @@ def main():
     ap.add_argument("--size", type=float, default=0.004, help="element size (m)")
     ap.add_argument("--accel-g", type=float, default=5000.0)
     ap.add_argument("--json", action="store_true", help="print the figures as JSON lines")
+    ap.add_argument("--case", type=int, action="append", choices=range(len(CASES)),
+                    help="run only this case (0, 1, 2; repeatable; default: all three)")
     args = ap.parse_args()
     comm = MPI.COMM_WORLD
     if comm.rank == 0 and not args.json:
         print(f"{'case':24s} {'F/(m_c a)':>9} {'lateral':>8} {'max pen/h':>9} {'far gap mm':>10} {'energy err':>10}")
-    for name, mu, sign in CASES:
+    for name, mu, sign in (CASES[k] for k in args.case) if args.case else CASES:
         r = carry(mu, sign, args.size, args.accel_g, comm=comm)
         if comm.rank:
             continue

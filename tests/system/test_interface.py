@@ -17,15 +17,18 @@ def test_uniformly_decelerated_charge_loads_the_shell_with_its_inertia(ranks):
     Averaged over the hold, the wall's force on the charge is m_charge × a within 1 % and axial, decelerating
     (front end and step ring) and under set-back (shell base); with μ = 0 the lateral walls carry under 1 %
     of it, with μ = 0.1 their friction carries part; the end away from the load has opened; the wall never
-    interpenetrates by 1 % of the element size; energy balance within 1e-6. On 1 and 2 ranks."""
+    interpenetrates by 1 % of the element size; energy balance within 1e-6. On 1 rank all three cases; on 2
+    ranks the decelerating one with friction (the demo under mpirun; the MPI lane compares 1 and 2 ranks bit for
+    bit in test_rank_invariance)."""
     import json
 
     from conftest import ROOT, run_python
 
-    r = run_python(ROOT / "demos" / "charge" / "carried_charge.py", "--json", ranks=ranks)
+    only = ["--case", "1"] if ranks > 1 else []
+    r = run_python(ROOT / "demos" / "charge" / "carried_charge.py", "--json", *only, ranks=ranks)
     assert r.returncode == 0, r.stderr
     cases = {c["case"]: c for c in map(json.loads, r.stdout.splitlines())}
-    assert len(cases) == 3
+    assert len(cases) == (1 if only else 3)
     for name, c in cases.items():
         assert c["force_over_m_a"] == pytest.approx(1.0, abs=1e-2), name
         assert c["transverse_over_axial"] < 1e-3
