@@ -34,3 +34,28 @@ def test_docs_scenes_md_is_what_fepen_keys_prints(capsys):
     printed = capsys.readouterr().out
     assert (ROOT / "docs" / "scenes.md").read_text() == "# Scene keys\n\n" + printed, (
         "docs/scenes.md is stale: (printf '# Scene keys\\n\\n'; python -m fepen keys) > docs/scenes.md")
+
+
+# ---- the mesh cache where meshes/README.md says ------------------------------------------------------------
+def test_the_mesh_cache_of_a_source_checkout_is_its_meshes_cache(monkeypatch):
+    """Run from this checkout (the README's editable install), meshes go to the checkout's meshes/cache."""
+    from fepen.geometry import mesh
+
+    monkeypatch.delenv("FEPEN_MESH_CACHE", raising=False)
+    assert mesh.cache_dir() == ROOT / "meshes" / "cache"
+
+
+def test_fepen_mesh_cache_comes_first_and_an_installed_fepen_caches_in_home(monkeypatch, tmp_path):
+    """$FEPEN_MESH_CACHE wins; a fepen outside a checkout (site-packages: no pyproject.toml beside it, even
+    with a meshes/ folder there) caches in ~/.cache/fepen/meshes."""
+    from fepen.geometry import mesh
+
+    monkeypatch.setenv("FEPEN_MESH_CACHE", str(tmp_path / "mine"))
+    assert mesh.cache_dir() == tmp_path / "mine"
+    monkeypatch.delenv("FEPEN_MESH_CACHE")
+    site = tmp_path / "site-packages"
+    (site / "fepen" / "geometry").mkdir(parents=True)
+    (site / "meshes").mkdir()
+    monkeypatch.setattr(mesh, "__file__", str(site / "fepen" / "geometry" / "mesh.py"))
+    monkeypatch.setenv("HOME", str(tmp_path / "home"))
+    assert mesh.cache_dir() == tmp_path / "home" / ".cache" / "fepen" / "meshes"
