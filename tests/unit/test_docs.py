@@ -2,6 +2,9 @@
 allowed values come from the schema itself), and docs/scenes.md is exactly what ``fepen keys`` prints
 (regenerate it with ``(printf '# Scene keys\\n\\n'; python -m fepen keys) > docs/scenes.md``)."""
 
+import json
+import os
+import sys
 from pathlib import Path
 
 import pytest
@@ -59,3 +62,82 @@ def test_fepen_mesh_cache_comes_first_and_an_installed_fepen_caches_in_home(monk
     monkeypatch.setattr(mesh, "__file__", str(site / "fepen" / "geometry" / "mesh.py"))
     monkeypatch.setenv("HOME", str(tmp_path / "home"))
     assert mesh.cache_dir() == tmp_path / "home" / ".cache" / "fepen" / "meshes"
+
+
+# ---- fepen view: what it says without a display, when ParaView fails, and where a run has no fields --------
+@pytest.fixture
+def run_with_fields(tmp_path):
+    """A directory that looks like a run with fields (fepen view checks for fields.xdmf first)."""
+    out = tmp_path / "run"
+    out.mkdir()
+    (out / "fields.xdmf").write_text("<Xdmf/>\n")
+    return out
+
+
+@pytest.fixture
+def fake_paraview(tmp_path, monkeypatch):
+    """A `paraview` on PATH that records its arguments and exits with the code given (a display is set)."""
+
+    def make(code: int) -> Path:
+        bin_dir, record = tmp_path / "bin", tmp_path / "paraview-args"
+        bin_dir.mkdir(exist_ok=True)
+        exe = bin_dir / "paraview"
+        exe.write_text(f'#!/bin/sh\necho "$@" > "{record}"\nexit {code}\n')
+        exe.chmod(0o755)
+        monkeypatch.setenv("PATH", f"{bin_dir}:{os.environ['PATH']}")
+        monkeypatch.setenv("DISPLAY", ":99")
+        return record
+
+    return make
+
+
+def test_fepen_view_without_a_display_exits_2_with_one_line(run_with_fields, monkeypatch, capsys):
+    monkeypatch.delenv("DISPLAY", raising=False)
+    monkeypatch.delenv("WAYLAND_DISPLAY", raising=False)
+    monkeypatch.setattr(sys, "platform", "linux")
+    assert main(["view", str(run_with_fields)]) == 2
+    captured = capsys.readouterr()
+    assert captured.err == "fepen view: no display: use --png FILE (an offscreen picture)\n"
+    assert "shown" not in captured.out
+
+
+def test_fepen_view_reports_a_paraview_that_fails_and_exits_4(run_with_fields, fake_paraview, capsys):
+    record = fake_paraview(3)
+    assert main(["view", str(run_with_fields)]) == 4
+    captured = capsys.readouterr()
+    assert captured.err == "fepen view: ParaView exited with code 3 (its messages are above)\n"
+    assert "shown" not in captured.out
+    assert record.read_text().split() == [f"--script={run_with_fields / 'view.py'}"]
+
+
+def test_fepen_view_says_shown_when_paraview_ends_well(run_with_fields, fake_paraview, capsys):
+    fake_paraview(0)
+    assert main(["view", str(run_with_fields)]) == 0
+    assert capsys.readouterr().out.strip() == f"shown: {run_with_fields}"
+
+
+def test_the_display_rule_of_each_platform():
+    from fepen.post.paraview import has_display
+
+    assert not has_display({}, "linux")
+    assert has_display({"DISPLAY": ":0"}, "linux") and has_display({"WAYLAND_DISPLAY": "wayland-0"}, "linux")
+    assert has_display({}, "darwin") and has_display({}, "win32")
+
+
+@pytest.mark.parametrize("summary, said", [
+    ({"fidelity": "rigid", "scene": {"effects": {"fidelity": "rigid"}, "run": {"fields": True}}},
+     "is a rigid run, which writes no fields"),
+    ({"fidelity": "plastic", "scene": {"effects": {"fidelity": "plastic"}, "run": {"fields": False}}},
+     "the run had run.fields = false"),
+    ({"fidelity": "plastic", "scene": {"effects": {"fidelity": "plastic"}, "run": {"fields": True}}},
+     "the run wrote no output time"),
+    (None, "not a run's results directory"),
+])
+def test_fepen_view_of_a_run_without_fields_says_why_in_its_fidelitys_terms(tmp_path, capsys, summary, said):
+    """A rigid run is not told about run.fields (which means nothing to it)."""
+    if summary is not None:
+        (tmp_path / "summary.json").write_text(json.dumps(summary))
+    assert main(["view", str(tmp_path)]) == 2
+    err = capsys.readouterr().err
+    assert err.startswith("fepen: bad input: dir: ") and said in err and err.count("\n") == 1
+    assert ("run.fields" in err) == (said == "the run had run.fields = false")
