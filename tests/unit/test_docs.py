@@ -141,3 +141,10 @@ def test_fepen_view_of_a_run_without_fields_says_why_in_its_fidelitys_terms(tmp_
     err = capsys.readouterr().err
     assert err.startswith("fepen: bad input: dir: ") and said in err and err.count("\n") == 1
     assert ("run.fields" in err) == (said == "the run had run.fields = false")
+
+
+def test_a_running_rigid_run_is_read_from_its_scene_toml(tmp_path, capsys):
+    """Before summary.json exists, the given keys of scene.toml say what the run is."""
+    (tmp_path / "scene.toml").write_text('[effects]\nfidelity = "rigid"\n\n[run]\n# fields = true\n')
+    assert main(["view", str(tmp_path)]) == 2
+    assert "is a rigid run, which writes no fields" in capsys.readouterr().err
