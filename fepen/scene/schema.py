@@ -176,8 +176,9 @@ SCHEMA: dict[str, Key] = {
                                         doc="lambda of the Mohr-Coulomb shear strength Y + lambda p of the cavity "
                                             "expansion (its sigma_s, the plastic-zone ratio c/a)"),
     "target.crater_depth_factor": number(2.37, "", 0.0, 50.0,
-                                         doc="k: the crater stage (effects.crater 'linear' or 'energy') holds "
-                                             "while the nose tip is less than k projectile diameters deep"),
+                                         doc="k: the crater stage (effects.crater) reaches k projectile "
+                                             "diameters deep ('linear': while the nose tip is shallower; "
+                                             "'energy': on the surface points shallower)"),
     "target.strength_model": choice("scaled-S", "scaled-S", "forrestal-S", "cavity-expansion", "metal",
                                     doc="sigma_s = S fc with S = S_coefficient fc^-S_exponent / sqrt(1 + D/S_size) "
                                         "(fc in MPa): fepen's calibrated scaled-S or Forrestal's S = 82.6 "
@@ -246,7 +247,7 @@ SCHEMA: dict[str, Key] = {
     # --- effects: what is off costs nothing ---
     "effects.fidelity": choice("plastic", "rigid", "elastic", "plastic",
                                doc="the projectile: 'rigid', a rigid body of revolution without a mesh (RK4, "
-                                   "about a second a shot; docs/theory.md §9); 'elastic', a meshed deformable "
+                                   "under a second a shot; docs/theory.md §9); 'elastic', a meshed deformable "
                                    "body, elastic (explicit dynamics); 'plastic', the same with Johnson-Cook "
                                    "plasticity (the paper's)"),
     "effects.crater": choice("energy", "none", "linear", "energy",
