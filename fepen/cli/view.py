@@ -17,14 +17,36 @@ def add_arguments(parser) -> None:
 
 
 def run(args) -> int:
-    """Show the run DIR, or render it to --png."""
+    """Show the run DIR, or render it to --png.
+
+    Returns:
+        0 when shown or written; 2 without a display (and no --png), 4 when the ParaView GUI failed: each with
+        one line ``fepen view: ...`` on stderr.
+    """
     from pathlib import Path
 
     from fepen.post import paraview
 
     out = Path(args.dir)
     if not (out / "fields.xdmf").is_file():
-        raise InputError("dir", f"{out} holds no fields.xdmf (a run with run.fields = true writes it)")
-    paraview.show(out, args.field, args.time, args.png)
+        raise InputError("dir", paraview.missing_fields(out))
+    try:
+        paraview.show(out, args.field, args.time, args.png)
+    except (paraview.NoDisplay, paraview.ViewerFailed) as err:
+        _error(f"fepen view: {err}")
+        return err.exit_code
     say(f"written: {args.png}" if args.png else f"shown: {out}")
     return 0
+
+
+def _error(line: str) -> None:
+    """One line on stderr (rank 0), kept for fepen.log."""
+    import sys
+
+    from mpi4py import MPI
+
+    from fepen.io import rundir
+
+    if MPI.COMM_WORLD.rank == 0:
+        print(line, file=sys.stderr, flush=True)
+        rundir.log_line(line)

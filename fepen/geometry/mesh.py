@@ -66,13 +66,19 @@ class ProjectileMesh:
 
 
 def cache_dir() -> Path:
-    """Where meshes are cached: $FEPEN_MESH_CACHE, else meshes/cache in the source tree if writable, else
-    ~/.cache/fepen/meshes."""
+    """Where meshes are cached (meshes/README.md).
+
+    Returns:
+        $FEPEN_MESH_CACHE when it is set; else, when fepen runs from a source checkout (the README's editable
+        install: fepen/ beside pyproject.toml and meshes/), that checkout's meshes/cache if meshes/ can be
+        written; else ~/.cache/fepen/meshes (an installed fepen).
+    """
     env = os.environ.get("FEPEN_MESH_CACHE")
     if env:
         return Path(env)
-    here = Path(__file__).resolve().parents[1] / "meshes"
-    if here.is_dir() and os.access(here, os.W_OK):
+    project = Path(__file__).resolve().parents[2]  # fepen/geometry/mesh.py -> the checkout's root
+    here = project / "meshes"
+    if (project / "pyproject.toml").is_file() and here.is_dir() and os.access(here, os.W_OK):
         return here / "cache"
     return Path.home() / ".cache" / "fepen" / "meshes"
 

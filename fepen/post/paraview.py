@@ -9,9 +9,85 @@ renders one picture offscreen instead.
 
 from __future__ import annotations
 
+import os
+import sys
 from pathlib import Path
 
-__all__ = ["VIEW_SCRIPT", "write_view_script", "plot", "show", "render_png"]
+from fepen.errors import InputError, MachineFault
+
+__all__ = ["VIEW_SCRIPT", "write_view_script", "plot", "show", "render_png", "has_display", "missing_fields",
+           "NoDisplay", "ViewerFailed"]
+
+#: what ``fepen view`` without a display says (exit code 2)
+NO_DISPLAY = "no display: use --png FILE (an offscreen picture)"
+
+
+class NoDisplay(InputError):
+    """A window was asked for where there is no display (no $DISPLAY or $WAYLAND_DISPLAY on X11/Wayland
+    systems): exit code 2, ``--png`` renders offscreen instead."""
+
+    def __init__(self):
+        super().__init__("", NO_DISPLAY)
+
+    def __reduce__(self):
+        return (type(self), ())
+
+
+class ViewerFailed(MachineFault):
+    """The ParaView GUI exited with a non-zero code or on a signal (its own messages went to the terminal):
+    exit code 4, a fault of the machine (its graphics), not of the run."""
+
+
+def has_display(environ=None, platform: str | None = None) -> bool:
+    """Whether a window can open: on Linux and the BSDs (X11, Wayland) only with $DISPLAY or $WAYLAND_DISPLAY;
+    elsewhere (macOS, Windows) always.
+
+    Args:
+        environ: the environment (default os.environ). platform: sys.platform's value (default this one's).
+
+    Returns:
+        True when a GUI can be started.
+    """
+    environ = os.environ if environ is None else environ
+    platform = sys.platform if platform is None else platform
+    if not platform.startswith(("linux", "freebsd", "openbsd", "netbsd")):
+        return True
+    return bool(environ.get("DISPLAY") or environ.get("WAYLAND_DISPLAY"))
+
+
+def missing_fields(out: Path) -> str:
+    """Why the directory ``out`` holds no fields.xdmf, in words that fit its run: a rigid run writes none, a
+    deformable run with run.fields = false neither, a run that stopped before its first output time none yet.
+
+    Args:
+        out: the directory.
+
+    Returns:
+        One line naming the directory and the reason.
+    """
+    import json
+
+    out = Path(out)
+    fidelity = fields = None
+    try:
+        summary = json.loads((out / "summary.json").read_text())
+        fidelity = summary.get("fidelity") or summary["scene"]["effects"]["fidelity"]
+        fields = summary["scene"]["run"]["fields"]
+    except (OSError, ValueError, KeyError, TypeError):  # a running or killed run: its scene.toml, whose
+        try:                                              # given keys are values (the others comments)
+            import tomllib
+
+            given = tomllib.loads((out / "scene.toml").read_text())
+            fidelity = given.get("effects", {}).get("fidelity")
+            fields = given.get("run", {}).get("fields")
+        except (OSError, ValueError, AttributeError):
+            return f"{out} holds no fields.xdmf and no run's summary.json or scene.toml: not a run's results directory"
+    if fidelity == "rigid":
+        return (f"{out} is a rigid run, which writes no fields (history.csv and summary.json only); run the scene "
+                "with effects.fidelity = 'plastic' or 'elastic' to see the projectile")
+    if fields is False:
+        return f"{out} holds no fields.xdmf: the run had run.fields = false"
+    return f"{out} holds no fields.xdmf yet: the run wrote no output time (run.output_interval) before it stopped"
 
 VIEW_SCRIPT = '''"""This run in ParaView: the projectile warped by its displacement, coloured by von Mises stress, the
 target face (y = 0) drawn, the time controls on the output times (written by fepen).
@@ -110,18 +186,28 @@ def show(out: Path, field: str = "von_mises_Pa", time: float | None = None, png:
         out: results directory with fields.xdmf. field: the field to colour by. time: output time (s); None:
             the last. png: render one picture there, offscreen (pvpython, render_png), instead of opening the
             GUI.
+
+    Raises:
+        NoDisplay: a window asked for (no ``png``) without a display (has_display).
+        ViewerFailed: the ParaView GUI exited with a non-zero code or on a signal.
     """
     import shutil
     import subprocess
 
     out = Path(out)
+    if not png and not has_display():
+        raise NoDisplay()
     script = out / "view.py"
     if not script.is_file():  # a run from before view.py was written
         write_view_script(out)
     if png and shutil.which("pvpython"):
         render_png(script, png, [*(["--time", repr(time)] if time is not None else []), "--field", field])
     elif not png and shutil.which("paraview"):
-        subprocess.run(["paraview", f"--script={script}"], check=False)
+        code = subprocess.run(["paraview", f"--script={script}"], check=False).returncode
+        if code < 0:
+            raise ViewerFailed(f"ParaView was killed by signal {-code}")
+        if code:
+            raise ViewerFailed(f"ParaView exited with code {code} (its messages are above)")
     else:
         plot(out, field, time, png)
 

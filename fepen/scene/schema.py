@@ -50,7 +50,8 @@ SCHEMA: dict[str, Key] = {
     "projectile.cad_scale": positive(1.0, "m per file unit", 1.0e3, doc="lengths of projectile.cad times this are "
                                                                          "metres (0.001 for a file in mm)"),
     "projectile.diameter": number(0.0236, "m", 1.0e-3, 1.0, doc="calibre (fepen's laws are for 1 mm and more)"),
-    "projectile.length": number(0.144, "m", 1.0e-3, 10.0),
+    "projectile.length": number(0.144, "m", 1.0e-3, 10.0, doc="overall length, nose tip to rear face (nose and "
+                                                             "boat-tail included)"),
     "projectile.crh": number(3.0, "", 0.5, 50.0, doc="ogive radius over diameter (0.5: hemisphere)"),
     "projectile.mass": positive(0.367, "kg", 1.0e4,
                                 doc="total mass; the cavity is sized, reduced or dropped to reach it (theory §1.1)"),
@@ -66,25 +67,49 @@ SCHEMA: dict[str, Key] = {
     "projectile.material.name": choice("45-steel", *STEELS, doc="a named steel of fepen/data/steels.toml: sets "
                                        "every projectile.material key not given explicitly (sources: "
                                        "docs/theory.md §4)"),
-    "projectile.material.density": number(7850.0, "kg/m^3", 100.0, 30000.0),
-    "projectile.material.youngs_modulus": number(210.0e9, "Pa", 1.0e6, 1.0e13),
-    "projectile.material.poisson_ratio": number(0.3, "", 0.0, 0.5, hi_open=True),
-    "projectile.material.A": number(950.0e6, "Pa", 0.0, 1.0e11, lo_open=True),
-    "projectile.material.B": number(725.0e6, "Pa", 0.0, 1.0e11),
-    "projectile.material.n": number(0.375, "", 0.0, 2.0, lo_open=True),
-    "projectile.material.C": number(0.015, "", 0.0, 1.0),
-    "projectile.material.m": number(0.625, "", 0.0, 10.0, lo_open=True),
-    "projectile.material.melt_temperature": number(1765.0, "K", 0.0, 1.0e4, lo_open=True),
-    "projectile.material.room_temperature": number(294.0, "K", 0.0, 1.0e4, lo_open=True),
-    "projectile.material.reference_strain_rate": positive(1.0, "1/s", 1.0e9),
-    "projectile.material.specific_heat": positive(470.0, "J/(kg K)", 1.0e5),
-    "projectile.material.taylor_quinney": number(0.9, "", 0.0, 1.0),
+    "projectile.material.density": number(7850.0, "kg/m^3", 100.0, 30000.0,
+                                          doc="density of the steel body (shell); with projectile.mass it sizes "
+                                              "the cavity"),
+    "projectile.material.youngs_modulus": number(210.0e9, "Pa", 1.0e6, 1.0e13,
+                                                 doc="E of the steel (elastic and plastic fidelities; it sets "
+                                                     "the stable time step)"),
+    "projectile.material.poisson_ratio": number(0.3, "", 0.0, 0.5, hi_open=True, doc="nu of the steel"),
+    "projectile.material.A": number(950.0e6, "Pa", 0.0, 1.0e11, lo_open=True,
+                                    doc="Johnson-Cook yield stress at zero plastic strain: sigma_y = (A + B "
+                                        "eps_p^n)(1 + C ln(rate/rate_0))(1 - T*^m) (plastic fidelity; "
+                                        "docs/theory.md §4)"),
+    "projectile.material.B": number(725.0e6, "Pa", 0.0, 1.0e11,
+                                    doc="Johnson-Cook hardening modulus: the B of B eps_p^n"),
+    "projectile.material.n": number(0.375, "", 0.0, 2.0, lo_open=True,
+                                    doc="Johnson-Cook hardening exponent: the n of B eps_p^n"),
+    "projectile.material.C": number(0.015, "", 0.0, 1.0,
+                                    doc="Johnson-Cook strain-rate coefficient of 1 + C ln(rate/rate_0), the factor "
+                                        "floored at 1 (effects.strain_rate)"),
+    "projectile.material.m": number(0.625, "", 0.0, 10.0, lo_open=True,
+                                    doc="Johnson-Cook thermal-softening exponent of 1 - T*^m, T* = (T - "
+                                        "room_temperature)/(melt_temperature - room_temperature) in [0, 1] "
+                                        "(effects.thermal)"),
+    "projectile.material.melt_temperature": number(1765.0, "K", 0.0, 1.0e4, lo_open=True,
+                                                   doc="T_melt of T* (no strength at it), and of the heat that "
+                                                       "melts the surface under effects.wear"),
+    "projectile.material.room_temperature": number(294.0, "K", 0.0, 1.0e4, lo_open=True,
+                                                   doc="T_room of T*: the projectile's initial temperature"),
+    "projectile.material.reference_strain_rate": positive(1.0, "1/s", 1.0e9,
+                                                          doc="rate_0 of the rate term: no rate hardening "
+                                                              "below it"),
+    "projectile.material.specific_heat": positive(470.0, "J/(kg K)", 1.0e5,
+                                                  doc="c_p of the adiabatic heating (effects.thermal) and of the "
+                                                      "melt enthalpy of effects.wear"),
+    "projectile.material.taylor_quinney": number(0.9, "", 0.0, 1.0,
+                                                 doc="beta: the fraction of the plastic work turned into heat "
+                                                     "(effects.thermal)"),
     "projectile.wear.efficiency": number(0.4437, "", 0.0, 1.0,
                                          doc="eta: the fraction of the interface heat that melts the surface off "
                                              "(effects.wear; docs/theory.md §14), calibrated once on the paper's "
                                              "recovered projectiles (docs/wear.md §2)"),
     "projectile.wear.friction": number(ABSENT, "", 0.0, 2.0,
-                                       doc="mu of the interface heat mu sigma_n |v_t|; absent: target.friction"),
+                                       doc="mu of the interface heat mu sigma_n v_t (v_t the sliding speed); "
+                                           "absent: target.friction"),
     "projectile.wear.distribution": choice("nose", "nose", "surface",
                                            doc="where the melted mass leaves: 'nose', the nose shortens along its "
                                                "axis keeping its kind (docs/theory.md §14.3); 'surface', each "
@@ -101,13 +126,22 @@ SCHEMA: dict[str, Key] = {
                                         doc="PEEQ at which a concrete-target run stops, beyond the method "
                                            "(docs/theory.md); absent: never (a mushrooming nose keeps running)"),
     # --- explosive charge (Table 4) ---
-    "charge.material.density": number(1850.0, "kg/m^3", 100.0, 30000.0),
-    "charge.material.youngs_modulus": number(10.1e9, "Pa", 1.0e5, 1.0e13),
-    "charge.material.poisson_ratio": number(0.3, "", 0.0, 0.5, hi_open=True),
-    "charge.material.yield_stress": positive(45.0e6, "Pa", 1.0e11),
-    "charge.material.tangent_modulus": number(600.0e6, "Pa", 0.0, 1.0e12),
-    "charge.friction": number(0.1, "", 0.0, 2.0),
-    "charge.contact": choice("frictional", "frictional", "tied", doc="shell-charge interface"),
+    "charge.material.density": number(1850.0, "kg/m^3", 100.0, 30000.0,
+                                      doc="density of the explosive filling the cavity (effects.charge; Table 4)"),
+    "charge.material.youngs_modulus": number(10.1e9, "Pa", 1.0e5, 1.0e13, doc="E of the charge"),
+    "charge.material.poisson_ratio": number(0.3, "", 0.0, 0.5, hi_open=True, doc="nu of the charge"),
+    "charge.material.yield_stress": positive(45.0e6, "Pa", 1.0e11,
+                                             doc="sigma_0 of the charge's bilinear hardening sigma_y = sigma_0 + "
+                                                 "H eps_p"),
+    "charge.material.tangent_modulus": number(600.0e6, "Pa", 0.0, 1.0e12,
+                                              doc="E_t, the slope of stress against total strain past yield: "
+                                                  "H = E E_t/(E - E_t)"),
+    "charge.friction": number(0.1, "", 0.0, 2.0, doc="Coulomb mu of the shell-charge interface (charge.contact "
+                                                     "= 'frictional'; docs/theory.md §13)"),
+    "charge.contact": choice("frictional", "frictional", "tied",
+                             doc="the shell-charge interface: 'frictional', the charge has nodes of its own on "
+                                 "the cavity wall, the interface opens and slides with Coulomb friction "
+                                 "(charge.friction); 'tied', shell and charge share the wall's nodes (bonded)"),
     # --- target (Table 3; the law: docs/paper.md §4) ---
     "target.kind": choice("concrete", "concrete", "rigid-wall",
                           doc="'concrete': a cavity-expansion target of target.material (or target.layers); "
@@ -115,85 +149,157 @@ SCHEMA: dict[str, Key] = {
     "target.material": choice("concrete", *TARGETS, doc="a named target of fepen/data/targets.toml: its law's "
                               "family and every target constant not given explicitly (docs/theory.md §16)"),
     "target.layers": Key(list, ABSENT, doc="[[target.layers]] tables front to back: material, thickness (m; "
-                                           "absent on the last: semi-infinite), gap (m, the air gap after it), and "
-                                           "any target constant overriding the material's (docs/theory.md §17)",
+                                           "absent on the last: semi-infinite), gap (m, the air gap after it), "
+                                           "crater ('none' or 'energy'; absent: effects.crater when given, else "
+                                           "the material's), and any target constant overriding the material's "
+                                           "(docs/theory.md §17); absent: one target of target.material",
                          form="a list of tables {material, thickness, gap, ...}", rows=_layers),
     "target.yield_stress": positive(ABSENT, "Pa", 1.0e11, doc="Y of a metal target (strength_model 'metal')"),
     "target.hardening_exponent": number(ABSENT, "", 0.0, 1.0, hi_open=True,
-                                        doc="n of a metal target's power-law hardening Y (E eps / Y)^n"),
+                                        doc="n of a metal target's power-law hardening sigma = Y (E eps / Y)^n "
+                                            "(strength_model 'metal')"),
     "target.compressive_strength": number(40.0e6, "Pa", 1.0e5, 1.0e10,
-                                          doc="f_c, on target.strength_basis (a cube value is converted)"),
+                                          doc="f_c, the unconfined compressive strength, on "
+                                              "target.strength_basis (a cube value is converted); the default "
+                                              "'concrete' gives 40 MPa on cubes (31.9 MPa cylinder)"),
     "target.strength_basis": choice("cylinder", "cylinder", "cube",
                                     doc="what compressive_strength was measured on: 'cylinder' (f_c, ACI/ASTM), "
                                         "or 'cube' (150 mm cubes, e.g. GB 50010 grades), converted to f_c by "
                                         "Eurocode 2 Table 3.1 (docs/theory.md §8.1)"),
-    "target.density": number(2400.0, "kg/m^3", 100.0, 30000.0),
-    "target.youngs_modulus": positive(ABSENT, "Pa", 1.0e13, doc="absent: 4.7 sqrt(f_c / MPa) GPa (ACI 318)"),
-    "target.tensile_strength": positive(ABSENT, "Pa", 1.0e10, doc="absent: compressive_strength / 10"),
-    "target.pressure_hardening": number(0.67, "", 0.0, 3.0, hi_open=True, doc="lambda of Mohr-Coulomb"),
-    "target.crater_depth_factor": number(2.37, "", 0.0, 50.0, doc="crater depth k over diameter"),
+    "target.density": number(2400.0, "kg/m^3", 100.0, 30000.0,
+                             doc="rho of the target: the inertial term B rho (v.n)^2 of the normal stress and "
+                                 "the energy crater (docs/theory.md §8.2-8.3); target.material's when not given"),
+    "target.youngs_modulus": positive(ABSENT, "Pa", 1.0e13, doc="E of the target; absent: 4.7 sqrt(f_c / MPa) GPa "
+                                                                       "(ACI 318, f_c the cylinder strength)"),
+    "target.tensile_strength": positive(ABSENT, "Pa", 1.0e10, doc="f_t; absent: the cylinder f_c / 10"),
+    "target.pressure_hardening": number(0.67, "", 0.0, 3.0, hi_open=True,
+                                        doc="lambda of the Mohr-Coulomb shear strength Y + lambda p of the cavity "
+                                            "expansion (its sigma_s, the plastic-zone ratio c/a)"),
+    "target.crater_depth_factor": number(2.37, "", 0.0, 50.0,
+                                         doc="k: the crater stage (effects.crater) reaches k projectile "
+                                             "diameters deep ('linear': while the nose tip is shallower; "
+                                             "'energy': on the surface points shallower)"),
     "target.strength_model": choice("scaled-S", "scaled-S", "forrestal-S", "cavity-expansion", "metal",
                                     doc="sigma_s = S fc with S = S_coefficient fc^-S_exponent / sqrt(1 + D/S_size) "
                                         "(fc in MPa): fepen's calibrated scaled-S or Forrestal's S = 82.6 "
                                         "fc^-0.544; or the paper's elastic-cracked-plastic cavity expansion; or "
                                         "'metal': Forrestal-Warren's power-law metal (yield_stress, "
                                         "hardening_exponent)"),
-    "target.S_coefficient": positive(ABSENT, "", 1.0e4, doc="absent: the strength model's"),
-    "target.S_exponent": number(ABSENT, "", 0.0, 2.0, doc="absent: the strength model's"),
-    "target.S_size": positive(ABSENT, "m", 1.0e6, doc="Bazant's D0 of the size effect; absent: the strength model's"),
+    "target.S_coefficient": positive(ABSENT, "", 1.0e4,
+                                     doc="a of S = a (f_c/MPa)^-b / sqrt(1 + D/S_size), sigma_s = S f_c "
+                                         "(strength_model 'scaled-S' or 'forrestal-S'); absent: the model's "
+                                         "(scaled-S 132.1, with effects.wear 124.6, with effects.friction "
+                                         "62.59; forrestal-S 82.6)"),
+    "target.S_exponent": number(ABSENT, "", 0.0, 2.0, doc="b of S (above); absent: the strength model's 0.544"),
+    "target.S_size": positive(ABSENT, "m", 1.0e6,
+                              doc="D0 of S (above), Bazant's size effect in the projectile diameter D; absent: "
+                                  "the model's (scaled-S 0.05631, with wear 0.06291, with friction 0.06558; "
+                                  "forrestal-S none)"),
     "target.quasi_static_stress": positive(ABSENT, "Pa", 1.0e11,
                                            doc="overrides the strength model's sigma_s; absent: computed"),
-    "target.inertial_factor": number(1.0, "", 0.0, 10.0, doc="B of sigma_n = sigma_s + B rho (v.n)^2"),
+    "target.inertial_factor": number(1.0, "", 0.0, 10.0,
+                                     doc="B of the normal stress sigma_n = sigma_s + B rho (v.n)^2 (v.n: the "
+                                         "surface's speed into the target); metals 1.5"),
     "target.friction": number(0.1, "", 0.0, 2.0, doc="Coulomb (static) coefficient, used when effects.friction"),
     "target.friction_dynamic": number(ABSENT, "", 0.0, 2.0,
                                       doc="mu_d of mu(v_t) = mu_d + (mu - mu_d) exp(-c v_t); absent: target.friction"),
     "target.friction_decay": number(0.0, "s/m", 0.0, 1.0e3, doc="c of the sliding law; 0: constant Coulomb mu"),
-    "target.separation_angle_deg": number(0.0, "deg", 0.0, 90.0, hi_open=True),
+    "target.separation_angle_deg": number(0.0, "deg", 0.0, 90.0, hi_open=True,
+                                          doc="phi_min of effects.separation: a surface point that meets its "
+                                              "direction of motion at less than this angle (sin phi = v.n / speed "
+                                              "<= sin phi_min) carries no load; 0: only points moving off the "
+                                              "surface (v.n <= 0) are unloaded; the default target.material "
+                                              "'concrete' gives 12 (calibrated; docs/theory.md §8.4)"),
     "target.onset_angle_deg": number(2.0, "deg", 0.0, 30.0,
-                                     doc="sigma_s develops over this first surface angle (0: at once)"),
-    "target.thickness": positive(ABSENT, "m", 100.0, doc="absent: semi-infinite"),
+                                     doc="phi_r: sigma_s grows linearly in sin phi over this first angle "
+                                         "between the surface and the motion (a grazing point hardly expands "
+                                         "the cavity); 0: at once, the paper's sharp switch (docs/theory.md §9)"),
+    "target.thickness": positive(ABSENT, "m", 100.0,
+                                 doc="slab thickness along the normal: the rear face at depth thickness (outcome "
+                                     "'perforated' past it); absent: semi-infinite"),
     "target.lock_density": number(2650.0, "kg/m^3", 100.0, 30000.0,
-                                  doc="Q1, density of fully compacted concrete (energy crater)"),
+                                  doc="Q1, density of fully compacted concrete (energy crater); rock: its "
+                                      "grain density"),
     "target.crush_strain": number(ABSENT, "", 0.0, 1.0, lo_open=True,
                                   doc="epsilon of the energy crater's strength energy; absent: 1 - density / "
-                                      "lock_density"),
+                                      "lock_density; the default 'concrete' gives 0.376 (calibrated)"),
     "target.free_surface_range": number(1.0, "", 0.0, 20.0, lo_open=True,
                                         doc="reach of the free face on sigma_s, in plastic-zone widths "
-                                            "(effects.free_surface; docs/theory.md §8.4)"),
+                                            "(effects.free_surface; docs/theory.md §8.4); the default "
+                                            "'concrete' gives 2 (calibrated)"),
     # --- striking conditions (Table 1; defaults are shot C3) ---
-    "impact.velocity": number(_C3.v0, "m/s", 0.0, 3000.0, lo_open=True),
-    "impact.obliquity_deg": number(_C3.obliquity_deg, "deg", 0.0, 90.0, hi_open=True),
-    "impact.attack_deg": number(_C3.attack_deg, "deg", -90.0, 90.0, lo_open=True, hi_open=True),
-    "impact.shot": Key(str, ABSENT, choices=tuple(SHOTS), doc="fills the three above from Table 1"),
+    "impact.velocity": number(_C3.v0, "m/s", 0.0, 3000.0, lo_open=True,
+                              doc="striking speed of the whole projectile when its nose tip touches the face at "
+                                  "the impact point O, along impact.obliquity_deg"),
+    "impact.obliquity_deg": number(_C3.obliquity_deg, "deg", 0.0, 90.0, hi_open=True,
+                                   doc="angle of the velocity from the target's normal; the velocity is v (sin a, "
+                                       "cos a) in the reported frame (x along the face, y depth; "
+                                       "docs/results.md), so +x is the direction of travel along the face; 0: "
+                                       "normal impact"),
+    "impact.attack_deg": number(_C3.attack_deg, "deg", -90.0, 90.0, lo_open=True, hi_open=True,
+                                doc="angle of attack: the projectile's axis from its velocity, in the same plane; "
+                                    "positive turns the nose further from the normal, toward +x (the axis at "
+                                    "obliquity + attack from the normal), negative back toward the normal "
+                                    "(docs/theory.md §7)"),
+    "impact.shot": Key(str, ABSENT, choices=tuple(SHOTS),
+                       doc="a test of the paper's Table 1: sets the three above to the shot's and compares the "
+                           "result with the test (summary.json experiment)"),
     # --- effects: what is off costs nothing ---
-    "effects.fidelity": choice("plastic", "rigid", "elastic", "plastic"),
-    "effects.crater": choice("energy", "none", "linear", "energy"),
-    "effects.separation": flag(True),
-    "effects.free_surface": flag(True),
-    "effects.friction": flag(False),
+    "effects.fidelity": choice("plastic", "rigid", "elastic", "plastic",
+                               doc="the projectile: 'rigid', a rigid body of revolution without a mesh (RK4, "
+                                   "under a second a shot; docs/theory.md §9); 'elastic', a meshed deformable "
+                                   "body, elastic (explicit dynamics); 'plastic', the same with Johnson-Cook "
+                                   "plasticity (the paper's)"),
+    "effects.crater": choice("energy", "none", "linear", "energy",
+                             doc="the crater stage near the face (target.crater_depth_factor): 'none', the "
+                                 "tunnel law from the face; 'linear', Forrestal's force rising linearly with "
+                                 "depth; 'energy', the paper's splash streamline (the medium thrown out unloads "
+                                 "the point); not given: the target material's ('none' for metals and soil; "
+                                 "docs/theory.md §8.3)"),
+    "effects.separation": flag(True, doc="flow separation: surface points meeting their motion at less than "
+                                         "target.separation_angle_deg carry no load (docs/theory.md §8.4)"),
+    "effects.free_surface": flag(True, doc="the target's faces cut the cavity expansion's plastic zone: sigma_s "
+                                           "falls toward the strength near a face (target.free_surface_range)"),
+    "effects.friction": flag(False, doc="Coulomb friction of the target: shear target.friction sigma_n against "
+                                        "the sliding velocity (scaled-S then takes its constants refitted with "
+                                        "friction; docs/theory.md §8.1, §8.4); off: frictionless"),
     "effects.wear": flag(False, doc="nose wear: the interface heat melts mass off the surface (rigid fidelity: "
                                     "the mass loss; deformable: the surface recedes; docs/theory.md §14)"),
     "effects.erosion": flag(False, doc="element erosion of the meshed projectile: cells past projectile.erosion.* "
                                        "are removed, the faces they expose loaded (docs/theory.md §15)"),
-    "effects.thermal": flag(True),
-    "effects.strain_rate": flag(True),
-    "effects.charge": flag(False),
+    "effects.thermal": flag(True, doc="plastic fidelity: adiabatic heating (taylor_quinney) and Johnson-Cook's "
+                                      "thermal softening 1 - T*^m, the temperature_K field; off: the projectile "
+                                      "stays at room_temperature"),
+    "effects.strain_rate": flag(True, doc="plastic fidelity: Johnson-Cook's rate term 1 + C ln(rate/rate_0); "
+                                          "off: rate-independent"),
+    "effects.charge": flag(False, doc="the cavity filled with the explosive charge (charge.*): meshed as a "
+                                      "second body by the elastic and plastic fidelities, its mass and "
+                                      "inertia counted by the rigid one (docs/charge.md)"),
     # --- mesh ---
-    "mesh.size": number(0.0025, "m", 2.0e-4, 0.05, doc="nominal element size"),
+    "mesh.size": number(0.0025, "m", 2.0e-4, 0.05,
+                        doc="nominal tetrahedron size of the elastic and plastic fidelities' mesh (the rigid "
+                            "fidelity has none: mesh.rigid_panel)"),
     "mesh.rigid_panel": number(ABSENT, "m", 2.0e-4, 0.5,
                                doc="meridian panel of the rigid fidelity's load rings; absent: diameter / 6"),
     "mesh.nose_size": number(ABSENT, "m", 2.0e-4, 0.05, doc="element size at the nose tip; absent: mesh.size"),
     "mesh.optimize": choice("netgen", "none", "gmsh", "netgen",
                             doc="tetrahedron optimiser; the stable step is set by the worst element"),
     # --- run control ---
-    "run.end_time": positive(ABSENT, "s", 1.0, doc="absent: until stopped, perforated or ricocheted"),
-    "run.output_interval": positive(5.0e-5, "s", 1.0),
+    "run.end_time": positive(ABSENT, "s", 1.0,
+                             doc="simulated time after the first contact at which the run ends (outcome "
+                                 "'ended'); absent: until the projectile stops, perforates, ricochets or "
+                                 "rebounds (at most 5 ms deformable, 50 ms rigid, or 20 times the time to "
+                                 "reach a layered target's last face if longer)"),
+    "run.output_interval": positive(5.0e-5, "s", 1.0,
+                                    doc="simulated time between field outputs (fields.xdmf); a deformable run's "
+                                        "history.csv records every tenth of it, at most 1 us apart"),
     "run.safety_factor": number(0.8, "", 0.0, 1.0, lo_open=True,
                                 doc="stable step = factor * (the estimate of run.stable_step)"),
     "run.stable_step": choice("eigenvalue", "altitude", "eigenvalue",
                               doc="eigenvalue: 2/omega_max of the discrete body (power iteration), tracked "
                                   "by h/c as it deforms; altitude: min h/c (conservative)"),
-    "run.fields": flag(True, doc="write fields.xdmf"),
+    "run.fields": flag(True, doc="write fields.xdmf + fields.h5 and the pictures made from them (elastic and "
+                                 "plastic fidelities; a rigid run writes no fields)"),
     "run.acceleration_filter_hz": number(1.0e4, "Hz", 0.0, 1.0e7,
                                          doc="low-pass cut-off of the filtered accelerations (accelerations.csv); "
                                              "0: none"),
