@@ -67,9 +67,10 @@ class Result:
         """The projectile at an output time (the last by default) warped by its displacement, coloured by
         ``field``, with the target face (pyvista; ``png``: write the picture offscreen instead of showing it).
         Returns the pyvista Plotter. ParaView: ``fepen view DIR`` or ``paraview --script=DIR/view.py``."""
-        if self.fields is None:
-            raise InputError("run.fields", f"{self.out} holds no fields.xdmf (the run had run.fields = false)")
         from fepen.post import paraview
+
+        if self.fields is None:
+            raise InputError("run.fields", paraview.missing_fields(self.out))
 
         return paraview.plot(self.out, field, time, png)
 
@@ -129,7 +130,7 @@ def _record_call(name: str, scene, **kwargs) -> None:
     from fepen.io import rundir
 
     args = ", ".join([_source(scene)] + [f"{k}={v!r}" for k, v in kwargs.items()])
-    rundir.begin_command([f"fepen.{name}({args})", f"# from {_caller()}"])
+    rundir.api_call([f"fepen.{name}({args})", f"# from {_caller()}"])
 
 
 def run(scene, out=None, comm=None, progress: bool = False, force: bool = False) -> Result:
@@ -154,13 +155,13 @@ def run(scene, out=None, comm=None, progress: bool = False, force: bool = False)
     from fepen.runs import resolve, run_in_directory, setup
 
     comm = _comm(comm)
+    _record_call("run", scene, out=None if out is None else str(out), **({"force": True} if force else {}))
     sc = scene if isinstance(scene, Scene) else Scene(scene)
     sh = resolve(sc)  # bad input before anything is written; the projectile built once
     setup.announce(sc, comm, sh.built)
     if out is None:
         out = comm.bcast(tempfile.mkdtemp(prefix="fepen-") if comm.rank == 0 else None, root=0)
     out = Path(out)
-    _record_call("run", scene, out=str(out), **({"force": True} if force else {}))
     run_in_directory(sc, out, comm, "force" if force else "new", progress=progress, sh=sh)
     return load(out)
 
@@ -171,13 +172,13 @@ def resume(results_dir, comm=None, progress: bool = False) -> Result:
     from fepen.runs import checkpoint, run_in_directory
 
     comm = _comm(comm)
+    _record_call("resume", results_dir)
     out = Path(results_dir)
     if not (out / "scene.toml").exists():
         raise InputError("--resume", f"{out} is not a results directory (no scene.toml)")
     sc = Scene(out / "scene.toml")
     rigid = sc.effects.fidelity == "rigid"  # seconds to run: a stopped rigid run runs again from the start
     state = None if rigid else checkpoint.read_state(out, comm)
-    _record_call("resume", out)
     run_in_directory(sc, out, comm, "resume", progress=progress, resume=state)
     return load(out)
 
@@ -207,11 +208,11 @@ def sweep(spec, out=None, comm=None, sets=(), fresh: bool = False, ranks_per_sho
     from fepen.studies import sweep as fsweep
 
     comm = _comm(comm)
+    _record_call("sweep", spec, out=None if out is None else str(out))
     engine.check_ranks_per_shot(ranks_per_shot, comm.size)
     if out is None:
         out = comm.bcast(tempfile.mkdtemp(prefix="fepen-sweep-") if comm.rank == 0 else None, root=0)
     out = Path(out)
-    _record_call("sweep", spec, out=str(out))
     say = (lambda *lines: print(*lines, sep="\n")) if progress and comm.rank == 0 else (lambda *lines: None)
     fsweep.run(spec, out, comm, ranks_per_shot, sets, fresh, say=say)
     comm.barrier()

@@ -82,6 +82,15 @@ def main(argv: list[str] | None = None) -> int:
 
     argv = list(sys.argv[1:] if argv is None else argv)
     rundir.begin_command(["fepen", *map(str, argv)])  # run.json's "command"
+    rundir._in_cli = True  # the API calls of the command keep this line
+    try:
+        return _main(argv)
+    finally:
+        rundir._in_cli = False
+
+
+def _main(argv: list[str]) -> int:
+    """main's command, with ``argv`` the command line's arguments."""
     debug = "--debug" in argv
     argv = [a for a in argv if a != "--debug"]
     try:

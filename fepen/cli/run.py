@@ -30,8 +30,8 @@ def run(args) -> int:
     else:
         result = api.run(api.Scene(args.scene, sets=args.sets), out=args.out, progress=True, force=args.force)
     summary, out = result.summary, result.out
-    keys = ("outcome", "Hx_mm", "Hy_mm", "Tx_mm", "Ty_mm", "length_mm", "residual_speed_m_s", "max_peeq",
-            "energy_error", "steps", "dt_s", "wall_s")
+    keys = ("outcome", "Hx_mm", "Hy_mm", "Tx_mm", "Ty_mm", "length_mm", "residual_speed_m_s",
+            *(("max_peeq",) if summary.get("fidelity") != "rigid" else ()), "energy_error", "steps", "dt_s", "wall_s")
     keys += tuple(k for k in ("mass_loss_kg", "mass_loss_percent") if k in summary)
     say(*(f"{k} = {summary[k]:.6g}" if isinstance(summary[k], float) else f"{k} = {summary[k]}"
           for k in keys), f"written: {out}/summary.json, history.csv, history.png"

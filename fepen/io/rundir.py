@@ -47,6 +47,17 @@ _transcript: list[str] = []
 _command_line: list[str] | None = None
 
 
+#: True while fepen.cli.main runs a command: the API calls it makes leave its command line in place
+_in_cli = False
+
+
+def api_call(command: list[str]) -> None:
+    """A call of the Python API (fepen.api) begins: it is the command run.json records, unless the API call is
+    made by a ``fepen`` command line (whose line stays the record)."""
+    if not _in_cli:
+        begin_command(command)
+
+
 def begin_command(command: list[str] | None) -> None:
     """A new command (fepen.cli.main calls it first): the command line the run directories it claims record
     (None: this process's ``sys.argv``), no log yet, nothing kept. The one way to set the recorded command
