@@ -167,6 +167,7 @@ def hazard_figure(out: Path, haz, rows: np.ndarray, columns: list[str]) -> Path:
         a.plot(y, peeq, color="C3", label="largest PEEQ of the surface cells")
         a.set(xlabel="distance behind the nose tip (mm)", ylabel="equivalent plastic strain PEEQ (−)",
               title=f"plastic strain: max {peeq.max():.3g} at {y[np.argmax(peeq)]:.0f} mm")
+        a.title.set_fontsize(9)
         a.grid(alpha=0.3)
     else:
         note = "elastic throughout: max PEEQ 0; "
@@ -178,7 +179,7 @@ def hazard_figure(out: Path, haz, rows: np.ndarray, columns: list[str]) -> Path:
         a.axhline(A / 1e6, color="k", ls="--", lw=1, label=f"static yield stress A = {A / 1e6:.0f} MPa"
                                                            f" ({info['steel'] or 'shell steel'})")
         sec = a.secondary_yaxis("right", functions=(lambda m, A=A: m * 1e6 / A, lambda u, A=A: u * A / 1e6))
-        sec.set_ylabel("utilisation σ_vm / A (−)")
+        sec.set_ylabel("utilisation: von Mises / A (−)")
         if len(vm):
             head += f" = {100 * vm.max() / A:.0f} % of A"
         a.set_ylim(0.0, max(1.08 * A, 1.05 * vm.max(initial=0.0)) / 1e6)
@@ -313,24 +314,38 @@ def nose_profile(solver, shape, tip_node, tail_node, tri: np.ndarray, out: Path)
         files.write_text(Path(out) / "nose_profile.csv", "\n".join(lines) + "\n", MPI.COMM_SELF)
         result = {"tip_recession_mm": float(behind.min() * 1e3) if len(behind) else 0.0,
                   "max_radius_mm": float(radius[sel].max() * 1e3) if sel.any() else 0.0}
-        from fepen.post.figures import new_figure, run_title, save_figure
-
-        fig = new_figure((8, 3.6))
-        ax = fig.subplots()
-        for sign in (1, -1):
-            ax.plot(z0 * 1e3, sign * r0 * 1e3, "k--", lw=1, label="before (the drawn shape)" if sign > 0 else None)
-            ax.plot(z_after * 1e3, sign * r_after * 1e3, "C3", lw=1.5,
-                    label="after (largest radius of the final surface)" if sign > 0 else None)
-        ax.set(xlabel="distance behind the original nose tip (mm)", ylabel="radius from the axis (mm)",
-               aspect="equal")
-        ax.set_title(f"nose tip {result['tip_recession_mm']:.2f} mm behind where it was, largest radius "
-                     f"{result['max_radius_mm']:.2f} mm", fontsize=9)
-        fig.suptitle(run_title(out, "nose profile"), fontsize=10)
-        ax.legend(loc="lower right", fontsize=8)
-        ax.grid(alpha=0.3)
-        fig.tight_layout()
-        save_figure(fig, Path(out) / "nose_profile.png", dpi=120)
+        nose_profile_figure(out, (z0, r0), (z_after, r_after), result)
     return comm.bcast(result, root=0)
+
+
+def nose_profile_figure(out: Path, before, after, result: dict) -> Path:
+    """nose_profile.png: the nose's outline before and after (both sides of the axis, equal scales).
+
+    Args:
+        out: the results directory. before, after: (distance behind the original tip (m), radius (m)) arrays
+            of the drawn shape and of the final surface. result: {"tip_recession_mm", "max_radius_mm"}.
+
+    Returns:
+        The PNG's path.
+    """
+    from fepen.post.figures import new_figure, run_title, save_figure
+
+    (z0, r0), (z_after, r_after) = before, after
+    fig = new_figure((8, 3.6))
+    ax = fig.subplots()
+    for sign in (1, -1):
+        ax.plot(np.asarray(z0) * 1e3, sign * np.asarray(r0) * 1e3, "k--", lw=1,
+                label="before (the drawn shape)" if sign > 0 else None)
+        ax.plot(np.asarray(z_after) * 1e3, sign * np.asarray(r_after) * 1e3, "C3", lw=1.5,
+                label="after (largest radius of the final surface)" if sign > 0 else None)
+    ax.set(xlabel="distance behind the original nose tip (mm)", ylabel="radius from the axis (mm)", aspect="equal")
+    ax.set_title(f"nose tip {result['tip_recession_mm']:.2f} mm behind where it was, largest radius "
+                 f"{result['max_radius_mm']:.2f} mm", fontsize=9)
+    fig.suptitle(run_title(out, "nose profile"), fontsize=10)
+    ax.legend(loc="lower right", fontsize=8)
+    ax.grid(alpha=0.3)
+    fig.tight_layout()
+    return save_figure(fig, Path(out) / "nose_profile.png", dpi=120)
 
 
 class ChargeSections:

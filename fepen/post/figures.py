@@ -14,7 +14,7 @@ from pathlib import Path
 import numpy as np
 from mpi4py import MPI
 
-from fepen.data import shot
+from fepen.data import SHOTS, shot
 from fepen.geometry import mesh as fmesh
 from fepen.geometry import tags
 
@@ -107,9 +107,44 @@ def save_figure(fig, path, dpi: int = 110) -> Path:
     return path
 
 
+def read_written_scene(path) -> dict:
+    """Every key of a scene.toml as fepen writes it into a results directory (the given keys as values, every
+    other resolved key as a comment line "# key = value" under its "# [section]"), flat and dotted; without
+    fepen.scene (fepen.post reads files, not scenes). Lines that are neither are skipped, and so are the
+    [[target.layers]] tables.
+
+    Args:
+        path: the scene.toml.
+
+    Returns:
+        {"impact.velocity": 584.3, ...}; empty when the file cannot be read.
+    """
+    import re
+    import tomllib
+
+    try:
+        lines = Path(path).read_text().splitlines()
+    except (OSError, UnicodeDecodeError):
+        return {}
+    header = re.compile(r"^(?:# )?\[([A-Za-z0-9_.]+)\]\s*$")
+    key = re.compile(r"^(?:# )?([A-Za-z_][A-Za-z0-9_]*) = (.+)$")
+    flat, section = {}, None
+    for line in lines:
+        if line.lstrip("# ").startswith("[["):
+            section = None
+        elif m := header.match(line):
+            section = m.group(1)
+        elif section is not None and (m := key.match(line)):
+            try:
+                flat[f"{section}.{m.group(1)}"] = tomllib.loads(f"v = {m.group(2)}")["v"]
+            except tomllib.TOMLDecodeError:
+                continue
+    return flat
+
+
 def run_info(out) -> dict:
-    """What a figure's title says of the run in a results directory, from its scene.toml (else summary.json's
-    scene); every value None when neither can be read.
+    """What a figure's title says of the run in a results directory, from its scene.toml (read_written_scene;
+    else summary.json's scene); a value None when neither gives it.
 
     Args:
         out: the results directory.
@@ -120,29 +155,29 @@ def run_info(out) -> dict:
         "charge_yield_Pa": the charge's initial yield stress}.
     """
     out = Path(out)
-    get = None
-    try:
-        from fepen import scene as fscene
-
-        sc = fscene.load(out / "scene.toml")
-        get = sc.get
-    except Exception:  # noqa: BLE001 - a title must not stop a run: fall back to summary.json
+    flat = read_written_scene(out / "scene.toml")
+    if not flat:
         try:
             import json
 
             tree = json.loads((out / "summary.json").read_text())["scene"]
-
-            def get(dotted, tree=tree):
-                node = tree
-                for part in dotted.split("."):
-                    node = node.get(part) if isinstance(node, dict) else None
-                return node
-        except Exception:  # noqa: BLE001
-            get = None
+            stack = [("", tree)]
+            while stack:
+                prefix, node = stack.pop()
+                for k, v in node.items():
+                    if isinstance(v, dict):
+                        stack.append((f"{prefix}{k}.", v))
+                    else:
+                        flat[f"{prefix}{k}"] = v
+        except (OSError, ValueError, KeyError, TypeError, AttributeError):
+            flat = {}
     keys = {"shot": "impact.shot", "fidelity": "effects.fidelity", "velocity_m_s": "impact.velocity",
             "obliquity_deg": "impact.obliquity_deg", "charge": "effects.charge", "yield_Pa": "projectile.material.A",
             "steel": "projectile.material.name", "charge_yield_Pa": "charge.material.yield_stress"}
-    return {k: (get(v) if get is not None else None) for k, v in keys.items()}
+    info = {k: flat.get(v) for k, v in keys.items()}
+    if info["shot"] in SHOTS and info["velocity_m_s"] is None:  # a scene.toml written by hand
+        info["velocity_m_s"], info["obliquity_deg"] = SHOTS[info["shot"]].v0, SHOTS[info["shot"]].obliquity_deg
+    return info
 
 
 def run_title(out, what: str = "", shot: str | None = None) -> str:

@@ -141,8 +141,6 @@ def stress_maps(out: Path, path: Path, time: float | None = None) -> dict:
         {"t_s", plane: {body: {"von_mises_max_Pa", "peeq_max", and where each is, "..._at_mm": [behind the
         nose tip along the axis, across it]}}}.
     """
-    from matplotlib.collections import PolyCollection
-
     from fepen.post.figures import new_figure, run_info, run_title, save_figure
 
     st = read_state(out, time)
@@ -180,49 +178,64 @@ def stress_maps(out: Path, path: Path, time: float | None = None) -> dict:
         col = 0
         for quantity in ("von_mises_Pa", "second"):
             for value, bname, yield_Pa in bodies:
-                ax = axes[r, col]
-                col += 1
                 name = second[bname] if quantity == "second" else quantity
-                mine = body[cells] == value
-                others = [q for q, m in zip(polys, mine) if not m]
-                ax.add_collection(PolyCollection([q[:, ::-1] for q in others], facecolors="0.85", edgecolors="none"))
-                vals = st[name][cells[mine]] * (1.0 if name == "peeq" else 1e-6) if name in st else np.zeros(0)
-                cmap = {"von_mises_Pa": "viridis", "peeq": "inferno", "axial_stress_Pa": "coolwarm"}[name]
-                pc = PolyCollection([q[:, ::-1] for q, m in zip(polys, mine) if m], array=vals, cmap=cmap,
-                                    edgecolors="face", linewidths=0.2)
-                top = float(np.abs(vals).max()) if len(vals) else 0.0
-                if name == "peeq":  # one scale for both planes: the body's largest PEEQ anywhere
-                    pc.set_clim(0.0, max(peeq_top[bname], 1e-9))
-                    label = "PEEQ (−)"
-                    title = f"{bname}: PEEQ, max {top:.3g} in this cut\n({peeq_top[bname]:.3g} anywhere)"
-                elif name == "axial_stress_Pa":
-                    pc.set_clim(-max(top, 1e-6), max(top, 1e-6))
-                    label = "axial stress (MPa)"
-                    title = f"{bname}: no cell has yielded (PEEQ 0):\naxial stress, tension > 0"
-                else:
-                    label = "von Mises stress (MPa)"
-                    title = f"{bname}: von Mises stress, max {top:.0f} MPa"
-                    if yield_Pa and len(vals):
-                        title += f"\n= {100 * top * 1e6 / yield_Pa:.0f} % of its yield stress {yield_Pa / 1e6:.0f} MPa"
-                ax.add_collection(pc)
-                bar = fig.colorbar(pc, ax=ax, fraction=0.08, pad=0.02, format="%.3g")
-                bar.set_label(label, fontsize=7)
-                bar.ax.tick_params(labelsize=7)
-                ax.set_title(title, fontsize=8)
-                ax.set_aspect("equal")
-                ax.autoscale_view()
-                ax.invert_yaxis()
-                ax.tick_params(labelsize=7)
-                if col == 1:
-                    ax.set_ylabel(f"{pname}\nalong the axis, behind the nose tip (mm)", fontsize=8)
-                if r == len(planes) - 1:
-                    ax.set_xlabel("across the axis (mm)", fontsize=8)
+                _map_panel(fig, axes[r, col], polys, body[cells] == value, st[name][cells[body[cells] == value]],
+                           name, bname, yield_Pa, peeq_top[bname])
+                axes[r, col].set_ylabel((f"{pname}\n" if col == 0 else "") + "behind the nose tip, along the axis "
+                                        "(mm)", fontsize=8 if col == 0 else 7)
+                col += 1
     when = f"t = {st['t'] * 1e6:.0f} µs after impact"
     fig.suptitle(run_title(out, f"stress maps at {when}") + "\n(cuts through the deformed projectile's axis; "
                  "grey: the other body)", fontsize=10)
     fig.tight_layout()
     save_figure(fig, path)
     return {"t_s": st["t"], **report}
+
+
+def _map_panel(fig, ax, polys, mine, values, name: str, bname: str, yield_Pa, peeq_top: float) -> None:
+    """One panel of stress_maps: a body's cut polygons coloured by one field (the other body grey).
+
+    Args:
+        fig, ax: the figure and its axes. polys: the cut polygons (mm, along the axis and across it).
+        mine: which polygons are this body's. values: the field on them (SI). name: the field
+        ("von_mises_Pa", "peeq" or "axial_stress_Pa"). bname: the body's name. yield_Pa: its initial yield
+        stress (None: unknown). peeq_top: its largest PEEQ anywhere (the PEEQ colour scale).
+    """
+    from matplotlib.collections import PolyCollection
+
+    others = [q for q, m in zip(polys, mine) if not m]
+    ax.add_collection(PolyCollection([q[:, ::-1] for q in others], facecolors="0.85", edgecolors="none"))
+    vals = np.asarray(values, float) * (1.0 if name == "peeq" else 1e-6)
+    cmap = {"von_mises_Pa": "viridis", "peeq": "inferno", "axial_stress_Pa": "coolwarm"}[name]
+    pc = PolyCollection([q[:, ::-1] for q, m in zip(polys, mine) if m], array=vals, cmap=cmap,
+                        edgecolors="face", linewidths=0.2)
+    top = float(np.abs(vals).max()) if len(vals) else 0.0
+    if name == "peeq":  # one scale for both planes: the body's largest PEEQ anywhere
+        pc.set_clim(0.0, max(peeq_top, 1e-9))
+        label = "PEEQ (−)"
+        title = f"{bname}: PEEQ, max {top:.3g} in this cut\n({peeq_top:.3g} anywhere)"
+    elif name == "axial_stress_Pa":  # the scale of 99 % of the cells: one hot cell hides nothing
+        lim = max(float(np.percentile(np.abs(vals), 99)) if len(vals) else 0.0, 1e-6)
+        pc.set_clim(-lim, lim)
+        label = "axial stress (MPa)"
+        span = f" {vals.min():.0f} to {vals.max():.0f} MPa" if len(vals) else ""
+        title = f"{bname}: no cell has yielded (PEEQ 0):\naxial stress{span}, tension > 0"
+    else:
+        label = "von Mises stress (MPa)"
+        title = f"{bname}: von Mises stress, max {top:.0f} MPa"
+        if yield_Pa and len(vals):
+            title += f"\n= {100 * top * 1e6 / yield_Pa:.0f} % of its yield stress {yield_Pa / 1e6:.0f} MPa"
+    ax.add_collection(pc)
+    extend = "both" if name == "axial_stress_Pa" and len(vals) and top > pc.get_clim()[1] else "neither"
+    bar = fig.colorbar(pc, ax=ax, fraction=0.08, pad=0.02, format="%.3g", extend=extend)
+    bar.set_label(label, fontsize=7)
+    bar.ax.tick_params(labelsize=7)
+    ax.set_title(title, fontsize=8)
+    ax.set_aspect("equal")
+    ax.autoscale_view()
+    ax.invert_yaxis()
+    ax.tick_params(labelsize=7)
+    ax.set_xlabel("across the axis (mm)", fontsize=7)
 
 
 def write_cut_planes(st: dict, x: np.ndarray, tip: np.ndarray, planes: dict, path: Path) -> None:
