@@ -218,7 +218,7 @@ def _map_panel(fig, ax, polys, mine, values, name: str, bname: str, yield_Pa, pe
         lim = max(float(np.percentile(np.abs(vals), 99)) if len(vals) else 0.0, 1e-6)
         pc.set_clim(-lim, lim)
         label = "axial stress (MPa)"
-        span = f" {vals.min():.0f} to {vals.max():.0f} MPa" if len(vals) else ""
+        span = f" {round(vals.min()) + 0} to {round(vals.max()) + 0} MPa" if len(vals) else ""  # no "-0"
         title = f"{bname}: no cell has yielded (PEEQ 0):\naxial stress{span}, tension > 0"
     else:
         label = "von Mises stress (MPa)"
