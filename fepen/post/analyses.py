@@ -1,7 +1,9 @@
 """The paper's analyses of a deformable run (docs/paper.md §8), gathered on rank 0.
 
 - Hazard map: the largest equivalent plastic strain of the surface cells (cells with a face on the outer
-  surface) in axial bins along the projectile, from the nose (``hazard.csv``, ``hazard.png``).
+  surface) in axial bins along the projectile, from the nose, and the largest von Mises stress those cells
+  reached at any history row (``hazard.csv``, ``hazard.png``): where a shot yields, and how close to
+  yielding an elastic one came.
 - Strain gauges: four surface cells — top (+x), bottom (−x), two sides (±z) in the body frame, where x is
   the plane of incidence — at 1/3 L and 1/2 L from the nose; their axial logarithmic strain
   ln |F a0| (a0 the reference axis) over time (``strains.csv``). Bending shows as top/bottom ≫ sides.
@@ -18,7 +20,7 @@ from mpi4py import MPI
 from fepen.geometry import tags
 from fepen.geometry.cad import CadBody
 from fepen.geometry.frames import unit_axis
-from fepen.solver import probes
+from fepen.solver import diagnostics, probes
 
 GAUGE_NAMES = ["top", "bottom", "side+", "side-"]
 GAUGE_DIRECTIONS = np.array([[1.0, 0.0, 0.0], [-1.0, 0.0, 0.0], [0.0, 0.0, 1.0], [0.0, 0.0, -1.0]])
@@ -68,14 +70,19 @@ class Gauges:
         self.cells = [nearest_cell(centres, self.surface, p, self.comm) for _, _, p in self.targets]
         self.columns = ["t_s"] + [f"{name}_{round(frac * 100)}pctL" for frac, name, _ in self.targets]
         self.rows = []
+        #: the largest von Mises stress of each owned cell at the history rows so far (Pa)
+        self.peak_von_mises = np.zeros(solver.n_cells)
 
     def state(self) -> dict[str, np.ndarray]:
-        """The rows so far (for checkpoints)."""
-        return {"rows": np.array(self.rows, dtype=float)}
+        """The rows so far and the cells' peak von Mises stress (for checkpoints)."""
+        return {"rows": np.array(self.rows, dtype=float), "peak_von_mises_Pa": self.peak_von_mises.copy()}
 
     def restore(self, state: dict) -> None:
-        """Put back what state() returned."""
+        """Put back what state() returned (a checkpoint without the peaks keeps zeros)."""
         self.rows = [list(r) for r in state["rows"]]
+        peak = state.get("peak_von_mises_Pa")
+        if peak is not None and len(peak) == len(self.peak_von_mises):
+            self.peak_von_mises = np.array(peak, dtype=float)
 
     def axial_strains(self) -> list[float]:
         """Axial logarithmic strain ln|F a0| of the gauge cells (a0 = reference axis), every rank."""
@@ -91,24 +98,31 @@ class Gauges:
         return list(self.comm.allreduce(np.array(out), op=MPI.SUM))
 
     def record(self) -> None:
+        """One gauge row, and every cell's von Mises stress into its peak (collective)."""
         self.rows.append([self.solver.t, *self.axial_strains()])
+        vm = diagnostics.von_mises(self.solver)
+        live = self.solver.mat >= 0  # an eroded cell's stress is gone, its peak kept
+        np.maximum(self.peak_von_mises, np.where(live, vm, 0.0), out=self.peak_von_mises)
 
     def hazard(self, bin_mm: float = 2.0):
-        """(axial bin centres from the nose in mm, largest surface-cell PEEQ per bin) on rank 0, else None."""
+        """(axial bin centres from the nose (mm), largest surface-cell PEEQ per bin, largest surface-cell von
+        Mises stress per bin over the history rows (Pa)) on rank 0, else None (collective)."""
         s = self.solver
-        parts = self.comm.gather((self.surface_y, s.eps_p[self.surface]), root=0)
+        parts = self.comm.gather((self.surface_y, s.eps_p[self.surface], self.peak_von_mises[self.surface]), root=0)
         if self.comm.rank:
             return None
         y = np.concatenate([p[0] for p in parts]) * 1e3
         e = np.concatenate([p[1] for p in parts])
+        vm = np.concatenate([p[2] for p in parts])
         edges = np.arange(0.0, y.max() + bin_mm, bin_mm)
         idx = np.clip(np.digitize(y, edges) - 1, 0, len(edges) - 2)
-        peak = np.zeros(len(edges) - 1)
+        peak, peak_vm = np.zeros(len(edges) - 1), np.zeros(len(edges) - 1)
         np.maximum.at(peak, idx, e)
-        return 0.5 * (edges[1:] + edges[:-1]), peak
+        np.maximum.at(peak_vm, idx, vm)
+        return 0.5 * (edges[1:] + edges[:-1]), peak, peak_vm
 
     def write(self, out: Path) -> None:
-        """strains.csv, hazard.csv and hazard.png (rank 0)."""
+        """strains.csv, hazard.csv and hazard.png (collective; rank 0 writes)."""
         haz = self.hazard()
         if self.comm.rank:
             return
@@ -116,53 +130,134 @@ class Gauges:
         np.savetxt(out / "strains.csv", np.array(self.rows), delimiter=",", header=",".join(self.columns),
                    comments="", fmt="%.9g")
         np.savetxt(out / "hazard.csv", np.column_stack(haz), delimiter=",",
-                   header="axial_from_nose_mm,max_surface_peeq", comments="", fmt="%.6g")
-        import matplotlib
-
-        matplotlib.use("Agg")
-        import matplotlib.pyplot as plt
-
-        fig, ax = plt.subplots(1, 2, figsize=(12, 3.8))
-        ax[0].plot(*haz)
-        ax[0].set(xlabel="distance from the nose (mm)", ylabel="max surface PEEQ", title="hazard map")
-        d = np.array(self.rows)
-        for k, name in enumerate(self.columns[1:]):
-            ax[1].plot(d[:, 0] * 1e6, d[:, k + 1] * 1e3, label=name, ls="-" if "33" in name else "--")
-        ax[1].set(xlabel="t (us)", ylabel="axial strain (1e-3)", title="surface cells at L/3 and L/2")
-        ax[1].legend(fontsize=6, ncol=2)
-        fig.tight_layout()
-        fig.savefig(out / "hazard.png", dpi=110)
-        plt.close(fig)
+                   header="axial_from_nose_mm,max_surface_peeq,peak_surface_von_mises_Pa", comments="", fmt="%.6g")
+        hazard_figure(out, haz, np.array(self.rows), self.columns)
 
 
-def deformed_picture(solver, path: Path, title: str = "") -> None:
-    """Half of the deformed projectile (cells with z <= 0 in the body frame), coloured by PEEQ."""
-    from fepen.post.figures import pyvista
+def hazard_figure(out: Path, haz, rows: np.ndarray, columns: list[str]) -> Path:
+    """hazard.png: where the projectile's surface yielded or came near it, and the strain gauges.
+
+    Panels, along the projectile from the nose: the largest surface PEEQ (only when some cell yielded);
+    the largest von Mises stress the surface cells reached at any history row (MPa), against the shell
+    steel's static yield stress A (Johnson–Cook, a dashed line; right axis: σ_vm / A, the utilisation).
+    Then the axial strain of the eight gauge cells over time (µs). A shot that stays elastic (C3) has no
+    PEEQ to map: its first panel is the von Mises one, with the note "elastic throughout: max PEEQ 0" and
+    the peak utilisation, which says how far from yielding the shell stayed and where it came closest.
+
+    Args:
+        out: the results directory (scene.toml for the title and A). haz: (bin centres (mm), largest PEEQ,
+            largest von Mises stress (Pa)) per axial bin. rows: the gauge rows (t_s, then one strain per
+            gauge). columns: their names ("t_s", "top_33pctL", ...).
+
+    Returns:
+        The PNG's path.
+    """
+    from fepen.post.figures import new_figure, run_info, run_title, save_figure
+
+    y, peeq, vm = (np.asarray(a, float) for a in haz)
+    info = run_info(out)
+    A = info["yield_Pa"]
+    plastic = bool(np.any(peeq > 0.0))
+    n = 3 if plastic else 2
+    fig = new_figure((5.2 * n, 4.2))
+    ax = list(fig.subplots(1, n))
+    note = ""
+    if plastic:
+        a = ax.pop(0)
+        a.plot(y, peeq, color="C3", label="largest PEEQ of the surface cells")
+        a.set(xlabel="distance behind the nose tip (mm)", ylabel="equivalent plastic strain PEEQ (−)",
+              title=f"plastic strain: max {peeq.max():.3g} at {y[np.argmax(peeq)]:.0f} mm")
+        a.title.set_fontsize(9)
+        a.grid(alpha=0.3)
+    else:
+        note = "elastic throughout: max PEEQ 0; "
+    a = ax.pop(0)
+    a.plot(y, vm / 1e6, color="C0", label="largest von Mises stress of the surface cells")
+    k = int(np.argmax(vm)) if len(vm) else 0
+    head = f"peak von Mises {vm.max() / 1e6:.0f} MPa at {y[k]:.0f} mm" if len(vm) else "no surface cells"
+    if A:
+        a.axhline(A / 1e6, color="k", ls="--", lw=1, label=f"static yield stress A = {A / 1e6:.0f} MPa"
+                                                           f" ({info['steel'] or 'shell steel'})")
+        sec = a.secondary_yaxis("right", functions=(lambda m, A=A: m * 1e6 / A, lambda u, A=A: u * A / 1e6))
+        sec.set_ylabel("utilisation: von Mises / A (−)")
+        if len(vm):
+            head += f" = {100 * vm.max() / A:.0f} % of A"
+        a.set_ylim(0.0, max(1.08 * A, 1.05 * vm.max(initial=0.0)) / 1e6)
+    a.set(xlabel="distance behind the nose tip (mm)", ylabel="von Mises stress (MPa)", title=note + head)
+    a.title.set_fontsize(9)
+    a.legend(fontsize=7, loc="lower center")
+    a.grid(alpha=0.3)
+    a = ax.pop(0)
+    if len(rows):
+        for j, name in enumerate(columns[1:]):
+            side, frac = name.rsplit("_", 1)
+            a.plot(rows[:, 0] * 1e6, rows[:, j + 1] * 1e3, ls="-" if frac.startswith("33") else "--", lw=1,
+                   label=f"{side}, {frac.replace('pctL', '')} % of L", color=f"C{j % 4}")
+    a.set(xlabel="time after impact (µs)", ylabel="axial log strain (1e-3)",
+          title="gauge cells on the surface at L/3 (—) and L/2 (--)")
+    a.title.set_fontsize(9)
+    a.legend(fontsize=6, ncol=2)
+    a.grid(alpha=0.3)
+    fig.suptitle(run_title(out, "hazard map along the projectile, and strain gauges"), fontsize=11)
+    fig.tight_layout()
+    return save_figure(fig, Path(out) / "hazard.png")
+
+
+def deformed_picture(solver, path: Path, title: str = "", peak_von_mises: np.ndarray | None = None) -> None:
+    """Half of the deformed projectile (cells with z <= 0 in the body frame, seen from +z: the cut face in the
+    plane of incidence), coloured by PEEQ; when no cell yielded (PEEQ 0 everywhere) and the peaks are
+    given, coloured instead by each cell's peak von Mises stress over the shot divided by the shell steel's
+    static yield stress A (the utilisation: how close to yielding each part came), with the note "elastic
+    throughout: max PEEQ 0". Collective; rank 0 writes.
+
+    Args:
+        solver: the ExplicitSolver. path: the PNG (its folder's scene.toml gives the title's run and A).
+        title: a line under the run's name (time, max PEEQ). peak_von_mises: each owned cell's largest von
+            Mises stress so far (Pa; Gauges.peak_von_mises), or None.
+    """
+    from fepen.post.figures import pyvista, run_info, run_title
 
     comm = solver.comm
     x = solver.positions()
     p = x[solver.dofs]
     centres0 = solver.X[solver.dofs].mean(axis=1)
     keep = (centres0[:, 2] <= 0.0) & (solver.mat >= 0)  # eroded cells are gone
-    parts = comm.gather((p[keep], solver.eps_p[keep]), root=0)
+    peak = np.zeros(len(keep)) if peak_von_mises is None else np.asarray(peak_von_mises)
+    given = comm.allreduce(peak_von_mises is not None, op=MPI.LAND)
+    parts = comm.gather((p[keep], solver.eps_p[keep], peak[keep], solver.mat[keep]), root=0)
     if comm.rank:
         return
     pts = np.concatenate([q[0] for q in parts])
     peeq = np.concatenate([q[1] for q in parts])
+    vm = np.concatenate([q[2] for q in parts])
+    mat = np.concatenate([q[3] for q in parts])
+    A = run_info(Path(path).parent)["yield_Pa"]
     pv = pyvista()
     n = len(pts)
     cells = np.hstack([np.full((n, 1), 4), np.arange(4 * n).reshape(n, 4)]).ravel()
     grid = pv.UnstructuredGrid(cells, np.full(n, pv.CellType.TETRA, dtype=np.uint8), pts.reshape(-1, 3) * 1e3)
-    grid.cell_data["PEEQ"] = peeq
     plotter = pv.Plotter(off_screen=True, window_size=(1400, 700))
     plotter.set_background("white")
     # no scalar bar: VTK's bar formats its labels with std::regex, which crashes beside the libstdc++ that
     # dolfinx loads; the colour range is written as text instead
-    hi = max(float(peeq.max()), 1e-12)
-    plotter.add_mesh(grid, scalars="PEEQ", cmap="inferno", clim=(0.0, hi), show_edges=False,
-                     show_scalar_bar=False)
+    if float(peeq.max(initial=0.0)) > 0.0 or not given or not A:
+        grid.cell_data["PEEQ"] = peeq
+        hi = max(float(peeq.max(initial=0.0)), 1e-12)
+        plotter.add_mesh(grid, scalars="PEEQ", cmap="inferno", clim=(0.0, hi), show_edges=False,
+                         show_scalar_bar=False)
+        scale = f"PEEQ colour scale: black 0 ... yellow {hi:.3g}"
+    else:
+        shell = mat == 0
+        util = np.where(shell, vm / A, 0.0)
+        grid.cell_data["utilisation"] = util
+        plotter.add_mesh(grid, scalars="utilisation", cmap="viridis", clim=(0.0, 1.0), show_edges=False,
+                         show_scalar_bar=False)
+        scale = (f"elastic throughout: max PEEQ 0. Colour: the shell's peak von Mises stress over the shot / its "
+                 f"yield stress A = {A / 1e6:.0f} MPa,\ndark blue 0 ... yellow 1 (yield); largest "
+                 f"{util.max(initial=0.0):.2f}")
     plotter.view_vector((0.0, 0.0, 1.0), viewup=(0.0, 1.0, 0.0))
-    plotter.add_text(f"{title}\nPEEQ colour scale: black 0 ... yellow {hi:.3g}", font_size=10, color="black")
+    head = run_title(Path(path).parent, "the deformed projectile, cut in the plane of incidence")
+    plotter.add_text("\n".join(t for t in (head, title, scale) if t), font_size=10, color="black")
     plotter.screenshot(str(path))
     plotter.close()
 
@@ -219,23 +314,38 @@ def nose_profile(solver, shape, tip_node, tail_node, tri: np.ndarray, out: Path)
         files.write_text(Path(out) / "nose_profile.csv", "\n".join(lines) + "\n", MPI.COMM_SELF)
         result = {"tip_recession_mm": float(behind.min() * 1e3) if len(behind) else 0.0,
                   "max_radius_mm": float(radius[sel].max() * 1e3) if sel.any() else 0.0}
-        import matplotlib
-
-        matplotlib.use("Agg")
-        import matplotlib.pyplot as plt
-
-        fig, ax = plt.subplots(figsize=(8, 3.2))
-        for sign in (1, -1):
-            ax.plot(z0 * 1e3, sign * r0 * 1e3, "k--", lw=1, label="before" if sign > 0 else None)
-            ax.plot(z_after * 1e3, sign * r_after * 1e3, "C3", lw=1.5, label="after" if sign > 0 else None)
-        ax.set(xlabel="distance behind the original tip (mm)", ylabel="radius (mm)", aspect="equal",
-               title=f"nose profile: tip {result['tip_recession_mm']:.2f} mm behind, "
-                     f"largest radius {result['max_radius_mm']:.2f} mm")
-        ax.legend(loc="lower right", fontsize=8)
-        fig.tight_layout()
-        fig.savefig(Path(out) / "nose_profile.png", dpi=120)
-        plt.close(fig)
+        nose_profile_figure(out, (z0, r0), (z_after, r_after), result)
     return comm.bcast(result, root=0)
+
+
+def nose_profile_figure(out: Path, before, after, result: dict) -> Path:
+    """nose_profile.png: the nose's outline before and after (both sides of the axis, equal scales).
+
+    Args:
+        out: the results directory. before, after: (distance behind the original tip (m), radius (m)) arrays
+            of the drawn shape and of the final surface. result: {"tip_recession_mm", "max_radius_mm"}.
+
+    Returns:
+        The PNG's path.
+    """
+    from fepen.post.figures import new_figure, run_title, save_figure
+
+    (z0, r0), (z_after, r_after) = before, after
+    fig = new_figure((8, 3.6))
+    ax = fig.subplots()
+    for sign in (1, -1):
+        ax.plot(np.asarray(z0) * 1e3, sign * np.asarray(r0) * 1e3, "k--", lw=1,
+                label="before (the drawn shape)" if sign > 0 else None)
+        ax.plot(np.asarray(z_after) * 1e3, sign * np.asarray(r_after) * 1e3, "C3", lw=1.5,
+                label="after (largest radius of the final surface)" if sign > 0 else None)
+    ax.set(xlabel="distance behind the original nose tip (mm)", ylabel="radius from the axis (mm)", aspect="equal")
+    ax.set_title(f"nose tip {result['tip_recession_mm']:.2f} mm behind where it was, largest radius "
+                 f"{result['max_radius_mm']:.2f} mm", fontsize=9)
+    fig.suptitle(run_title(out, "nose profile"), fontsize=10)
+    ax.legend(loc="lower right", fontsize=8)
+    ax.grid(alpha=0.3)
+    fig.tight_layout()
+    return save_figure(fig, Path(out) / "nose_profile.png", dpi=120)
 
 
 class ChargeSections:

@@ -1,4 +1,10 @@
-"""Figures (PNG, off-screen). Imports of matplotlib and pyvista stay inside the functions."""
+"""Figures (PNG, off-screen). Imports of matplotlib and pyvista stay inside the functions.
+
+Every matplotlib figure of fepen is drawn on its own ``matplotlib.figure.Figure`` with an explicit Agg canvas
+(new_figure) and written by save_figure: fepen never imports matplotlib's state machine (plt) and never
+changes the user's backend (a notebook's plots keep appearing after ``fepen.run``). Titles name the run by
+its shot and fidelity (run_title: "C3 (584.3 m/s, 10.5°), plastic"), never by its results directory.
+"""
 
 from __future__ import annotations
 
@@ -8,7 +14,7 @@ from pathlib import Path
 import numpy as np
 from mpi4py import MPI
 
-from fepen.data import shot
+from fepen.data import SHOTS, shot
 from fepen.geometry import mesh as fmesh
 from fepen.geometry import tags
 
@@ -63,35 +69,218 @@ def mesh_picture(pm: fmesh.ProjectileMesh, path: Path, title: str = "") -> None:
     plotter.close()
 
 
+#: display names of the fidelities in titles
+FIDELITY_NAMES = {"rigid": "rigid", "elastic": "elastic", "plastic": "plastic"}
+
+
+def new_figure(figsize):
+    """A matplotlib Figure on its own Agg canvas (no plt state machine, no global backend).
+
+    Args:
+        figsize: (width, height) in inches.
+
+    Returns:
+        The matplotlib.figure.Figure.
+    """
+    from matplotlib.backends.backend_agg import FigureCanvasAgg
+    from matplotlib.figure import Figure
+
+    fig = Figure(figsize=figsize)
+    FigureCanvasAgg(fig)
+    return fig
+
+
+def save_figure(fig, path, dpi: int = 110) -> Path:
+    """Write fig as a PNG through a temporary file renamed over path (never a half-written picture).
+
+    Args:
+        fig: a Figure of new_figure. path: the PNG. dpi: its resolution.
+
+    Returns:
+        path.
+    """
+    from fepen.atomic import replacing
+
+    path = Path(path)
+    with replacing(path, ".png") as tmp:
+        fig.savefig(tmp, dpi=dpi, format="png")
+    return path
+
+
+def read_written_scene(path) -> dict:
+    """Every key of a scene.toml as fepen writes it into a results directory (the given keys as values, every
+    other resolved key as a comment line "# key = value" under its "# [section]"), flat and dotted; without
+    fepen.scene (fepen.post reads files, not scenes). Lines that are neither are skipped, and so are the
+    [[target.layers]] tables.
+
+    Args:
+        path: the scene.toml.
+
+    Returns:
+        {"impact.velocity": 584.3, ...}; empty when the file cannot be read.
+    """
+    import re
+    import tomllib
+
+    try:
+        lines = Path(path).read_text().splitlines()
+    except (OSError, UnicodeDecodeError):
+        return {}
+    header = re.compile(r"^(?:# )?\[([A-Za-z0-9_.]+)\]\s*$")
+    key = re.compile(r"^(?:# )?([A-Za-z_][A-Za-z0-9_]*) = (.+)$")
+    flat, section = {}, None
+    for line in lines:
+        if line.lstrip("# ").startswith("[["):
+            section = None
+        elif m := header.match(line):
+            section = m.group(1)
+        elif section is not None and (m := key.match(line)):
+            try:
+                flat[f"{section}.{m.group(1)}"] = tomllib.loads(f"v = {m.group(2)}")["v"]
+            except tomllib.TOMLDecodeError:
+                continue
+    return flat
+
+
+def run_info(out) -> dict:
+    """What a figure's title says of the run in a results directory, from its scene.toml (read_written_scene;
+    else summary.json's scene); a value None when neither gives it.
+
+    Args:
+        out: the results directory.
+
+    Returns:
+        {"shot": impact.shot or None, "fidelity", "velocity_m_s", "obliquity_deg", "charge": bool,
+        "yield_Pa": the shell's Johnson–Cook A (its static yield stress) or None, "steel": its name,
+        "charge_yield_Pa": the charge's initial yield stress}.
+    """
+    out = Path(out)
+    flat = read_written_scene(out / "scene.toml")
+    if not flat:
+        try:
+            import json
+
+            tree = json.loads((out / "summary.json").read_text())["scene"]
+            stack = [("", tree)]
+            while stack:
+                prefix, node = stack.pop()
+                for k, v in node.items():
+                    if isinstance(v, dict):
+                        stack.append((f"{prefix}{k}.", v))
+                    else:
+                        flat[f"{prefix}{k}"] = v
+        except (OSError, ValueError, KeyError, TypeError, AttributeError):
+            flat = {}
+    keys = {"shot": "impact.shot", "fidelity": "effects.fidelity", "velocity_m_s": "impact.velocity",
+            "obliquity_deg": "impact.obliquity_deg", "charge": "effects.charge", "yield_Pa": "projectile.material.A",
+            "steel": "projectile.material.name", "charge_yield_Pa": "charge.material.yield_stress"}
+    info = {k: flat.get(v) for k, v in keys.items()}
+    if info["shot"] in SHOTS and info["velocity_m_s"] is None:  # a scene.toml written by hand
+        info["velocity_m_s"], info["obliquity_deg"] = SHOTS[info["shot"]].v0, SHOTS[info["shot"]].obliquity_deg
+    return info
+
+
+def run_title(out, what: str = "", shot: str | None = None) -> str:
+    """A figure's title naming the run: "C3 (584.3 m/s, 10.5°), plastic: what", or "600 m/s at 10°, rigid:
+    what" when no Table 1 shot is named; never the results directory.
+
+    Args:
+        out: the results directory (its scene.toml). what: the figure's subject. shot: the shot's name when
+            the caller knows it (else the scene's impact.shot).
+
+    Returns:
+        The title.
+    """
+    info = run_info(out)
+    shot = shot or info["shot"]
+    v, ob = info["velocity_m_s"], info["obliquity_deg"]
+    impact = f"{v:g} m/s, {ob:g}°" if v is not None and ob is not None else ""
+    if shot:
+        name = f"{shot} ({impact})" if impact else shot
+    else:
+        name = impact.replace(", ", " at ") if impact else "fepen run"
+    fid = info["fidelity"]
+    name += f", {FIDELITY_NAMES.get(fid, fid)}" if fid else ""
+    name += ", charged" if info["charge"] else ""
+    return f"{name}: {what}" if what else name
+
+
+def _nonzero(values) -> bool:
+    return bool(np.any(np.abs(np.nan_to_num(np.asarray(values, float))) > 0.0))
+
+
 def history_figure(out: Path, experiment: str | None = None, comm=MPI.COMM_WORLD) -> None:
-    """history.png: force, trajectory (with the experiment's end points when a shot is named), energies."""
+    """history.png (rank 0), four panels over the time after impact (µs): the nose and tail depths with the
+    Table 1 test's final depths as horizontal lines; the target's deceleration; the path in the plane of
+    incidence with the test's final nose and tail; the energies (kinetic, the energy given to the target,
+    and the stored elastic energy and plastic dissipation when not zero throughout).
+
+    Args:
+        out: the results directory (history.csv, scene.toml). experiment: the Table 1 shot's name, or None
+            (then the scene's impact.shot). comm: the run's communicator (only rank 0 draws).
+    """
     if comm.rank != 0:
         return
-    import matplotlib
-
-    matplotlib.use("Agg")
-    import matplotlib.pyplot as plt
-
-    data = np.genfromtxt(Path(out) / "history.csv", delimiter=",", names=True)
-    data = np.atleast_1d(data)
-    fig, ax = plt.subplots(1, 3, figsize=(14, 3.8))
+    out = Path(out)
+    data = np.atleast_1d(np.genfromtxt(out / "history.csv", delimiter=",", names=True))
+    name = experiment or run_info(out)["shot"]
+    s = shot(name) if name else None
+    fig = new_figure((12.5, 8.0))
+    ax = fig.subplots(2, 2).ravel()
     t = data["t_s"] * 1e6
-    ax[0].plot(t, data["decel_g"] / 1e3)
-    ax[0].set(xlabel="t (us)", ylabel="deceleration (1000 g)")
-    ax[1].plot(data["nose_x_mm"], data["nose_y_mm"], label="nose tip")
-    ax[1].plot(data["tail_x_mm"], data["tail_y_mm"], label="tail centre")
-    name = experiment
-    if name:
-        s = shot(name)
-        ax[1].plot([s.Hx_mm], [s.Hy_mm], "o", color="C0", label=f"{name} nose, test")
-        ax[1].plot([s.Tx_mm], [s.Ty_mm], "s", color="C1", label=f"{name} tail, test")
-    ax[1].invert_yaxis()
-    ax[1].set(xlabel="x along the face (mm)", ylabel="depth (mm)", aspect="equal")
-    ax[1].legend(fontsize=7)
-    for k in ("kinetic_J", "internal_work_J", "plastic_J", "external_work_J"):
-        ax[2].plot(t, data[k], label=k)
-    ax[2].set(xlabel="t (us)", ylabel="energy (J)")
-    ax[2].legend(fontsize=7)
+    tlabel = "time after impact (µs)"
+    # depths against time
+    ax[0].plot(t, data["nose_y_mm"], color="C3", label="nose depth")
+    ax[0].plot(t, data["tail_y_mm"], color="C0", label="tail depth")
+    if s is not None:
+        ax[0].axhline(s.Hy_mm, color="C3", ls="--", lw=1, label=f"{name} test: final nose depth {s.Hy_mm:g} mm")
+        ax[0].axhline(s.Ty_mm, color="C0", ls="--", lw=1, label=f"{name} test: final tail depth {s.Ty_mm:g} mm")
+    ax[0].invert_yaxis()
+    ax[0].set(xlabel=tlabel, ylabel="depth below the target face (mm)", title="depth")
+    ax[0].legend(fontsize=7, loc="best")
+    # deceleration
+    ax[1].plot(t, data["decel_g"] / 1e3, color="k", lw=1, label="target deceleration along the axis")
+    ax[1].set(xlabel=tlabel, ylabel="deceleration (1000 g)", title="deceleration (force / mass)")
+    # path
+    ax[2].plot(data["nose_x_mm"], data["nose_y_mm"], color="C3", label="nose tip")
+    ax[2].plot(data["tail_x_mm"], data["tail_y_mm"], color="C0", label="tail centre")
+    ax[2].plot([data["tail_x_mm"][-1], data["nose_x_mm"][-1]], [data["tail_y_mm"][-1], data["nose_y_mm"][-1]],
+               "-", color="0.4", lw=3, alpha=0.6, label="final axis")
+    if s is not None:
+        ax[2].plot([s.Tx_mm, s.Hx_mm], [s.Ty_mm, s.Hy_mm], "k-", lw=1.5, label=f"{name} test: final axis")
+        ax[2].plot([s.Hx_mm], [s.Hy_mm], "o", color="C3", mec="k", label=f"{name} test: nose")
+        ax[2].plot([s.Tx_mm], [s.Ty_mm], "s", color="C0", mec="k", label=f"{name} test: tail")
+    ax[2].axhline(0.0, color="saddlebrown", lw=1)
+    ax[2].invert_yaxis()
+    ax[2].set(xlabel="x along the target face (mm)", ylabel="depth below the target face (mm)",
+              title="path in the plane of incidence (equal scales)")
+    ax[2].set_aspect("equal", adjustable="datalim")
+    ax[2].legend(fontsize=7, loc="best")
+    # energies
+    ax[3].plot(t, data["kinetic_J"] / 1e3, label="kinetic")
+    ax[3].plot(t, -data["external_work_J"] / 1e3, label="given to the target (−external work)")
+    names = data.dtype.names
+    zero, small = [], None
+    for key, label, colour in (("elastic_J", "stored elastic", "C2"), ("plastic_J", "plastic dissipation", "C3")):
+        if key in names and _nonzero(data[key]):
+            small = small or ax[3].twinx()  # joules, beside the tens of kilojoules
+            small.plot(t, data[key], "--", color=colour, lw=1, label=f"{label} (J, right axis)")
+        elif key in names:
+            zero.append(label)
+    ax[3].set(xlabel=tlabel, ylabel="energy (kJ)", title="energies")
+    handles, labels = ax[3].get_legend_handles_labels()
+    if small is not None:
+        small.set_ylabel("energy (J)")
+        more = small.get_legend_handles_labels()
+        handles, labels = handles + more[0], labels + more[1]
+    (small or ax[3]).legend(handles, labels, fontsize=7, loc="center right", framealpha=0.9,
+                 title=("zero throughout: " + ", ".join(zero)) if zero else None, title_fontsize=7)
+    for a in ax:
+        a.grid(alpha=0.3)
+    depth = float(np.nanmax(data["nose_y_mm"]))
+    line = f"final nose depth {data['nose_y_mm'][-1]:.1f} mm, deepest {depth:.1f} mm"
+    if s is not None:
+        line += f" (test {s.Hy_mm:g} mm: {100 * (data['nose_y_mm'][-1] / s.Hy_mm - 1):+.1f} %)"
+    fig.suptitle(run_title(out, "history", name) + "\n" + line, fontsize=11)
     fig.tight_layout()
-    fig.savefig(Path(out) / "history.png", dpi=110)
-    plt.close(fig)
+    save_figure(fig, out / "history.png")

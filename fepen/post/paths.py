@@ -128,14 +128,14 @@ def paths_figure(runs: Mapping[str, Path], out: Path, shots: Sequence[str] | Non
     Returns:
         out.
     """
-    from matplotlib.figure import Figure
+    from fepen.post.figures import new_figure, save_figure
 
     names = [n for n in (oblique_shots() if shots is None else shots) if n in SHOTS]
     colours = {label: f"C{i}" for i, label in enumerate(runs)}
     ncols = min(3, max(len(names), 1))
     nrows = max(math.ceil(len(names) / ncols), 1)
     height = 6.0 * nrows + 0.8
-    fig = Figure(figsize=(4.4 * ncols, height))
+    fig = new_figure((4.4 * ncols, height))
     axes = np.atleast_1d(fig.subplots(nrows, ncols, squeeze=False).ravel())
     for ax, name in zip(axes, names):
         paths = {label: p for label, d in runs.items() if (p := read_path(Path(d) / name)) is not None}
@@ -156,8 +156,7 @@ def paths_figure(runs: Mapping[str, Path], out: Path, shots: Sequence[str] | Non
     fig.tight_layout(rect=(0, 0.55 / height, 1, 1 - 0.45 / height))
     out = Path(out)
     out.parent.mkdir(parents=True, exist_ok=True)
-    fig.savefig(out, dpi=110)
-    return out
+    return save_figure(fig, out)
 
 
 def _labelled(text: str) -> tuple[str, Path]:

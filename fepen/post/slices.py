@@ -130,67 +130,112 @@ def stress_maps(out: Path, path: Path, time: float | None = None) -> dict:
     """Equivalent stress and PEEQ of shell and charge in the x–y and y–z planes, one figure; and the same
     cuts as data, ``path`` with the suffix .vtu (write_cut_planes), for ParaView, pyvista and meshio.
 
-    Returns:
-        {plane: {body: {"von_mises_max_Pa", "peeq_max", and where each is, "..._at_mm": [behind the nose tip
-        along the axis, across it]}}}.
-    """
-    import matplotlib
+    A body with no plastic strain anywhere at that time (PEEQ 0 in every cell: C3's shell at 2.5 mm stays
+    elastic) has nothing to show in a PEEQ panel: its second panel shows the axial stress instead (MPa,
+    tension red, compression blue: the load path and the bending across the axis), titled "no cell has
+    yielded (PEEQ 0)". PEEQ panels share one colour scale, the body's largest PEEQ anywhere. The von
+    Mises panels' titles give the largest value and its fraction of the body's initial yield stress (the
+    shell steel's Johnson–Cook A, the charge's yield stress).
 
-    matplotlib.use("Agg")
-    import matplotlib.pyplot as plt
-    from matplotlib.collections import PolyCollection
+    Returns:
+        {"t_s", plane: {body: {"von_mises_max_Pa", "peeq_max", and where each is, "..._at_mm": [behind the
+        nose tip along the axis, across it]}}}.
+    """
+    from fepen.post.figures import new_figure, run_info, run_title, save_figure
 
     st = read_state(out, time)
     x = st["X"] + st["displacement_m"]
     tip, _, planes = _axis_frame(st)
     body = st.get("cell_tag", np.ones(len(st["cells"])))
-    quantities = [("von_mises_Pa", "equivalent stress (MPa)", 1e-6, "viridis")]
-    if "peeq" in st:
-        quantities.append(("peeq", "PEEQ", 1.0, "inferno"))
-    bodies = [(1.0, "shell"), (2.0, "charge")] if np.any(body == 2.0) else [(1.0, "projectile")]
-    ncol = len(quantities) * len(bodies)
-    fig, axes = plt.subplots(len(planes), ncol, figsize=(2.6 * ncol + 1, 9.5), squeeze=False)
+    info = run_info(out)
+    bodies = [(1.0, "shell", info["yield_Pa"]), (2.0, "charge", info["charge_yield_Pa"])] if np.any(body == 2.0) \
+        else [(1.0, "projectile", info["yield_Pa"])]
+    # the second panel of each body: PEEQ where some cell yielded, else its axial stress
+    second, peeq_top = {}, {}
+    for value, bname, _ in bodies:
+        mine = body == value
+        peeq_top[bname] = float(st["peeq"][mine].max()) if "peeq" in st and mine.any() else 0.0
+        second[bname] = "peeq" if peeq_top[bname] > 0.0 or "axial_stress_Pa" not in st else "axial_stress_Pa"
+    ncol = 2 * len(bodies)
+    fig = new_figure((2.7 * ncol + 1, 9.5))
+    axes = fig.subplots(len(planes), ncol, squeeze=False)
     report = {}
     write_cut_planes(st, x, tip, planes, Path(path).with_suffix(".vtu"))
     for r, (pname, (normal, basis)) in enumerate(planes.items()):
         polys, cells = cut(x[st["cells"]], normal, float(normal @ tip), basis)
         polys = [(q - tip @ basis.T) * 1e3 for q in polys]
         report[pname] = {}
-        col = 0
-        for name, label, scale, cmap in quantities:
-            for value, bname in bodies:
-                ax = axes[r, col]
-                col += 1
-                mine = body[cells] == value
-                others = [p for p, m in zip(polys, mine) if not m]
-                ax.add_collection(PolyCollection([p[:, ::-1] for p in others], facecolors="0.85", edgecolors="none"))
-                vals = st[name][cells[mine]] * scale
-                pc = PolyCollection([p[:, ::-1] for p, m in zip(polys, mine) if m], array=vals, cmap=cmap,
-                                    edgecolors="face", linewidths=0.2)
-                if name == "peeq" and len(vals):
-                    pc.set_clim(0.0, max(float(vals.max()), 1e-6))
-                ax.add_collection(pc)
-                fig.colorbar(pc, ax=ax, fraction=0.08, pad=0.02)
-                none = name == "peeq" and (not len(vals) or float(vals.max()) == 0.0)
-                ax.set_title(f"{bname}: {label}" + (" = 0 everywhere" if none else ""), fontsize=8)
-                ax.set_aspect("equal")
-                ax.autoscale_view()
-                ax.invert_yaxis()
-                ax.tick_params(labelsize=7)
-                if col == 1:
-                    ax.set_ylabel(f"{pname}\nalong the axis from the nose tip (mm)", fontsize=8)
-                if len(vals):
+        for value, bname, _ in bodies:
+            mine = body[cells] == value
+            mine_polys = [q for q, m in zip(polys, mine) if m]
+            entry = report[pname].setdefault(bname, {}) if mine.any() else {}
+            for name, scale, key in (("von_mises_Pa", 1e-6, "von_mises_max_Pa"), ("peeq", 1.0, "peeq_max")):
+                if name in st and mine.any():
+                    vals = st[name][cells[mine]] * scale
                     k = int(np.argmax(vals))
-                    at = [p for p, m in zip(polys, mine) if m][k].mean(axis=0)
-                    entry = report[pname].setdefault(bname, {})
-                    key = "peeq_max" if name == "peeq" else "von_mises_max_Pa"
                     entry[key] = float(vals[k] / scale)
-                    entry[key.replace("_Pa", "") + "_at_mm"] = [float(at[0]), float(at[1])]
-    fig.suptitle(f"{Path(out).name}: t = {st['t'] * 1e6:.0f} us (deformed; grey: the other body)", fontsize=10)
+                    entry[key.replace("_Pa", "") + "_at_mm"] = [float(v) for v in mine_polys[k].mean(axis=0)]
+        col = 0
+        for quantity in ("von_mises_Pa", "second"):
+            for value, bname, yield_Pa in bodies:
+                name = second[bname] if quantity == "second" else quantity
+                _map_panel(fig, axes[r, col], polys, body[cells] == value, st[name][cells[body[cells] == value]],
+                           name, bname, yield_Pa, peeq_top[bname])
+                axes[r, col].set_ylabel((f"{pname}\n" if col == 0 else "") + "behind the nose tip, along the axis "
+                                        "(mm)", fontsize=8 if col == 0 else 7)
+                col += 1
+    when = f"t = {st['t'] * 1e6:.0f} µs after impact"
+    fig.suptitle(run_title(out, f"stress maps at {when}") + "\n(cuts through the deformed projectile's axis; "
+                 "grey: the other body)", fontsize=10)
     fig.tight_layout()
-    fig.savefig(path, dpi=110)
-    plt.close(fig)
+    save_figure(fig, path)
     return {"t_s": st["t"], **report}
+
+
+def _map_panel(fig, ax, polys, mine, values, name: str, bname: str, yield_Pa, peeq_top: float) -> None:
+    """One panel of stress_maps: a body's cut polygons coloured by one field (the other body grey).
+
+    Args:
+        fig, ax: the figure and its axes. polys: the cut polygons (mm, along the axis and across it).
+        mine: which polygons are this body's. values: the field on them (SI). name: the field
+        ("von_mises_Pa", "peeq" or "axial_stress_Pa"). bname: the body's name. yield_Pa: its initial yield
+        stress (None: unknown). peeq_top: its largest PEEQ anywhere (the PEEQ colour scale).
+    """
+    from matplotlib.collections import PolyCollection
+
+    others = [q for q, m in zip(polys, mine) if not m]
+    ax.add_collection(PolyCollection([q[:, ::-1] for q in others], facecolors="0.85", edgecolors="none"))
+    vals = np.asarray(values, float) * (1.0 if name == "peeq" else 1e-6)
+    cmap = {"von_mises_Pa": "viridis", "peeq": "inferno", "axial_stress_Pa": "coolwarm"}[name]
+    pc = PolyCollection([q[:, ::-1] for q, m in zip(polys, mine) if m], array=vals, cmap=cmap,
+                        edgecolors="face", linewidths=0.2)
+    top = float(np.abs(vals).max()) if len(vals) else 0.0
+    if name == "peeq":  # one scale for both planes: the body's largest PEEQ anywhere
+        pc.set_clim(0.0, max(peeq_top, 1e-9))
+        label = "PEEQ (−)"
+        title = f"{bname}: PEEQ, max {top:.3g} in this cut\n({peeq_top:.3g} anywhere)"
+    elif name == "axial_stress_Pa":  # the scale of 99 % of the cells: one hot cell hides nothing
+        lim = max(float(np.percentile(np.abs(vals), 99)) if len(vals) else 0.0, 1e-6)
+        pc.set_clim(-lim, lim)
+        label = "axial stress (MPa)"
+        span = f" {round(vals.min()) + 0} to {round(vals.max()) + 0} MPa" if len(vals) else ""  # no "-0"
+        title = f"{bname}: no cell has yielded (PEEQ 0):\naxial stress{span}, tension > 0"
+    else:
+        label = "von Mises stress (MPa)"
+        title = f"{bname}: von Mises stress, max {top:.0f} MPa"
+        if yield_Pa and len(vals):
+            title += f"\n= {100 * top * 1e6 / yield_Pa:.0f} % of its yield stress {yield_Pa / 1e6:.0f} MPa"
+    ax.add_collection(pc)
+    extend = "both" if name == "axial_stress_Pa" and len(vals) and top > pc.get_clim()[1] else "neither"
+    bar = fig.colorbar(pc, ax=ax, fraction=0.08, pad=0.02, format="%.3g", extend=extend)
+    bar.set_label(label, fontsize=7)
+    bar.ax.tick_params(labelsize=7)
+    ax.set_title(title, fontsize=8)
+    ax.set_aspect("equal")
+    ax.autoscale_view()
+    ax.invert_yaxis()
+    ax.tick_params(labelsize=7)
+    ax.set_xlabel("across the axis (mm)", fontsize=7)
 
 
 def write_cut_planes(st: dict, x: np.ndarray, tip: np.ndarray, planes: dict, path: Path) -> None:
@@ -237,17 +282,17 @@ def trajectory_figure(out: Path, path: Path, experiment=None, outlines: int = 6)
         outlines: how many output times to draw, evenly spread from the first to the last.
     """
     import matplotlib
-
-    matplotlib.use("Agg")
-    import matplotlib.pyplot as plt
     from matplotlib.collections import PolyCollection
+
+    from fepen.post.figures import new_figure, run_title, save_figure
 
     out = Path(out)
     h = np.atleast_1d(np.genfromtxt(out / "history.csv", delimiter=",", names=True))
-    fig, ax = plt.subplots(figsize=(7, 7))
+    fig = new_figure((7, 7.4))
+    ax = fig.subplots()
     times = output_times(out)
     picks = sorted(set(np.linspace(0, len(times) - 1, min(outlines, len(times))).round().astype(int)))
-    cmap = plt.get_cmap("viridis")
+    cmap = matplotlib.colormaps["viridis"]
     ez, basis = np.array([0.0, 0.0, 1.0]), np.array([[1.0, 0.0, 0.0], [0.0, -1.0, 0.0]])  # (x, depth)
     for i, k in enumerate(picks):
         st = read_state(out, float(times[k]))
@@ -256,27 +301,29 @@ def trajectory_figure(out: Path, path: Path, experiment=None, outlines: int = 6)
         polys, _ = cut(x[st["cells"][live]], ez, 0.0, basis)
         colour = cmap(i / max(len(picks) - 1, 1))
         ax.add_collection(PolyCollection([q * 1e3 for q in polys], facecolors=colour, edgecolors="none", alpha=0.8,
-                                         label=f"t = {st['t'] * 1e6:.0f} us"))
+                                         label=f"projectile at t = {st['t'] * 1e6:.0f} µs"))
     ax.plot(h["nose_x_mm"], h["nose_y_mm"], "-", color="C3", lw=1, label="nose path")
     ax.plot(h["tail_x_mm"], h["tail_y_mm"], "--", color="C0", lw=1, label="tail path")
+    name = getattr(experiment, "name", None)
     if experiment is not None:
         ax.plot([experiment.Tx_mm, experiment.Hx_mm], [experiment.Ty_mm, experiment.Hy_mm], "k-", lw=2.5,
-                label="test: final tail to nose")
+                label=f"{name or 'test'} test: final tail to nose (Table 1)")
         ax.plot([experiment.Hx_mm], [experiment.Hy_mm], "k^", ms=8)
     ax.autoscale_view()
     x0, x1 = ax.get_xlim()
     y0, y1 = ax.get_ylim()
-    ax.axhspan(0.0, max(y1, 1.0), color="0.9", zorder=0)
+    ax.axhspan(0.0, 10.0 * max(y1, 1.0), color="0.9", zorder=0)  # the target, past any limits drawn
+    ax.set_ylim(y0, y1)
     ax.axhline(0.0, color="k", lw=1)
-    ax.text(x0, 0.0, " target face", va="bottom", fontsize=8)
-    ax.set(xlabel="x (mm)", ylabel="depth, -y (mm)", title=f"{out.name}: the shot in the plane of incidence")
+    ax.text(0.01, 0.0, "target face", va="bottom", fontsize=8, transform=ax.get_yaxis_transform())
+    ax.set(xlabel="x along the target face (mm)", ylabel="depth below the target face (mm)")
+    ax.set_title(run_title(out, "the shot in the plane of incidence", name), fontsize=10)
     ax.set_aspect("equal", adjustable="datalim")
     ax.invert_yaxis()
     ax.legend(fontsize=7, loc="best")
     ax.grid(alpha=0.3)
     fig.tight_layout()
-    fig.savefig(path, dpi=110)
-    plt.close(fig)
+    save_figure(fig, path)
 
 
 def cross_sections(out: Path, path: Path, sections: dict, time: float | None = None) -> dict:
@@ -288,17 +335,16 @@ def cross_sections(out: Path, path: Path, sections: dict, time: float | None = N
     Returns:
         {label: {"min": most compressive strain, "max": most tensile, "charge_mean": mean over the charge}}.
     """
-    import matplotlib
-
-    matplotlib.use("Agg")
-    import matplotlib.pyplot as plt
     from matplotlib.collections import PolyCollection
+
+    from fepen.post.figures import new_figure, run_title, save_figure
 
     st = read_state(out, time)
     X, cells = st["X"], st["cells"]
     strain = _strain_axial(X, X + st["displacement_m"], cells)
     body = st.get("cell_tag", np.ones(len(cells)))
-    fig, axes = plt.subplots(1, len(sections), figsize=(4.2 * len(sections), 4.0), squeeze=False)
+    fig = new_figure((4.2 * len(sections), 4.3))
+    axes = fig.subplots(1, len(sections), squeeze=False)
     basis = np.array([[1.0, 0.0, 0.0], [0.0, 0.0, 1.0]])
     report = {}
     for ax, (label, y) in zip(axes[0], sections.items()):
@@ -312,8 +358,9 @@ def cross_sections(out: Path, path: Path, sections: dict, time: float | None = N
         if np.any(ch):  # outline of the charge's cut
             for q in (q for q, m in zip(polys, ch) if m):
                 ax.plot(*np.vstack([q, q[:1]]).T * 1e3, color="k", lw=0.1, alpha=0.3)
-        fig.colorbar(pc, ax=ax, fraction=0.05, label="axial strain (1e-3)")
-        ax.set(title=f"{label}: {y * 1e3:.1f} mm behind the nose tip", xlabel="x (mm)", ylabel="z (mm)")
+        fig.colorbar(pc, ax=ax, fraction=0.05, label="axial strain (1e-3, tension > 0)")
+        ax.set(title=f"{label.replace('_', ' ')}: {y * 1e3:.1f} mm behind the nose tip",
+               xlabel="x, in the plane of incidence (mm)", ylabel="z, across it (mm)")
         ax.title.set_fontsize(8)
         ax.set_aspect("equal")
         ax.autoscale_view()
@@ -321,11 +368,10 @@ def cross_sections(out: Path, path: Path, sections: dict, time: float | None = N
         report[label] = {"y_mm": y * 1e3, "min": float(vals.min()) * 1e-3, "max": float(vals.max()) * 1e-3,
                          "charge_mean": float(np.sum(areas[ch] * vals[ch]) / max(areas[ch].sum(), 1e-300)) * 1e-3
                          if np.any(ch) else None}
-    fig.suptitle(f"{Path(out).name}: axial logarithmic strain on material cross-sections, t = {st['t'] * 1e6:.0f} us",
+    fig.suptitle(run_title(out, f"axial logarithmic strain on material cross-sections, t = {st['t'] * 1e6:.0f} µs"),
                  fontsize=10)
     fig.tight_layout()
-    fig.savefig(path, dpi=110)
-    plt.close(fig)
+    save_figure(fig, path)
     return report
 
 
@@ -335,14 +381,12 @@ def interface_profile(out: Path, path: Path, times=None) -> dict:
     Returns:
         {time (s): {"gap_max_mm", "slip_max_mm", "gap_max_at_mm", "slip_max_at_mm"}}.
     """
-    import matplotlib
-
-    matplotlib.use("Agg")
-    import matplotlib.pyplot as plt
+    from fepen.post.figures import new_figure, run_title, save_figure
 
     all_t = output_times(out)
     times = all_t[[len(all_t) // 4, len(all_t) // 2, -1]] if times is None else times
-    fig, ax = plt.subplots(1, 2, figsize=(12, 3.8))
+    fig = new_figure((12, 4.2))
+    ax = fig.subplots(1, 2)
     report = {}
     for t in times:
         st = read_state(out, t)
@@ -355,51 +399,57 @@ def interface_profile(out: Path, path: Path, times=None) -> dict:
         wall = np.flatnonzero(cnt[inv] == 2)
         y = X[wall, 1] * 1e3
         g, s = st["interface_gap_m"][wall] * 1e3, st["interface_slip_m"][wall] * 1e3
-        ax[0].plot(y, g, ".", ms=2, label=f"t = {st['t'] * 1e6:.0f} us")
-        ax[1].plot(y, s, ".", ms=2, label=f"t = {st['t'] * 1e6:.0f} us")
+        ax[0].plot(y, g, ".", ms=2, label=f"t = {st['t'] * 1e6:.0f} µs")
+        ax[1].plot(y, s, ".", ms=2, label=f"t = {st['t'] * 1e6:.0f} µs")
         report[st["t"]] = {"gap_max_mm": float(g.max()), "gap_max_at_mm": float(y[np.argmax(g)]),
                            "slip_max_mm": float(s.max()), "slip_max_at_mm": float(y[np.argmax(s)])}
-    ax[0].set(xlabel="wall node: reference distance behind the nose tip (mm)", ylabel="gap (mm, > 0 open)")
-    ax[1].set(xlabel="wall node: reference distance behind the nose tip (mm)", ylabel="slip (mm)")
+    ax[0].set(xlabel="wall node: reference distance behind the nose tip (mm)", ylabel="gap (mm, > 0 open)",
+              title="shell–charge gap")
+    ax[1].set(xlabel="wall node: reference distance behind the nose tip (mm)", ylabel="slip (mm)",
+              title="shell–charge slip")
     for a in ax:
-        a.legend(fontsize=7)
+        a.legend(fontsize=7, markerscale=4)
+        a.grid(alpha=0.3)
+    fig.suptitle(run_title(out, "the shell–charge interface"), fontsize=10)
     fig.tight_layout()
-    fig.savefig(path, dpi=110)
-    plt.close(fig)
+    save_figure(fig, path)
     return report
 
 
 def charge_histories(out: Path, path: Path) -> None:
     """Shell and charge accelerations (raw and filtered) and the charge's section stresses over time."""
-    import matplotlib
-
-    matplotlib.use("Agg")
-    import matplotlib.pyplot as plt
+    from fepen.post.figures import new_figure, run_title, save_figure
 
     acc = np.genfromtxt(Path(out) / "accelerations.csv", delimiter=",", names=True)
     sec = np.genfromtxt(Path(out) / "charge_sections.csv", delimiter=",", names=True)
-    fig, ax = plt.subplots(1, 4, figsize=(18, 3.8))
+    fig = new_figure((18, 4.4))
+    ax = fig.subplots(1, 4)
     t = acc["t_s"] * 1e6
+    tlabel = "time after impact (µs)"
     for name, colour in (("shell_acc", "C0"), ("charge_acc", "C3")):
         ax[0].plot(t, acc[f"{name}_g"] / 1e3, color=colour, lw=0.5, alpha=0.5)
         ax[0].plot(t, acc[f"{name}_filtered_g"] / 1e3, color=colour, lw=1.5, label=f"{name.split('_')[0]} (filtered)")
-    ax[0].set(xlabel="t (us)", ylabel="axial acceleration (1000 g)", title="thin: raw")
+    ax[0].set(xlabel=tlabel, ylabel="axial acceleration (1000 g)", title="accelerations (thin: raw)")
     ts = sec["t_s"] * 1e6
     for k in range(5):
-        ax[1].plot(ts, sec[f"axis{k}_axial_Pa"] / 1e6, label=f"axis point {k} (front to rear)")
-    ax[1].set(xlabel="t (us)", ylabel="axial stress (MPa)", title="along the charge's axis")
+        ax[1].plot(ts, sec[f"axis{k}_axial_Pa"] / 1e6, label=f"axis point {k + 1} of 5 (front to rear)")
+    ax[1].set(xlabel=tlabel, ylabel="axial stress (MPa, compression < 0)", title="along the charge's axis")
     for label, ls in (("front", "-"), ("nose_end", "--"), ("mid", ":")):
         for r, colour in zip((0, 33, 67, 90), ("C0", "C1", "C2", "C3")):
             ax[2].plot(ts, sec[f"{label}_r{r}_axial_Pa"] / 1e6, ls=ls, color=colour, lw=0.8,
-                       label=f"{label}, r = {r} %")
+                       label=f"{label.replace('_', ' ')}, r = {r} % of the cavity radius")
             ax[3].plot(ts, sec[f"{label}_r{r}_shear_Pa"] / 1e6, ls=ls, color=colour, lw=0.8)
-    ax[2].set(xlabel="t (us)", ylabel="axial stress (MPa)", title="sections: - front, -- nose end, : mid")
-    ax[3].set(xlabel="t (us)", ylabel="shear stress (MPa)", title="sections (colour: radius)")
+    ax[2].set(xlabel=tlabel, ylabel="axial stress (MPa, compression < 0)",
+              title="sections: — front, -- nose end, ··· mid")
+    ax[3].set(xlabel=tlabel, ylabel="shear stress (MPa)", title="sections (colour: radius, as left)")
     for a in ax[:3]:
         a.legend(fontsize=6)
+    for a in ax:
+        a.grid(alpha=0.3)
+        a.title.set_fontsize(9)
+    fig.suptitle(run_title(out, "the charge's accelerations and section stresses"), fontsize=10)
     fig.tight_layout()
-    fig.savefig(path, dpi=110)
-    plt.close(fig)
+    save_figure(fig, path)
 
 
 def charge_report(out: Path, sections: dict, time: float | None = None) -> dict:

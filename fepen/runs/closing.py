@@ -41,8 +41,8 @@ class Closing:
                 slices.stress_maps(run.out, run.out / "stress_maps_end.png")
                 slices.trajectory_figure(run.out, run.out / "trajectory.png", table1_shot(name) if name else None)
         else:
-            analyses.deformed_picture(s, run.out / "deformed.png",
-                                      f"t = {s.t * 1e6:.0f} us, max PEEQ {diagnostics.max_peeq(s):.3g}")
+            analyses.deformed_picture(s, run.out / "deformed.png", f"t = {s.t * 1e6:.0f} µs, max PEEQ "
+                                      f"{diagnostics.max_peeq(s):.3g}", run.gauges.peak_von_mises)
         m = run.model
         if m.surface is not None:
             self.profile = analyses.nose_profile(s, run.pm.shape, m.tip, m.tail, m.surface.tri, run.out)

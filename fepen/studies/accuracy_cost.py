@@ -12,7 +12,6 @@ from pathlib import Path
 import numpy as np
 
 from fepen import scene as fscene
-from fepen.atomic import replacing
 from fepen.io import files
 from fepen.studies import processes
 
@@ -221,15 +220,15 @@ def _write(rows, exponents, speedups, out: Path) -> None:
 
 def pareto(rows, path: Path) -> None:
     """Error against Table 1 (nose) and against the finest run, against wall time, log-log."""
-    import matplotlib
+    from matplotlib.lines import Line2D
 
-    matplotlib.use("Agg")
-    import matplotlib.pyplot as plt
+    from fepen.post.figures import new_figure, save_figure
 
-    fig, axes = plt.subplots(1, 2, figsize=(12, 5))
+    fig = new_figure((12, 5))
+    axes = fig.subplots(1, 2)
     marks = {"mesh": "o", "fidelity": "s", "cheaper": "^", "costlier": "v", "ranks": "D"}
     colours = {"C3": "tab:blue", "C7": "tab:red"}
-    for ax, key, label in ((axes[0], "nose_error", "nose error against Table 1"),
+    for ax, key, label in ((axes[0], "nose_error", "nose error against Table 1's test"),
                            (axes[1], "H_vs_finest", "nose position against the finest run")):
         for r in rows:
             if "failed" in r or not np.isfinite(r.get(key, np.nan)) or r.get(key, 0) <= 0:
@@ -240,11 +239,9 @@ def pareto(rows, path: Path) -> None:
                         xytext=(3, 2), textcoords="offset points")
         ax.set(xlabel="wall time of the run (s)", ylabel=f"{label} (%)")
         ax.grid(True, which="both", alpha=0.3)
-    handles = [plt.Line2D([], [], marker=m, ls="", color="gray", label=g) for g, m in marks.items()]
-    handles += [plt.Line2D([], [], marker="o", ls="", color=c, label=s) for s, c in colours.items()]
+    handles = [Line2D([], [], marker=m, ls="", color="gray", label=f"varied: {g}") for g, m in marks.items()]
+    handles += [Line2D([], [], marker="o", ls="", color=c, label=f"shot {s}") for s, c in colours.items()]
     axes[0].legend(handles=handles, fontsize=8)
     fig.suptitle("fepen: accuracy against time (shots C3 and C7)")
     fig.tight_layout()
-    with replacing(path, ".png") as tmp:
-        fig.savefig(tmp, dpi=120)
-    plt.close(fig)
+    save_figure(fig, path, dpi=120)

@@ -281,35 +281,35 @@ def markdown(table: list[dict], header: str = "") -> str:
 
 
 def figure(results: dict[str, list[dict]], path, method: str = "default") -> None:
-    """Predicted against measured depth, one marker per set, with the ±10 % and ±20 % bands."""
-    import matplotlib
+    """Predicted against measured depth, one marker per set, with the ±10 % and ±20 % bands (log scales, mm)."""
+    from fepen.post.figures import new_figure, save_figure
 
-    matplotlib.use("Agg")
-    import matplotlib.pyplot as plt
-
-    fig, ax = plt.subplots(figsize=(6.4, 6.0))
-    hi = max(max(max(s["depth"], s[method]) for s in shots) for shots in results.values()) * 1.1
-    lo = min(min(min(s["depth"], s[method]) for s in shots) for shots in results.values()) / 1.1
+    fig = new_figure((6.6, 6.4))
+    ax = fig.subplots()
+    hi = max(max(max(s["depth"], s[method]) for s in shots) for shots in results.values()) * 1.1e3
+    lo = min(min(min(s["depth"], s[method]) for s in shots) for shots in results.values()) / 1.1 * 1e3
     line = np.geomspace(lo, hi, 50)
-    ax.plot(line, line, "k-", lw=1)
+    ax.plot(line, line, "k-", lw=1, label="predicted = measured")
     for f, style in ((0.1, "--"), (0.2, ":")):
         ax.plot(line, line * (1 + f), "k" + style, lw=0.8, label=f"±{f:.0%}")
         ax.plot(line, line * (1 - f), "k" + style, lw=0.8)
     markers = "osD^v<>pXh*P"
+    count = 0
     for i, (name, shots) in enumerate(results.items()):
-        ax.plot([s["depth"] for s in shots], [s[method] for s in shots], markers[i % len(markers)], ms=5,
-                mfc="none", label=f"{name} ({len(shots)})")
+        count += len(shots)
+        ax.plot([s["depth"] * 1e3 for s in shots], [s[method] * 1e3 for s in shots], markers[i % len(markers)],
+                ms=5, mfc="none", label=f"{name} ({len(shots)} tests)")
     ax.set_xscale("log")
     ax.set_yscale("log")
     ax.set_xlim(lo, hi)
     ax.set_ylim(lo, hi)
-    ax.set_xlabel("measured depth (m)")
-    ax.set_ylabel(f"predicted depth (m), rigid fidelity, {method} law")
+    ax.set_xlabel("measured depth of penetration (mm)")
+    ax.set_ylabel(f"predicted depth (mm): rigid fidelity, {method} law")
+    ax.set_title(f"rigid fidelity against {count} measured depths ({len(results)} data sets)", fontsize=10)
     ax.legend(fontsize=7, loc="upper left")
     ax.grid(True, which="both", lw=0.3)
     fig.tight_layout()
-    fig.savefig(path, dpi=130)
-    plt.close(fig)
+    save_figure(fig, path, dpi=130)
 
 
 def validate_depth(paths=(), sets=(), out="results/validate-depth", workers: int = 1,

@@ -133,7 +133,7 @@ def ballistic_limit(scene_path, sets, out, comm=None, ranks_per_shot: int = 1, v
         result.update(a=a, p=p, rms_m_s=rms)
     if comm.rank == 0:
         files.write_json(out / "ballistic_limit.json", result, MPI.COMM_SELF)
-        _limit_figure(result, out / "ballistic_limit.png")
+        _limit_figure(result, out / "ballistic_limit.png", probe)
         say(f"ballistic limit {v_bl:.1f} m/s (bracket {lo:.2f}-{hi:.2f}, tol {tol:g}); "
             f"{v_bl - tol:.1f} m/s: {check['below']['outcome']}, {v_bl + tol:.1f} m/s: {check['above']['outcome']}"
             + (f"; Recht-Ipson a = {result['a']:.3f}, p = {result['p']:.2f}, rms {result['rms_m_s']:.1f} m/s"
@@ -141,33 +141,50 @@ def ballistic_limit(scene_path, sets, out, comm=None, ranks_per_shot: int = 1, v
     return result
 
 
-def _limit_figure(res: dict, path: Path) -> None:
-    import matplotlib
+def _scene_line(sc) -> str:
+    """What a study's figure says of its base scene: fidelity, projectile mass and calibre, the target."""
+    layers = sc.get("target.layers")
+    if layers:
+        target = f"{len(layers)}-layer target"
+    else:
+        thick = sc.get("target.thickness")
+        target = f"{sc.get('target.material')}" + (f", {thick * 1e3:g} mm thick" if thick else "")
+        fc = sc.get("target.compressive_strength")
+        from fepen.data import TARGETS
 
-    matplotlib.use("Agg")
-    import matplotlib.pyplot as plt
+        if fc and TARGETS.get(sc.get("target.material"), {}).get("family") in ("concrete", "rock"):
+            target += f", f_c {fc / 1e6:g} MPa"
+    return (f"{sc.get('effects.fidelity')} fidelity; {sc.get('projectile.mass') * 1e3:g} g, "
+            f"{sc.get('projectile.diameter') * 1e3:g} mm projectile; {target}")
 
-    fig, ax = plt.subplots(figsize=(5.5, 4))
+
+def _limit_figure(res: dict, path: Path, sc=None) -> None:
+    """ballistic_limit.png: residual against striking speed, the shots that did not perforate on the axis,
+    the Recht–Ipson fit and the limit (dotted). sc: the base Scene (for the title), or None."""
+    from fepen.post.figures import new_figure, save_figure
+
+    fig = new_figure((6.4, 4.6))
+    ax = fig.subplots()
     pts = res["curve"] + [{"v_m_s": b["v_m_s"], "residual_speed_m_s": b["residual_speed_m_s"]}
                           for b in res["bisection"] if b["outcome"] == "perforated"]
     v = np.array([p["v_m_s"] for p in pts])
     vr = np.array([p["residual_speed_m_s"] for p in pts])
     ax.plot(v, vr, "o", label="fepen shots (perforated)")
     stuck = [b["v_m_s"] for b in res["bisection"] if b["outcome"] != "perforated"]
-    ax.plot(stuck, np.zeros(len(stuck)), "x", color="tab:red", label="not perforated")
+    ax.plot(stuck, np.zeros(len(stuck)), "x", color="tab:red", label="fepen shots (not perforated)")
     if "a" in res:
         x = np.linspace(res["v_bl_m_s"], max(v.max(), res["v_bl_m_s"] * 1.4), 200)
         ax.plot(x, recht_ipson(x, res["v_bl_m_s"], res["a"], res["p"]), "-", color="k",
-                label=f"Recht-Ipson a = {res['a']:.3f}, p = {res['p']:.2f}")
-    ax.axvline(res["v_bl_m_s"], ls=":", color="k")
+                label=f"Recht–Ipson fit: a = {res['a']:.3f}, p = {res['p']:.2f}")
+    ax.axvline(res["v_bl_m_s"], ls=":", color="k", label=f"ballistic limit {res['v_bl_m_s']:.1f} m/s")
     ax.set_xlabel("striking speed (m/s)")
     ax.set_ylabel("residual speed (m/s)")
-    ax.set_title(f"ballistic limit {res['v_bl_m_s']:.1f} m/s (± {res['tol_m_s'] / 2:g})")
+    title = f"ballistic limit {res['v_bl_m_s']:.1f} m/s (± {res['tol_m_s'] / 2:g} m/s)"
+    ax.set_title(title + (f"\n{_scene_line(sc)}" if sc is not None else ""), fontsize=9)
     ax.grid(alpha=0.3)
     ax.legend(fontsize=8)
     fig.tight_layout()
-    fig.savefig(path, dpi=120)
-    plt.close(fig)
+    save_figure(fig, path, dpi=120)
 
 
 def ricochet(scene_path, sets, out, comm=None, ranks_per_shot: int = 1, speeds=(300, 400, 500, 600, 700, 800, 900),
@@ -184,7 +201,7 @@ def ricochet(scene_path, sets, out, comm=None, ranks_per_shot: int = 1, speeds=(
     """
     comm = MPI.COMM_WORLD if comm is None else comm
     base = _base(scene_path, sets)
-    fscene.Scene(base)
+    probe = fscene.Scene(base)
     speeds = [float(v) for v in speeds]
     if not speeds or not all(0 < v <= 3000 for v in speeds) or not 0 < obliquity_max < 90 or not tol > 0:
         raise InputError("--speeds", "speeds in (0, 3000] m/s, obliquity_max in (0, 90) deg, tol > 0")
@@ -222,30 +239,29 @@ def ricochet(scene_path, sets, out, comm=None, ranks_per_shot: int = 1, speeds=(
               "map": cells}
     if comm.rank == 0:
         files.write_json(out / "ricochet.json", result, MPI.COMM_SELF)
-        _ricochet_figure(result, out / "ricochet.png")
+        _ricochet_figure(result, out / "ricochet.png", probe)
         say("critical obliquity: " + ", ".join(f"{v:g} m/s {c:.1f} deg" for v, c in zip(speeds, critical)))
     return result
 
 
-def _ricochet_figure(res: dict, path: Path) -> None:
-    import matplotlib
-
-    matplotlib.use("Agg")
-    import matplotlib.pyplot as plt
-
+def _ricochet_figure(res: dict, path: Path, sc=None) -> None:
+    """ricochet.png: the outcome of every shot over striking speed and obliquity, and the bisected ricochet
+    boundary. sc: the base Scene (for the title), or None."""
+    from fepen.post.figures import new_figure, save_figure
     from fepen.studies.sweep_figures import OUTCOME_COLOURS
 
-    fig, ax = plt.subplots(figsize=(5.5, 4.2))
+    fig = new_figure((6.4, 4.8))
+    ax = fig.subplots()
     for name in sorted({c["outcome"] for c in res["map"]}):
         c = [m for m in res["map"] if m["outcome"] == name]
         ax.plot([m["v_m_s"] for m in c], [m["obliquity_deg"] for m in c], "s", ms=5,
-                color=OUTCOME_COLOURS.get(name, "k"), label=name, alpha=0.8)
+                color=OUTCOME_COLOURS.get(name, "k"), label=f"fepen shots: {name}", alpha=0.8)
     ax.plot(res["speeds_m_s"], res["critical_obliquity_deg"], "-k", lw=1.5,
-            label=f"ricochet boundary (± {res['tol_deg'] / 2:g} deg)")
+            label=f"ricochet boundary (± {res['tol_deg'] / 2:g}°)")
     ax.set_xlabel("striking speed (m/s)")
-    ax.set_ylabel("obliquity (deg)")
+    ax.set_ylabel("obliquity from the face normal (°)")
+    ax.set_title("critical obliquity of ricochet" + (f"\n{_scene_line(sc)}" if sc is not None else ""), fontsize=9)
     ax.grid(alpha=0.3)
     ax.legend(fontsize=8)
     fig.tight_layout()
-    fig.savefig(path, dpi=120)
-    plt.close(fig)
+    save_figure(fig, path, dpi=120)
