@@ -14,19 +14,25 @@
 # results. Run it as a script (`python demos/api_tour.py [--out DIR]`), under MPI
 # (`mpirun -n 2 python demos/api_tour.py`), or open it as a notebook with jupytext.
 #
-# The API has three calls and one scene type:
+# The API has four calls and one scene type:
 #
 # - `fepen.Scene(source, sets=...)` builds a validated scene. The source can be a TOML file, TOML text
 #   or a nested dict, and `sets` takes `--set`-style overrides.
 # - `fepen.run(scene, out=None, comm=None)` runs it, exactly as `fepen run` does, and returns a `Result`.
 # - `fepen.load(results_dir)` reads any finished run's directory back into a `Result`.
+# - `fepen.sweep(spec, out=None)` runs many shots and returns their table as a pandas DataFrame
+#   (demos/rigid_study.py).
 
 # +
 import argparse
 import tempfile
 from pathlib import Path
 
+import matplotlib
+
 import fepen
+
+backend = matplotlib.get_backend()  # fepen draws on figures of its own: the notebook's backend stays
 
 parser = argparse.ArgumentParser(description="A tour of fepen's Python API")
 parser.add_argument("--out", default=None, help="where the runs go (default: a temporary directory)")
@@ -61,6 +67,7 @@ except fepen.InputError as err:
 # `history.csv`. The columns are in SI units or carry their unit in their name.
 
 r1 = fepen.run(rigid, out=root / "rigid", comm=comm, force=True)  # force: a second tour replaces the first
+assert matplotlib.get_backend() == backend, "fepen.run changed matplotlib's backend"
 if comm.rank == 0:
     print(f"rigid: {r1.summary['outcome']}, Hy = {r1.summary['Hy_mm']:.1f} mm "
           f"(test {r1.summary['experiment']['Hy_mm']:g} mm), {len(r1.history)} history rows")
@@ -92,15 +99,14 @@ if comm.rank == 0:
 
 # ## A picture from the loaded results
 #
-# The trajectories of the nose tip, rigid against deformable, with the test's end point.
+# The trajectories of the nose tip, rigid against deformable, with the test's end point, drawn with pyplot as
+# any of the notebook's own plots: fepen draws on figures of its own and leaves pyplot's backend alone, so this
+# shows inline in a notebook (and is only saved, with Agg, when the tour runs as a script).
 
 # +
+import matplotlib.pyplot as plt  # noqa: E402
+
 if comm.rank == 0:
-    import matplotlib
-
-    matplotlib.use("Agg")
-    import matplotlib.pyplot as plt
-
     fig, ax = plt.subplots(figsize=(5, 4))
     for res, label in ((r1, "rigid"), (again, "plastic")):
         h = res.history
@@ -113,4 +119,5 @@ if comm.rank == 0:
     fig.tight_layout()
     fig.savefig(root / "tour.png", dpi=100)
     print("written:", root / "tour.png")
+    plt.show()
 # -

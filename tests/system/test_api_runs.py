@@ -1,5 +1,5 @@
 """The Python API in whole processes: fepen.run of a bare dict, fepen.load of a results directory, and the
-literate API tour (demos/api_tour.py), serially and on two MPI ranks."""
+literate API tour (demos/api_tour.py) on two MPI ranks (its serial run is test_notebooks': as a notebook)."""
 
 import json
 
@@ -22,7 +22,7 @@ def test_run_a_dict_and_load_it_back(tmp_path):
 
 
 @pytest.mark.slow
-@pytest.mark.parametrize("ranks", [1, 2])
+@pytest.mark.parametrize("ranks", [2])
 def test_api_tour(tmp_path, ranks):
     r = run_python(ROOT / "demos" / "api_tour.py", "--out", tmp_path, ranks=ranks)
     assert r.returncode == 0, r.stderr[-3000:]
