@@ -91,25 +91,26 @@ def _cell_J(solver) -> np.ndarray:
 
 def _elastic_by_material(solver) -> np.ndarray:
     """This rank's stored elastic energy per material (J): the volumetric part on the owned nodes' columns
-    (Σ V0_a K/2 (ln J_a)^2; per cell without nodal pressure), the deviatoric Σ V s:s / (4G) per live cell."""
+    (Σ V0_a K/2 (ln J_a)^2; per cell without nodal pressure) and the deviatoric Σ V s:s / (4G) per live cell."""
     s = solver
     nm, n = len(s.materials), s.n_owned
-    live = s.mat >= 0
-    mat = s.mat[live]
-    J = _cell_J(s)[live]
-    G = np.array([m.shear_modulus for m in s.materials])
-    sd = s.s[: s.n_cells][live]
+    mat = s.mat
+    live = mat >= 0
+    J = _cell_J(s)
+    G = np.array([m.shear_modulus for m in s.materials])[mat]  # eroded cells (−1): weighed 0 below
+    sd = s.s  # column-major: whole columns are cheap, rows are not
     ss = sd[:, 0] ** 2 + sd[:, 1] ** 2 + sd[:, 2] ** 2 + 2.0 * (sd[:, 3] ** 2 + sd[:, 4] ** 2 + sd[:, 5] ** 2)
-    out = np.bincount(mat, weights=J * s.vol0[live] * ss / (4.0 * G[mat]), minlength=nm)
+    per_cell = J * s.vol0 * ss / (4.0 * G)
     if s.nodal:
         v0, v = s.nodal_vol0[:n], s.nodal_vol[:n]
         has = v0 > 0.0
         lj = np.log(np.where(has, v, 1.0) / np.where(has, v0, 1.0))
-        out += 0.5 * s.bulk * np.sum(v0 * lj * lj, axis=0)
+        out = 0.5 * s.bulk * np.sum(v0 * lj * lj, axis=0)
     else:
-        lj = np.log(J)
-        out += np.bincount(mat, weights=s.vol0[live] * 0.5 * s.bulk[mat] * lj * lj, minlength=nm)
-    return out
+        lj = np.log(np.where(live, J, 1.0))
+        per_cell += s.vol0 * 0.5 * s.bulk[mat] * lj * lj
+        out = np.zeros(nm)
+    return out + np.bincount(np.where(live, mat, 0), weights=np.where(live, per_cell, 0.0), minlength=nm)
 
 
 def _bilinear_plastic(solver) -> np.ndarray:
@@ -194,19 +195,26 @@ class Bodies:
 
 
 def bodies(solver, e: Energies) -> Bodies:
-    """Each body's kinetic energy and world x, y momentum (exact sums over the owned nodes: the same bits on
-    any partition), and its internal energy from the step's energies ``e`` (collective)."""
+    """Each body's kinetic energy and world x, y momentum, and its internal energy from the step's energies
+    ``e`` (collective). Exact sums over the owned nodes (the same bits on any partition): the whole body's
+    momentum, the last body's (the charge's) over its own nodes; the first (the shell) is the whole less the
+    others (the whole kinetic energy is e.kinetic, an exact sum too)."""
     s = solver
     n, nm = s.n_owned, len(s.materials)
     v = s.velocity_at_step()[:n]
     mb = s.mass_by_material[:n]
-    terms = np.empty((n, 3 * nm))
-    terms[:, :nm] = 0.5 * mb * np.sum(v * v, axis=1)[:, None]
-    terms[:, nm: 2 * nm] = mb * v[:, :1]
-    terms[:, 2 * nm:] = mb * v[:, 1:2]
-    sums = assembly.exact_sum(terms, s.comm)
+    whole = assembly.exact_sum(s.mass[:n, None] * v[:, :2], s.comm)
+    kinetic, momentum = np.zeros(nm), np.zeros((nm, 2))
+    for k in range(1, nm):
+        on = np.flatnonzero(mb[:, k] > 0.0)
+        w, vk = mb[on, k], v[on]
+        sums = assembly.exact_sum(np.column_stack([0.5 * w * np.sum(vk * vk, axis=1), w * vk[:, 0], w * vk[:, 1]]),
+                                  s.comm)
+        kinetic[k], momentum[k] = sums[0], sums[1:]
+    kinetic[0] = e.kinetic - np.sum(kinetic[1:])
+    momentum[0] = whole - np.sum(momentum[1:], axis=0)
     internal = np.array(e.elastic_by_body) + np.array(e.plastic_by_body)
-    return Bodies(sums[:nm], internal, np.column_stack([sums[nm: 2 * nm], sums[2 * nm:]]))
+    return Bodies(kinetic, internal, momentum)
 
 
 def tied_interface_force(solver, body: int = 1) -> np.ndarray:
