@@ -20,11 +20,32 @@ G0 = 9.80665  # m/s^2, for accelerations in g
 HISTORY_COLUMNS = ["t_s", "nose_x_mm", "nose_y_mm", "tail_x_mm", "tail_y_mm", "speed_m_s", "decel_g",
                    "vx_m_s", "vy_m_s", "force_x_N", "force_y_N", "length_mm", "kinetic_J", "internal_work_J",
                    "external_work_J", "elastic_J", "plastic_J", "heat_J", "energy_error", "contact_nodes",
-                   "dt_s", "max_peeq", "contact_area_m2"]
+                   "dt_s", "max_peeq", "contact_area_m2", "total_energy_J", "energy_ratio"]
+# the last two, in every history (both fidelities; LS-DYNA's glstat): total_energy_J (J) = kinetic_J +
+# internal_work_J + friction_J − the shell–charge contact's normal work + removed_kinetic_J − external_work_J,
+# the target's (or rigid wall's) work counted as energy it took, as LS-DYNA counts a stonewall's or a contact's;
+# it stays at the striking kinetic energy KE_0 when the balance holds (the terms of energy_error, signed).
+# energy_ratio (-) = total_energy_J / KE_0: 1 for a perfect balance. Rigid fidelity: kinetic_J + the kinetic
+# energy the worn mass carried off − external_work_J (no internal energy, no interface).
 COL = {k: i for i, k in enumerate(HISTORY_COLUMNS)}
 #: appended with a charge: mass-averaged acceleration of each body along the axis (tail to nose), in g
 #: (negative while the projectile decelerates)
 CHARGE_COLUMNS = ["shell_acc_g", "charge_acc_g"]
+#: appended with a charge, after CHARGE_COLUMNS (LS-DYNA's matsum, fepen.solver.diagnostics.bodies): each
+#: body's kinetic energy (J), internal energy, elastic + plastic work (J; the plastic work split between the
+#: bodies exactly when the shell alone heats, the default), and momentum (N s) in the reported frame (x along
+#: the face in the direction of travel, y depth: positive while moving into the target, as vx_m_s, vy_m_s). A
+#: node of the tied wall counts in each body with the mass it takes from that body's cells, so shell + charge
+#: = kinetic_J, elastic_J + plastic_J, and mass × (vx_m_s, vy_m_s).
+BODY_COLUMNS = ["shell_kinetic_J", "shell_internal_J", "shell_px_N_s", "shell_py_N_s",
+                "charge_kinetic_J", "charge_internal_J", "charge_px_N_s", "charge_py_N_s"]
+#: appended with a charge, after BODY_COLUMNS (LS-DYNA's rcforc): the resultant force the shell exerts on the
+#: charge across their interface (N), reported frame (x along the face, y depth: positive pushing the charge
+#: into the target; it is negative while the shell decelerates the charge), and its magnitude (N, with the
+#: out-of-plane part). Frictional contact: the sum of the contact forces on the charge's wall nodes
+#: (fepen.solver.shell_charge); tied: the rate of change of the charge's momentum minus the external load on
+#: it (fepen.solver.diagnostics.tied_interface_force). Over time its impulse is the change of charge_p*_N_s.
+RESULTANT_COLUMNS = ["contact_fx_N", "contact_fy_N", "contact_force_N"]
 #: appended with effects.wear or effects.erosion (either fidelity): the mass, the interface heat, the eroded
 #: cells and the kinetic energy the removed material carried away, so far
 REMOVAL_COLUMNS = ["mass_kg", "wear_heat_J", "eroded_cells", "removed_kinetic_J"]
@@ -42,21 +63,23 @@ def history_row(t, tip, tail, velocity, force, mass, energies: dict, contact: in
         tip, tail: world positions (m) of the nose tip and tail centre. velocity: centre-of-mass velocity.
         force: target force on the projectile (N, world). mass: projectile mass (kg).
         contact: number of loaded points (nodes on a rigid wall); contact_area: loaded area (m^2).
-        energies: kinetic, internal_work, external_work, elastic, plastic, heat, energy_error (J, -).
+        energies: kinetic, internal_work, external_work, elastic, plastic, heat, energy_error, total_energy,
+            energy_ratio (J, -).
     """
     axis = unit_axis(tip, tail)
     decel = -float(np.dot(force, axis)) / mass / G0
     row = [t, tip[0] * 1e3, -tip[1] * 1e3, tail[0] * 1e3, -tail[1] * 1e3, float(np.linalg.norm(velocity)), decel,
            velocity[0], -velocity[1], force[0], -force[1], float(np.linalg.norm(tip - tail)) * 1e3,
            energies["kinetic"], energies["internal_work"], energies["external_work"], energies["elastic"],
-           energies["plastic"], energies["heat"], energies["energy_error"], contact, dt, peeq, contact_area]
+           energies["plastic"], energies["heat"], energies["energy_error"], contact, dt, peeq, contact_area,
+           energies["total_energy"], energies["energy_ratio"]]
     return row
 
 
 def write_history(rows, out: Path, comm=MPI.COMM_WORLD, columns=None) -> None:
     """history.csv (rank 0, atomically; collective: a failed write raises MachineFault on every rank, and
-    the file keeps its last complete version); columns: HISTORY_COLUMNS (default), + CHARGE_COLUMNS with a
-    charge."""
+    the file keeps its last complete version); columns: HISTORY_COLUMNS (default), + CHARGE_COLUMNS, BODY_COLUMNS
+    and RESULTANT_COLUMNS with a charge, ..."""
 
     def write():
         files.inject("history")

@@ -71,7 +71,8 @@ class DeformableRun(Run):
 
     @property
     def columns(self) -> list[str]:
-        return (results.HISTORY_COLUMNS + (results.CHARGE_COLUMNS if self.pm.charge else [])
+        charge = results.CHARGE_COLUMNS + results.BODY_COLUMNS + results.RESULTANT_COLUMNS
+        return (results.HISTORY_COLUMNS + (charge if self.pm.charge else [])
                 + (results.INTERFACE_COLUMNS if self.contact is not None else [])
                 + (results.REMOVAL_COLUMNS if self.removing else []))
 
@@ -162,7 +163,8 @@ class DeformableRun(Run):
         x = s.positions()
         e = diagnostics.energies(s)
         en = dict(kinetic=e.kinetic, internal_work=e.internal_work, external_work=e.external_work,
-                  elastic=e.elastic, plastic=e.plastic, heat=e.heat, energy_error=e.balance_error)
+                  elastic=e.elastic, plastic=e.plastic, heat=e.heat, energy_error=e.balance_error,
+                  total_energy=e.total, energy_ratio=e.ratio)
         if e.balance_error > ENERGY_LIMIT:
             raise SimulationError(
                 f"energy balance lost: error {e.balance_error:.1%} at step {s.step_count}, t = {s.t * 1e6:.3f} us "
@@ -173,6 +175,11 @@ class DeformableRun(Run):
         extra = []
         if self.pm.charge:
             extra += list(diagnostics.body_accelerations(s, unit_axis(tip, tail)) / results.G0)
+            b = diagnostics.bodies(s, e)
+            for k in range(2):  # reported frame: y is depth
+                extra += [b.kinetic[k], b.internal[k], b.momentum[k, 0], -b.momentum[k, 1]]
+            f = self.contact.resultant() if self.contact is not None else diagnostics.tied_interface_force(s)
+            extra += [f[0], -f[1], float(np.linalg.norm(f))]
             self.sections.record(tip, tail)
         if self.contact is not None:
             i = self.contact.summary()

@@ -230,8 +230,10 @@ class RigidRun(Run):
         tail = body.to_world(s, self.tail_ref[None])[0]
         ke = body.kinetic_energy(s)
         removed = self.wear.kinetic_removed if self.wear is not None else 0.0
+        total = ke + removed - self.w_ext  # glstat's total: the target's work counted as energy it took
         en = dict(kinetic=ke, internal_work=0.0, external_work=self.w_ext, elastic=0.0, plastic=0.0, heat=0.0,
-                  energy_error=energy.balance_error(ke, self.ke0, self.w_ext, removed_kinetic=removed))
+                  energy_error=energy.balance_error(ke, self.ke0, self.w_ext, removed_kinetic=removed),
+                  total_energy=total, energy_ratio=total / self.ke0)
         rear = -float(body.points(s)[0][:, 1].max())
         return Snapshot(tip, tail, s.V, self.F, body.mass, en, self.loaded, self.dt, 0.0, self.area, rear)
 

@@ -1,7 +1,7 @@
 """What a run reads off an ExplicitSolver between steps: the energies and their balance, the body's
-momentum and accelerations, plastic strain, the stress fields written out, and the internal force through
-dolfinx (the reference of the solver's own assembly, for tests and benchmarks). Nothing here changes the
-solver's state."""
+momentum and accelerations, each body's energies and momentum and the force across the tied shell–charge
+interface, plastic strain, the stress fields written out, and the internal force through dolfinx (the
+reference of the solver's own assembly, for tests and benchmarks). Nothing here changes the solver's state."""
 
 from __future__ import annotations
 
@@ -12,6 +12,7 @@ from dolfinx import cpp as _cpp
 from mpi4py import MPI
 
 from fepen.laws import energy
+from fepen.laws import materials as M
 from fepen.solver import assembly, kernels
 
 
@@ -30,6 +31,23 @@ class Energies:
     friction: float = 0.0
     removed_kinetic: float = 0.0
     removed_internal: float = 0.0
+    #: per material (0 the shell, 1 the charge): stored elastic energy and plastic work (J)
+    elastic_by_body: tuple = ()
+    plastic_by_body: tuple = ()
+
+    @property
+    def total(self) -> float:
+        """The total energy (J), glstat's: KE + W_int + E_interface + KE_removed + E_target, with E_interface
+        = friction dissipation − normal work of the shell–charge contact and E_target = −W_ext the energy the
+        target (or rigid wall) took; the terms of balance_error, so that a perfect balance keeps it at KE_0."""
+        return (self.kinetic + self.internal_work + self.friction - self.interface_normal_work
+                + self.removed_kinetic - self.external_work)
+
+    @property
+    def ratio(self) -> float:
+        """glstat's energy ratio: total / (KE_0 + external work), the target's work being counted in the total
+        (as LS-DYNA counts a stonewall's or a contact's energy), so total / KE_0; 1 for a perfect balance."""
+        return self.total / max(self.initial_kinetic, 1e-300)
 
     @property
     def balance_error(self) -> float:
@@ -47,14 +65,15 @@ def energies(solver) -> Energies:
     s = solver
     c = s.comm
     ke = s.kinetic_energy(s.velocity_at_step())
-    vol = kernels.volumetric_energy(s.nodal_vol, s.nodal_vol0, s.bulk, s.n_owned)
-    if not s.nodal:
-        vol = _element_volumetric_energy(s)
-    dev = _deviatoric_energy(s)
+    nm = len(s.materials)
     w_int, w_ext = work_sums(s)
-    sums = c.allreduce(np.array([vol + dev, s._plastic, s._heat, s._w_if_n, s._w_if_t, s._removed[1],
-                                 s._removed[2]]), op=MPI.SUM)
-    return Energies(ke, w_int, w_ext, sums[0], sums[1], sums[2], s.ke0 or 0.0, sums[3], -sums[4], sums[5], sums[6])
+    sums = c.allreduce(np.concatenate([_elastic_by_material(s), _bilinear_plastic(s),
+                                       [s._plastic, s._heat, s._w_if_n, s._w_if_t, s._removed[1], s._removed[2]]]),
+                       op=MPI.SUM)
+    elastic, bilinear = sums[:nm], sums[nm: 2 * nm]
+    plastic, heat, w_n, w_t, removed_ke, removed_ie = sums[2 * nm:]
+    return Energies(ke, w_int, w_ext, float(np.sum(elastic)), plastic, heat, s.ke0 or 0.0, w_n, -w_t, removed_ke,
+                    removed_ie, tuple(elastic), tuple(_plastic_by_material(s.materials, plastic, heat, bilinear)))
 
 
 def work_sums(solver) -> tuple[float, float]:
@@ -70,14 +89,78 @@ def _cell_J(solver) -> np.ndarray:
     return J
 
 
-def _deviatoric_energy(solver) -> float:
-    G = np.array([m.shear_modulus for m in solver.materials])[solver.mat]
-    return kernels.deviatoric_energy(solver.s, _cell_J(solver), solver.vol0, G)
+def _elastic_by_material(solver) -> np.ndarray:
+    """This rank's stored elastic energy per material (J): the volumetric part on the owned nodes' columns
+    (Σ V0_a K/2 (ln J_a)^2; per cell without nodal pressure) and the deviatoric Σ V s:s / (4G) per live cell."""
+    s = solver
+    nm, n = len(s.materials), s.n_owned
+    mat = s.mat
+    live = mat >= 0
+    J = _cell_J(s)
+    G = np.array([m.shear_modulus for m in s.materials])[mat]  # eroded cells (−1): weighed 0 below
+    sd = s.s  # column-major: whole columns are cheap, rows are not
+    ss = sd[:, 0] ** 2 + sd[:, 1] ** 2 + sd[:, 2] ** 2 + 2.0 * (sd[:, 3] ** 2 + sd[:, 4] ** 2 + sd[:, 5] ** 2)
+    per_cell = J * s.vol0 * ss / (4.0 * G)
+    if s.nodal:
+        v0, v = s.nodal_vol0[:n], s.nodal_vol[:n]
+        has = v0 > 0.0
+        lj = np.log(np.where(has, v, 1.0) / np.where(has, v0, 1.0))
+        out = 0.5 * s.bulk * np.sum(v0 * lj * lj, axis=0)
+    else:
+        lj = np.log(np.where(live, J, 1.0))
+        per_cell += s.vol0 * 0.5 * s.bulk[mat] * lj * lj
+        out = np.zeros(nm)
+    return out + np.bincount(np.where(live, mat, 0), weights=np.where(live, per_cell, 0.0), minlength=nm)
 
 
-def _element_volumetric_energy(solver) -> float:
-    lj = np.log(_cell_J(solver))
-    return float(np.sum(solver.vol0 * 0.5 * solver.bulk[solver.mat] * lj * lj))
+def _bilinear_plastic(solver) -> np.ndarray:
+    """This rank's plastic work per material in closed form for the bilinear materials (J): Σ V0 (σ_0 ε_p +
+    H ε_p² / 2) over their cells, the work of σ_y = σ_0 + H ε_p along ε_p per reference volume (the solver's
+    own sum Σ σ_y Δε_p V is over the current volume: this differs from it by the volume change, under 1 %
+    for the charge); 0 for the other materials."""
+    s = solver
+    nm = len(s.materials)
+    out = np.zeros(nm)
+    for k, m in enumerate(s.materials):
+        if m.kind == M.BILINEAR:
+            e = s.eps_p[: s.n_cells][s.mat == k]
+            out[k] = float(np.sum(s.vol0[s.mat == k] * (m.params[M.A_] * e + 0.5 * m.params[M.H_] * e * e)))
+    return out
+
+
+def _heats(m) -> bool:
+    """Whether material m turns a fraction β > 0 of its plastic work into heat (Johnson–Cook, thermal on)."""
+    p = m.params
+    return m.kind == M.JOHNSON_COOK and p[M.THERMAL_ON] > 0.0 and p[M.BETA] > 0.0
+
+
+def _plastic_by_material(materials, plastic: float, heat: float, bilinear) -> list[float]:
+    """The plastic work (J) split per material, from the solver's two running sums (the plastic work and the
+    heat, over all cells). Exact (to round-off) when at most one material is left unknown after these:
+    an elastic material does none; when exactly one material heats, its share is heat / β (the solver adds
+    β σ_y Δε_p V to the heat and σ_y Δε_p V to the plastic work, the same terms); the one material left takes
+    the rest. The charged projectile (a Johnson–Cook shell with effects.thermal, a bilinear charge) is so.
+    Otherwise (effects.thermal = false) a bilinear material's share is its closed form (_bilinear_plastic) and
+    the last material takes the rest.
+
+    Args:
+        materials: the solver's materials. plastic, heat: the global sums (J). bilinear: the global closed
+            forms per material (_bilinear_plastic).
+    """
+    nm = len(materials)
+    known: dict[int, float] = {k: 0.0 for k, m in enumerate(materials) if m.kind == M.ELASTIC}
+    heating = [k for k, m in enumerate(materials) if _heats(m)]
+    if len(heating) == 1:
+        known[heating[0]] = heat / materials[heating[0]].params[M.BETA]
+    unknown = [k for k in range(nm) if k not in known]
+    if unknown:
+        other = [k for k in unknown if materials[k].kind != M.BILINEAR]
+        rest = other[-1] if other else unknown[-1]  # the one that takes the rest
+        for k in unknown:
+            if k != rest:  # the bilinear ones by their closed form (no other rule: the rest takes all)
+                known[k] = float(bilinear[k]) if materials[k].kind == M.BILINEAR else 0.0
+        known[rest] = plastic - sum(known.values())
+    return [known[k] for k in range(nm)]
 
 
 def momentum_velocity(solver) -> np.ndarray:
@@ -93,6 +176,60 @@ def body_accelerations(solver, axis: np.ndarray) -> np.ndarray:
     n = solver.n_owned
     along = solver.acc[:n] @ axis
     return assembly.exact_sum(solver.mass_by_material[:n] * along[:, None], solver.comm) / solver.body_mass
+
+
+@dataclass
+class Bodies:
+    """Each body's (material's: 0 the shell, 1 the charge) energies and momentum, LS-DYNA's matsum. A node on
+    a tied interface counts in each body with the lumped mass it takes from that body's cells (as
+    body_accelerations), so the bodies' sums are the whole projectile's.
+
+    Attributes:
+        kinetic: Σ ½ m_a^(body) |v_a|² (J), v at the step. internal: elastic + plastic (J; Energies'
+        elastic_by_body and plastic_by_body). momentum: Σ m_a^(body) v_a, world x and y (N s).
+    """
+
+    kinetic: np.ndarray
+    internal: np.ndarray
+    momentum: np.ndarray
+
+
+def bodies(solver, e: Energies) -> Bodies:
+    """Each body's kinetic energy and world x, y momentum, and its internal energy from the step's energies
+    ``e`` (collective). Exact sums over the owned nodes (the same bits on any partition): the whole body's
+    momentum, the last body's (the charge's) over its own nodes; the first (the shell) is the whole less the
+    others (the whole kinetic energy is e.kinetic, an exact sum too)."""
+    s = solver
+    n, nm = s.n_owned, len(s.materials)
+    v = s.velocity_at_step()[:n]
+    mb = s.mass_by_material[:n]
+    whole = assembly.exact_sum(s.mass[:n, None] * v[:, :2], s.comm)
+    kinetic, momentum = np.zeros(nm), np.zeros((nm, 2))
+    for k in range(1, nm):
+        on = np.flatnonzero(mb[:, k] > 0.0)
+        w, vk = mb[on, k], v[on]
+        sums = assembly.exact_sum(np.column_stack([0.5 * w * np.sum(vk * vk, axis=1), w * vk[:, 0], w * vk[:, 1]]),
+                                  s.comm)
+        kinetic[k], momentum[k] = sums[0], sums[1:]
+    kinetic[0] = e.kinetic - np.sum(kinetic[1:])
+    momentum[0] = whole - np.sum(momentum[1:], axis=0)
+    internal = np.array(e.elastic_by_body) + np.array(e.plastic_by_body)
+    return Bodies(kinetic, internal, momentum)
+
+
+def tied_interface_force(solver, body: int = 1) -> np.ndarray:
+    """The resultant force the other bodies exert on ``body`` (the charge) across a tied interface (N, world),
+    all ranks: the rate of change of its momentum minus the external load on it,
+    Σ_a m_a^(body) a_a − Σ_a (m_a^(body) / m_a) f_ext,a over the owned nodes (exact sums). A node of the
+    shared wall counts in the body with its share m_a^(body) of its mass, so this is the force that changes
+    the body's momentum as Bodies defines it; the sum of the body's own internal forces vanishes (each
+    cell's nodal forces sum to zero), so it is what the other body's cells give across the wall. With the
+    charge enclosed in the shell, the external term is zero."""
+    s = solver
+    n = s.n_owned
+    mb = s.mass_by_material[:n, body]
+    share = np.where(mb > 0.0, mb / s._mass_div[:n], 0.0)
+    return assembly.exact_sum(mb[:, None] * s.acc[:n] - share[:, None] * s.fext[:n], s.comm)
 
 
 def max_peeq(solver) -> float:

@@ -103,6 +103,12 @@ class ShellChargeContact:
         s.acc[self.pb[ib]] -= self.force[ib] * self._inv_mb
         s.a_fn.x.scatter_forward()
 
+    def resultant(self) -> np.ndarray:
+        """The resultant of the last step's contact forces on the charge (N, world), all ranks: what the shell
+        exerts on the charge across the interface (LS-DYNA's rcforc), −Σ force over the pairs whose charge
+        node this rank owns (those it applied), an exact sum (the same bits on any partition)."""
+        return -assembly.exact_sum(self.force[self._b_own], self.solver.comm)
+
     # ------------------------------------------------------------------------------------------------
     def gap_and_slip(self) -> tuple[np.ndarray, np.ndarray]:
         """Per local pair: the gap (m, > 0 open) and the slip, the tangential relative displacement (m)."""
