@@ -12,6 +12,7 @@
     outputs      History, Fields, Checkpoint, Progress: due / write / close on one clock
     checkpoint   checkpoint files and --resume
     interrupts   SIGTERM / SIGINT during a run
+    probes       the user's point and cell histories ([[output.probes]], probes.csv)
 """
 
 from __future__ import annotations
@@ -22,7 +23,7 @@ from fepen.runs import setup, shot
 from fepen.runs.rigid import RigidRun
 from fepen.runs.shot import Shot, resolve
 
-__all__ = ["shot", "setup", "run", "rigid", "batch", "model", "deformable", "closing", "events", "outputs",
+__all__ = ["shot", "setup", "run", "rigid", "batch", "model", "deformable", "closing", "events", "outputs", "probes",
            "checkpoint", "interrupts", "run_scene", "run_in_directory", "expected_end", "resolve", "Shot", "RigidRun"]
 
 
