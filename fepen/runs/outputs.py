@@ -29,15 +29,21 @@ def next_multiple(interval: float, t: float) -> float:
         interval: the output interval (s), > 0. t: the time now (s).
 
     Returns:
-        k x interval (s), the product as a float (the same bits wherever it is computed).
+        k x interval (s), rounded to 15 significant digits: the same bits wherever it is computed, and one
+        time where two grids meet (10 x 1e-6 and 1 x 1e-5 are both 1e-05, as the files print them).
     """
     tol = GRID_TOLERANCE * interval
     k = math.floor(t / interval) + 1
-    while k > 1 and (k - 1) * interval > t + tol:
+    while k > 1 and _decimal((k - 1) * interval) > t + tol:
         k -= 1
-    while k * interval <= t + tol:
+    while _decimal(k * interval) <= t + tol:
         k += 1
-    return k * interval
+    return _decimal(k * interval)
+
+
+def _decimal(x: float) -> float:
+    """x to 15 significant digits (within 5e-16 of it)."""
+    return float(f"{x:.15g}")
 
 
 class Clock:

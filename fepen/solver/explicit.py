@@ -385,17 +385,20 @@ class ExplicitSolver:
 
 
 def _choose_step(s: ExplicitSolver) -> None:
-    """The coming step ``s.dt``: the stable step, shortened to end on the next landing time (``s.landing``) when
-    it would cross it (central differences take any shorter step; the stable step bounds it from above), or to
-    half the way there when a full step would leave less than a step (no sliver of a step before it)."""
+    """The coming step ``s.dt``: the stable step, or, with a landing time ahead (``s.landing``), the time to it
+    cut into the fewest equal steps no longer than the stable step, the last of which ends on it (central
+    differences take any shorter step; the stable step bounds it from above). Equal steps, not one short one
+    before each landing: a step that changes every interval pumps energy into the highest modes (a C3 run at
+    300 m/s, elastic: an energy error of 2.6e-3 with one short step per microsecond, 1.2e-5 without landing)."""
     dt, s._land_at = s.dt_stable, -1.0
     if s.landing is not None:
         target = s.landing(s.t)
         r = target - s.t
-        if LANDING_SLIVER * dt < r <= dt:
-            dt, s._land_at = r, target
-        elif dt < r < 2.0 * dt:
-            dt = 0.5 * r
+        if r > LANDING_SLIVER * dt:
+            n = max(1, math.ceil(r / dt * (1.0 - 1e-12)))
+            dt = r / n
+            if n == 1:
+                s._land_at = target
     s.dt = dt
 
 
