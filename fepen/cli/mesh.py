@@ -19,7 +19,10 @@ def run(args) -> int:
 
     sc = fscene.load(args.scene, args.sets)
     # force: `fepen mesh` has always written its files among whatever --out holds (it has no --force option)
-    info = api.mesh(sc, args.out, force=True)
+    from fepen.geometry import mesh as fmesh
+
+    with fmesh.progress(True):  # gmsh's stages and the elapsed time, on a terminal
+        info = api.mesh(sc, args.out, force=True)
     keys = ("cells", "nodes", "mass_kg", "volume_m3", "min_quality", "shortest_altitude_m", "stable_dt_s")
     say(*(f"{k} = {info[k]:.6g}" if isinstance(info[k], float) else f"{k} = {info[k]}" for k in keys),
         f"altitude_over_size = {info['altitude_over_size']:.4f}",

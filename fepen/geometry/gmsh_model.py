@@ -94,6 +94,16 @@ ALTITUDE_GOAL = 0.27
 MAX_SEEDS = 6
 
 
+#: called with the name of each stage as it starts ("building", "meshing", "optimising"), or None: the mesh's
+#: progress bar (fepen.geometry.mesh.progress)
+stage_hook = None
+
+
+def _stage(name: str) -> None:
+    if stage_hook is not None:
+        stage_hook(name)
+
+
 def build_best(shape: Shape | cad.CadBody, opts: MeshOptions, charge: bool) -> float:
     """Mesh with :func:`build`, retrying new seeds until the shortest altitude reaches ALTITUDE_GOAL x size.
 
@@ -128,6 +138,7 @@ def build(shape: Shape | cad.CadBody, opts: MeshOptions, charge: bool, seed: int
     """
     import gmsh
 
+    _stage("building")
     if isinstance(shape, cad.CadBody):
         cad.build(shape.file, shape.scale)
         _size_and_mesh(opts, 0.0, seed)
@@ -230,7 +241,10 @@ def _size_and_mesh(opts: MeshOptions, nose_length: float, seed: int, algorithm: 
         f.setNumber(thr, "DistMin", 0.0)
         f.setNumber(thr, "DistMax", nose_length)
         f.setAsBackgroundMesh(thr)
+    _stage("meshing")
     gmsh.model.mesh.generate(3)
+    if opts.optimize != "none":
+        _stage("optimising")
     if opts.optimize == "netgen":
         gmsh.model.mesh.optimize("Netgen")
     if opts.optimize != "none":

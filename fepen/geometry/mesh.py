@@ -5,12 +5,14 @@ along the projectile, its cavity sized to a mass on the mesh, its wall split for
 
 from __future__ import annotations
 
+import contextlib
 import functools
 import hashlib
 import json
 import logging
 import math
 import os
+import threading
 import time
 from dataclasses import asdict, dataclass, fields, replace
 from pathlib import Path
@@ -27,6 +29,62 @@ from fepen.version import __version__
 
 #: mesh-mass tolerance of the cavity sizing (kg)
 MASS_TOLERANCE = 2.5e-4
+
+#: whether a mesh built by gmsh shows its progress bar (set by ``progress``: fepen run, fepen mesh)
+_PROGRESS = {"on": False}
+
+
+@contextlib.contextmanager
+def progress(on: bool):
+    """Within it, a mesh that gmsh builds (not one read from the cache) shows a bar on rank 0's stderr: the
+    stage (building, meshing, optimising, and the try when a seed is retried) and the elapsed time. Quiet when
+    stderr is not a terminal, unless FEPEN_PROGRESS=1 (a run under mpirun started from one); FEPEN_PROGRESS=0
+    keeps it quiet.
+
+    Args:
+        on: the switch (the run's progress switch).
+    """
+    before, _PROGRESS["on"] = _PROGRESS["on"], bool(on)
+    try:
+        yield
+    finally:
+        _PROGRESS["on"] = before
+
+
+def bar_disabled() -> bool | None:
+    """tqdm's ``disable`` for a bar that is wanted: FEPEN_PROGRESS=1 shows it, 0 hides it, unset: None (shown
+    only on a terminal)."""
+    env = os.environ.get("FEPEN_PROGRESS")
+    return None if env not in ("0", "1") else env == "0"
+
+
+class _MeshBar:
+    """The stages of gmsh and the elapsed time, refreshed every second by a thread (gmsh's calls release the
+    interpreter lock)."""
+
+    def __init__(self):
+        import sys
+
+        from tqdm import tqdm
+
+        self.bar = tqdm(desc="mesh: building", bar_format="{desc} [{elapsed}]", file=sys.stderr, leave=False,
+                        disable=bar_disabled())
+        self.tries, self.done = 0, threading.Event()
+        self.thread = threading.Thread(target=self._tick, daemon=True)
+        self.thread.start()
+
+    def _tick(self) -> None:
+        while not self.done.wait(1.0):
+            self.bar.refresh()
+
+    def stage(self, name: str) -> None:
+        self.tries += name == "building"
+        self.bar.set_description_str(f"mesh: {name}" + (f" (try {self.tries})" if self.tries > 1 else ""))
+
+    def close(self) -> None:
+        self.done.set()
+        self.thread.join()
+        self.bar.close()
 
 
 def _code_hash() -> str:
@@ -229,6 +287,21 @@ def _mesh_on_root(shape: Shape | CadBody, opts, charge: bool, mass, rho_s, rho_c
         cached = _read_entry(key, msh, side)
         if cached is not None:
             return cached, 0.0, True
+
+    bar = _MeshBar() if _PROGRESS["on"] else None
+    gmsh_model.stage_hook = bar.stage if bar is not None else None
+    try:
+        return _build_on_root(shape, opts, charge, mass, rho_s, rho_c, use_cache, msh, side, key)
+    finally:
+        gmsh_model.stage_hook = None
+        if bar is not None:
+            bar.close()
+
+
+def _build_on_root(shape, opts, charge: bool, mass, rho_s, rho_c, use_cache: bool, msh: Path, side: Path,
+                   key: str):
+    """Rank 0, not from the cache: gmsh's mesh, its cavity sized to the mass, cached and read back."""
+    import gmsh
 
     t0 = time.perf_counter()
     current = shape

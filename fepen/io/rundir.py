@@ -37,6 +37,7 @@ RESERVE, RESERVE_BYTES = ".fepen.reserve", 256 * 1024
 MARKERS = ("summary.json", "run.json", "history.csv", "fields.xdmf", "checkpoint")
 #: what a fepen run writes into its directory: ``--force`` removes these and nothing else
 OUTPUT_NAMES = ("summary.json", "run.json", "fepen.log", "scene.toml", "history.csv", "history.png", "checkpoint",
+                "probes.csv",
                 "fields.xdmf", "fields.h5", "fields.d", "fields_*.xdmf", "fields_*.h5", "view.py", "*.png",
                 "accelerations.csv", "gauges*.csv", "hazard*.csv", "sections*.csv", "charge*.csv", "charge*.json",
                 "nose_profile*.csv", "profile*.csv", "strains*.csv", "*.vtu", "*.tmp*", "run.log", RESERVE)

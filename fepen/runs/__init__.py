@@ -12,6 +12,7 @@
     outputs      History, Fields, Checkpoint, Progress: due / write / close on one clock
     checkpoint   checkpoint files and --resume
     interrupts   SIGTERM / SIGINT during a run
+    probes       the user's point and cell histories ([[output.probes]], probes.csv)
 """
 
 from __future__ import annotations
@@ -22,7 +23,7 @@ from fepen.runs import setup, shot
 from fepen.runs.rigid import RigidRun
 from fepen.runs.shot import Shot, resolve
 
-__all__ = ["shot", "setup", "run", "rigid", "batch", "model", "deformable", "closing", "events", "outputs",
+__all__ = ["shot", "setup", "run", "rigid", "batch", "model", "deformable", "closing", "events", "outputs", "probes",
            "checkpoint", "interrupts", "run_scene", "run_in_directory", "expected_end", "resolve", "Shot", "RigidRun"]
 
 
@@ -46,7 +47,7 @@ def run_scene(scene, out, comm=MPI.COMM_WORLD, progress: bool = False, resume: d
         scene: a resolved Scene.
         out: the results directory (None: write nothing; rigid runs only).
         comm: the communicator of the run.
-        progress: a progress bar on rank 0 (deformable runs).
+        progress: progress bars on rank 0 (deformable runs: the mesh's stages, then the simulated time).
         resume: a checkpoint's state (fepen.runs.checkpoint.read_state) to continue from (deformable runs).
         sh: the scene's Shot when already resolved.
 
@@ -56,10 +57,13 @@ def run_scene(scene, out, comm=MPI.COMM_WORLD, progress: bool = False, resume: d
     sh = sh or resolve(scene)
     if sh.rigid:
         return RigidRun(sh, out, comm).run()
+    from fepen.geometry import mesh as fmesh
     from fepen.runs.deformable import DeformableRun  # dolfinx: only a deformable run pays for importing it
 
     end = expected_end(scene, sh) if progress and comm.rank == 0 else None
-    return DeformableRun(sh, out, comm, end, resume).run()
+    with fmesh.progress(progress):  # gmsh's stages, when it meshes
+        run = DeformableRun(sh, out, comm, end, resume)
+    return run.run()
 
 
 def run_in_directory(scene, out, comm=MPI.COMM_WORLD, mode: str = "new", progress: bool = False,

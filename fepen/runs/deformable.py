@@ -17,6 +17,7 @@ from fepen.io import results
 from fepen.io.fields import FieldWriter
 from fepen.post import analyses, paraview
 from fepen.runs import checkpoint, closing, events, model, outputs, shot
+from fepen.runs import probes as run_probes
 from fepen.runs.run import Removal, Run, Snapshot
 from fepen.solver import diagnostics, explicit, probes
 
@@ -46,6 +47,8 @@ class DeformableRun(Run):
         sh = shot.of(shot_)
         self.fidelity = sh.fidelity
         self.model = m = model.build(sh, comm)
+        if sh.probes:  # located before any step: a point outside the mesh is an input error
+            self.probes = run_probes.MeshProbes(sh.probes, m.solver, sh.mesh.options.size)
         super().__init__(sh, out, comm)
         self.pm, self.solver, self.load, self.contact = m.pm, m.solver, m.load, m.contact
         self.initial_mass = self.solver.initial_mass
@@ -53,8 +56,8 @@ class DeformableRun(Run):
         self.sections = analyses.ChargeSections(self.solver, self.pm) if self.pm.charge else None
         self.closing = closing.Closing()
         o = sh.outputs
-        self.fields_out = outputs.Fields(o.output_interval) if o.fields else None
-        self.checkpoints = outputs.Checkpoint(o.checkpoint_interval, o.checkpoint_interval)
+        self.fields_out = outputs.Fields(o.output_interval, grid=True) if o.fields else None
+        self.checkpoints = outputs.Checkpoint(o.checkpoint_interval, o.checkpoint_interval, grid=True)
         field_times = self.restore(resume) if resume is not None else []
         self.fields = self._field_writer(field_times) if self.fields_out is not None else None
         self.outputs += [x for x in (self.fields_out, self.checkpoints) if x is not None]
@@ -249,7 +252,7 @@ class DeformableRun(Run):
         """(the components whose state is arrays, per rank; those whose state is small, kept in state.json)."""
         m = self.model
         arrays = {"solver": self.solver, "load": self.load, "gauges": self.gauges, "sections": self.sections,
-                  "surface": m.surface if self.removing else None, "recession": m.recession}
+                  "surface": m.surface if self.removing else None, "recession": m.recession, "probes": self.probes}
         small = {"rules": self.rules, "crossings": self.crossings, "erosion": m.erosion, "history": self.history,
                  "fields": self.fields_out, "checkpoints": self.checkpoints}
         return ({k: c for k, c in arrays.items() if c is not None}, {k: c for k, c in small.items() if c is not None})

@@ -13,7 +13,7 @@ from fepen.geometry import mesh as fmesh
 from fepen.geometry import revolution, tags
 from fepen.geometry.shape import Shape
 from fepen.laws import target as tg
-from fepen.runs import setup, shot
+from fepen.runs import outputs, setup, shot
 from fepen.solver import erosion, explicit, probes, recession, rigid_wall, shell_charge, surface, target_load
 
 
@@ -100,6 +100,7 @@ def build(sh, comm: MPI.Comm = MPI.COMM_WORLD) -> Model:
         y_c = _nose_zone(s, surf, sh.built.shape) if w.distribution == "nose" else None
         receding = recession.Recession(s, surf, w.friction, w.efficiency, w.enthalpy, w.density, zone_end=y_c)
         load.wear = receding
+    s.landing = outputs.landing(sh)  # the steps end on the output times
     R, v = sh.rotation, sh.velocity
     s.set_initial(displacement=lambda X: X @ R.T - X, velocity=lambda X: np.tile(v, (len(X), 1)))
     return Model(pm, s, load, contact, tip, tail, sh.speed, surf, sh.law, mesh_s, time.perf_counter() - t0,

@@ -5,11 +5,45 @@ each has ``due(run)``, ``write(run)`` and ``close(run, completed)``; the timed o
     Fields       the fields (fepen.io.fields) every run.output_interval, and history.csv with them
     Checkpoint   a checkpoint (fepen.runs.checkpoint) every run.checkpoint_interval, and history.csv
     Progress     the tqdm bar on rank 0
+
+The deformable run's steps end on the output times (``Landing``: the explicit solver shortens the step that
+would cross one), so that its clocks, on the grid (``Clock(grid=True)``), give rows at k x interval exactly.
+The rigid fidelity's clock keeps its steps' times (its RK4 step is longer than the history interval: every
+step is a row, and the batched path, fepen/laws/rigid_batch.c, repeats that clock bit for bit).
 """
 
 from __future__ import annotations
 
+import math
 from time import perf_counter
+
+#: two output times closer than this fraction of an interval are one time (k x 1e-6 and m x 5e-5 differ by
+#: rounding where they coincide)
+GRID_TOLERANCE = 1e-9
+
+
+def next_multiple(interval: float, t: float) -> float:
+    """The first k x interval (k an integer) later than t by more than GRID_TOLERANCE x interval.
+
+    Args:
+        interval: the output interval (s), > 0. t: the time now (s).
+
+    Returns:
+        k x interval (s), rounded to 15 significant digits: the same bits wherever it is computed, and one
+        time where two grids meet (10 x 1e-6 and 1 x 1e-5 are both 1e-05, as the files print them).
+    """
+    tol = GRID_TOLERANCE * interval
+    k = math.floor(t / interval) + 1
+    while k > 1 and _decimal((k - 1) * interval) > t + tol:
+        k -= 1
+    while _decimal(k * interval) <= t + tol:
+        k += 1
+    return _decimal(k * interval)
+
+
+def _decimal(x: float) -> float:
+    """x to 15 significant digits (within 5e-16 of it)."""
+    return float(f"{x:.15g}")
 
 
 class Clock:
@@ -18,24 +52,69 @@ class Clock:
     Args:
         interval: simulated time between two outputs (s); 0 or less: never due.
         next: the first output time (s).
+        grid: the times are k x interval (products, not sums: no drift), and a time within GRID_TOLERANCE of
+            an interval of ``next`` is due (a run whose steps land on the output times, Landing); False: the
+            rigid fidelity's clock (next += interval past t, due at t >= next).
     """
 
-    def __init__(self, interval: float, next: float = 0.0):
-        self.interval, self.next = interval, next
+    def __init__(self, interval: float, next: float = 0.0, grid: bool = False):
+        self.interval, self.next, self.grid = interval, next, grid
 
     def due(self, t: float) -> bool:
-        return self.interval > 0.0 and t >= self.next
+        if self.interval <= 0.0:
+            return False
+        return t >= self.next - (GRID_TOLERANCE * self.interval if self.grid else 0.0)
 
     def advance(self, t: float) -> None:
+        if self.grid:
+            self.next = next_multiple(self.interval, t)
+            return
         while self.next <= t:
             self.next += self.interval
 
 
-class Timed:
-    """An output due on its Clock of simulated time."""
+class Landing:
+    """The next time a step must end on: the first output time of any clock after t, or the run's end.
 
-    def __init__(self, interval: float, first: float = 0.0):
-        self.clock = Clock(interval, first)
+    Args:
+        intervals: the clocks' intervals (s); those <= 0 are never due and ignored.
+        end: the time the run ends at the latest (s).
+
+    Calling it with the time now (s) returns that time (s).
+    """
+
+    def __init__(self, intervals, end: float):
+        self.intervals = tuple(i for i in intervals if i > 0.0)
+        self.end = end
+
+    def __call__(self, t: float) -> float:
+        target = min((next_multiple(i, t) for i in self.intervals), default=math.inf)
+        tol = GRID_TOLERANCE * min(self.intervals, default=0.0)
+        if t < self.end <= target + tol:
+            return self.end
+        return target
+
+
+def landing(shot) -> Landing:
+    """The Landing of a deformable shot's outputs: its history rows, its fields (run.fields), its checkpoints
+    and its end.
+
+    Args:
+        shot: the fepen.runs.shot.Shot.
+
+    Returns:
+        The Landing (the explicit solver's ``landing``).
+    """
+    o = shot.outputs
+    return Landing((o.history_interval, o.output_interval if o.fields else 0.0, o.checkpoint_interval),
+                   shot.hard_end)
+
+
+class Timed:
+    """An output due on its Clock of simulated time (on the grid: Clock's ``grid``)."""
+
+    def __init__(self, interval: float, first: float = 0.0, grid: bool = False):
+        self.clock = Clock(interval, first, grid)
 
     def due(self, run) -> bool:
         return self.clock.due(run.t)

@@ -27,6 +27,7 @@ from fepen.laws.rigid_body import (
     matrix_to_quat,
     tet_mass_properties,
 )
+from fepen.runs import probes as run_probes
 from fepen.runs import setup, shot
 from fepen.runs.run import Removal, Run, Snapshot
 
@@ -168,6 +169,8 @@ class RigidRun(Run):
         self.t, self.step_count = 0.0, 0
         self.prev = self.state
         self.F = self.body.derivative(self.state, self.force_fn)[1]  # the force of a row: at its step's start
+        if sh.probes and history and self.out is not None:
+            self.probes = run_probes.RigidProbes(sh.probes)
 
     # ------------------------------------------------------------------------------------------------
     def force_fn(self, s: RigidState, x, v, n):

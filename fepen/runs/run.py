@@ -82,6 +82,8 @@ class Run:
     fidelity: str = ""
     #: steps between two checks of the stop rules
     check_every: int = 1
+    #: the user's probes (fepen.runs.probes), recorded with the history rows, or None
+    probes = None
 
     def __init__(self, shot: Shot, out, comm=MPI.COMM_WORLD):
         self.shot, self.comm = shot, comm
@@ -94,7 +96,7 @@ class Run:
         self.rules = events.StopRules(law.thickness if law is not None else None, shot.end_time is None)
         self.crossings = fl.Crossings(law.faces()) if shot.layered else None
         self.removing = shot.wear is not None or shot.erosion is not None
-        self.history = outputs.History(shot.outputs.history_interval)
+        self.history = outputs.History(shot.outputs.history_interval, grid=not shot.rigid)
         self.outputs: list = [self.history]
         self.stop: BaseException | None = None  # what stopped the run before its end
 
@@ -211,6 +213,8 @@ class Run:
             row += [s.mass, r.heat_J, r.eroded_cells, r.kinetic_J]
         results.finite_row(row, self.step_count, self.t)
         self.rows.append(row)
+        if self.probes is not None:
+            self.probes.record(self)
         if self.crossings is not None:
             self.crossings.update(self.t, -float(s.tip[1]), s.rear_depth, float(np.linalg.norm(s.velocity)))
         return row
@@ -228,9 +232,11 @@ class Run:
                 rundir.log_line(f"fepen: while stopping, {type(o).__name__.lower()} output: {err}")
 
     def write_history(self) -> None:
-        """history.csv of the rows so far (collective)."""
+        """history.csv (and probes.csv) of the rows so far (collective)."""
         if self.out is not None:
             results.write_history(self.rows, self.out, self.comm, self.columns)
+            if self.probes is not None:
+                self.probes.write(self.out, self.comm)
 
     # ---- the summary --------------------------------------------------------------------------------------
     def removal_summary(self) -> dict:

@@ -16,6 +16,7 @@ from fepen.geometry.cad import CadBody
 from fepen.geometry.mass_rule import Built
 from fepen.laws import target as tg
 from fepen.laws import wear
+from fepen.runs import probes as run_probes
 from fepen.runs import setup
 from fepen.scene import to_toml
 
@@ -83,6 +84,8 @@ class Shot:
         experiment: the Table 1 shot's name (impact.shot) or None.
         scene: the resolved scene as a dict (summary.json's "scene"); scene_toml: as scene.toml (the given keys).
         body_key: what identifies the projectile (a sweep's shots share a body).
+        probes: output.probes, the user's point and cell histories ({"name", "point", "kind"}, ...; each point
+            checked inside the exact body: fepen.runs.probes.check_inside).
     """
 
     fidelity: str
@@ -108,6 +111,7 @@ class Shot:
     scene: dict = field(repr=False)
     body_key: tuple = field(repr=False, default=())
     scene_toml: str = field(repr=False, default="")
+    probes: tuple = ()
 
     @property
     def rigid(self) -> bool:
@@ -185,6 +189,8 @@ def resolve(scene, toml: bool = True) -> Shot:
     end = scene.get("run.end_time")
     materials = () if rigid else tuple(setup.materials(scene, built))
     e = scene.projectile.erosion
+    probes = tuple(scene.get("output.probes") or ())
+    run_probes.check_inside(built.shape, probes, scene.effects.charge)
     return Shot(
         fidelity=scene.effects.fidelity, built=built, law=law, rotation=R, velocity=v, crh=scene.projectile.crh,
         wear=_wear(scene), erosion=ErosionParameters(e.strain, e.step_ratio) if scene.effects.erosion else None,
@@ -194,7 +200,7 @@ def resolve(scene, toml: bool = True) -> Shot:
         charge_friction=scene.charge.friction, rigid_step=scene.get("run.rigid_step"),
         nominal_diameter=scene.projectile.diameter,
         experiment=scene.get("impact.shot"), scene=scene.as_dict(), body_key=setup.body_key(scene),
-        scene_toml=to_toml(scene) if toml else "")
+        scene_toml=to_toml(scene) if toml else "", probes=probes)
 
 
 def of(shot_or_scene) -> Shot:

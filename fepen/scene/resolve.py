@@ -218,6 +218,18 @@ def _metal_constants_known(name: str, c: dict) -> None:
                 raise InputError(f"target.{k}", f"a metal target ({name}) needs it")
 
 
+@cross_check("[[output.probes]] of kind 'cell' with effects.fidelity 'elastic' or 'plastic' (the rigid body has no "
+             "stresses)")
+def _cell_probes_meshed(flat: dict, given: dict) -> None:
+    if flat["effects.fidelity"] != "rigid":
+        return
+    for i, probe in enumerate(flat.get("output.probes") or ()):
+        if probe["kind"] == "cell":
+            raise InputError(f"output.probes[{i}].kind", "'cell' reads a cell's stresses, PEEQ and temperature: "
+                                                          "use it with effects.fidelity = 'elastic' or 'plastic' (the "
+                                                          "rigid fidelity has 'node' probes only)")
+
+
 #: the projectile keys of a drawn body, refused beside projectile.cad
 CAD_EXCLUDES = ("projectile.nose", "projectile.diameter", "projectile.length", "projectile.crh", "projectile.mass",
                 "projectile.nose_length", "projectile.meplat_diameter", "projectile.boattail_length",
@@ -348,7 +360,7 @@ def _check_across(flat: dict, given: dict) -> None:
     """The checks across keys of the resolved values, in this order (the first refusal is the one reported);
     each layer's and the mass rule of a shot were checked as they resolved."""
     _check_projectile_keys(flat, given)
-    for check in (_mass_and_charge, _erosion_meshed, _orders, _melt_above_room, _axis_into_target,
+    for check in (_mass_and_charge, _erosion_meshed, _cell_probes_meshed, _orders, _melt_above_room, _axis_into_target,
                   _rigid_step_within_end, _charge_hardening):
         check(flat, given)
     if "target.layers" not in flat:

@@ -9,14 +9,62 @@ cavity, tensile strength, ...) are explained in docs/theory.md.
 from __future__ import annotations
 
 from fepen.data import CONSTANTS, FAMILIES, SHOTS, STEELS, TARGETS, shot
-from fepen.scene.keys import ABSENT, Key, check_layers, check_sections, choice, flag, number, positive
+from fepen.errors import InputError
+from fepen.scene.keys import (
+    ABSENT,
+    Key,
+    check_layers,
+    check_sections,
+    choice,
+    display_name,
+    finite,
+    flag,
+    number,
+    positive,
+    shown,
+)
 
-__all__ = ["SCHEMA", "SECTIONS", "LAYER_KEYS", "LAYER_FIELDS"]
+__all__ = ["SCHEMA", "SECTIONS", "LAYER_KEYS", "LAYER_FIELDS", "PROBE_FIELDS"]
 
 
 def _layers(key: Key, name: str, value) -> list:
     """target.layers' rows: each table's keys checked as LAYER_FIELDS declares them."""
     return check_layers(key, name, value, LAYER_FIELDS)
+
+
+def _probes(key: Key, name: str, value) -> list:
+    """output.probes' rows: each table's name (unique, letters, digits, '_' or '-'), point ([x, y, z], m) and
+    kind ('node' or 'cell', default 'node'); unknown keys refused.
+
+    Args:
+        key: the list key (for its allowed form). name: the key's name. value: what the user gave.
+
+    Returns:
+        The rows as {"name": str, "point": [x, y, z], "kind": str}.
+    """
+    if not isinstance(value, list) or not value or not all(isinstance(v, dict) for v in value):
+        raise InputError(name, f"got {shown(value)}, expected {key.allowed()} ([[output.probes]] in TOML)")
+    out, seen = [], set()
+    for i, table in enumerate(value):
+        here = f"{name}[{i}]"
+        for k in table:
+            if k not in PROBE_FIELDS:
+                raise InputError(f"{here}.{display_name(k)}", f"unknown key (allowed: {', '.join(PROBE_FIELDS)})")
+        label, point = table.get("name"), table.get("point")
+        if not isinstance(label, str) or not label or not all(c.isascii() and (c.isalnum() or c in "_-")
+                                                               for c in label):
+            raise InputError(f"{here}.name", f"got {shown(label)}, expected a name of letters, digits, '_' or '-' "
+                                             "(it starts the probe's column names in probes.csv)")
+        if label in seen:
+            raise InputError(f"{here}.name", f"{label!r} is given twice: each probe needs its own name")
+        seen.add(label)
+        if (not isinstance(point, list) or len(point) != 3
+                or not all(isinstance(v, (int, float)) and not isinstance(v, bool) and finite(v) for v in point)):
+            raise InputError(f"{here}.point", f"got {shown(point)}, expected [x, y, z] in metres in the undeformed "
+                                              "projectile's frame (nose tip at the origin, axis +y)")
+        kind = PROBE_FIELDS["kind"].check(f"{here}.kind", table.get("kind", "node"))
+        out.append({"name": label, "point": [float(v) for v in point], "kind": kind})
+    return out
 
 
 _C3 = shot("C3")
@@ -307,10 +355,28 @@ SCHEMA: dict[str, Key] = {
                                       doc="simulated time between checkpoints (fepen run --resume DIR); 0: none"),
     "run.rigid_step": positive(ABSENT, "s", 1e-3,
                                doc="RK4 step of the rigid fidelity; absent: min(0.1 D/v0, t_stop/300)"),
+    # --- user-chosen histories (LS-DYNA nodout/elout, OpenRadioss /TH) ---
+    "output.probes": Key(list, ABSENT, doc="[[output.probes]] tables {name, point, kind}: histories written to "
+                                           "probes.csv at the history rows' times. point: [x, y, z] (m) in the "
+                                           "undeformed projectile's frame (nose tip at the origin, axis +y), "
+                                           "inside the body. kind 'node' (default): the nearest mesh node's "
+                                           "displacement, velocity and acceleration (the rigid fidelity: the "
+                                           "rigid motion of the point), in the target's frame (m, m/s, m/s^2, as "
+                                           "fields.xdmf); 'cell': the cell holding the point, its von Mises and "
+                                           "axial stress, pressure (Pa), PEEQ and temperature (K), meshed "
+                                           "fidelities only. Columns <name>_<quantity>_<unit> (docs/results.md)",
+                         form="a list of tables {name, point = [x, y, z], kind = 'node' or 'cell'}", rows=_probes),
 }
 
 #: the tables of the scene (the first part of every key)
 SECTIONS = sorted({name.split(".")[0] for name in SCHEMA})
+
+#: what one [[output.probes]] table may hold (name and point are checked by _probes)
+PROBE_FIELDS: dict[str, Key] = {
+    "name": Key(str, ABSENT, doc="the probe's name, unique: its columns in probes.csv start with it"),
+    "point": Key(list, ABSENT, "m", doc="[x, y, z] in the undeformed projectile's frame"),
+    "kind": choice("node", "node", "cell"),
+}
 
 #: the keys of one [[target.layers]] table besides the target constants
 LAYER_KEYS = ("material", "thickness", "gap", "crater", "family")

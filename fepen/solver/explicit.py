@@ -43,6 +43,9 @@ class StepTimes:
 
 #: steps between two evaluations of the stable step
 STEP_EVERY = 4
+#: a landing time closer than this fraction of the stable step is not landed on (the output it is for is
+#: written at the step after, as without landing): no step that short
+LANDING_SLIVER = 1e-6
 #: the eigenvalue step's gain over the altitude estimate is rounded down to a multiple of this (calibrate_step)
 GAIN_QUANTUM = 0.005
 
@@ -77,7 +80,7 @@ class Interface(Protocol):
 #: are each rank's own partial sums
 STATE_ARRAYS = ("U", "Vel", "acc", "fint", "fext", "s", "eps_p", "temp", "sy0", "X", "mat", "_removed", "_work")
 STATE_SCALARS = ("t", "step_count", "dt", "dt_prev", "dt0", "dt_min", "_plastic", "_heat",
-                 "ke0", "_w_if_n", "_w_if_t")
+                 "ke0", "_w_if_n", "_w_if_t", "dt_stable", "_land_at")
 
 
 class ExplicitSolver:
@@ -199,8 +202,8 @@ class ExplicitSolver:
             self.acc[self.fixed] = 0.0
         self.a_fn.x.scatter_forward()
         self.ke0 = self.kinetic_energy(self.Vel)
-        self.dt = self.stable_step()
-        self.dt0 = self.dt_min = self.dt
+        self.dt_stable = self.dt0 = self.dt_min = self.stable_step()
+        _choose_step(self)
         if self.interface is not None:
             self.interface(self)
 
@@ -329,12 +332,13 @@ class ExplicitSolver:
                 self.acc[self.fixed] = 0.0
             kernels.work_halves(du, self.fint, self.fext, n, self._work)
         self.a_fn.x.scatter_forward()
-        self.t += dt
+        self.t = self._land_at if self._land_at >= 0.0 else self.t + dt
         self.step_count += 1
         self.dt_prev = dt
         self.times.update += perf_counter() - t0
         if self.step_count % STEP_EVERY == 1:
             self._new_step(h_c)
+        _choose_step(self)
         if self.interface is not None:
             t0 = perf_counter()
             self.interface(self)
@@ -345,7 +349,7 @@ class ExplicitSolver:
         new = self.safety * self.step_gain * self.comm.allreduce(h_c, op=MPI.MIN)
         if not (new > 1e-3 * self.dt0):
             failures.step_collapsed(self, h_c, new)
-        self.dt = new
+        self.dt_stable = new
         self.dt_min = min(self.dt_min, new)
 
     def state(self) -> dict[str, np.ndarray]:
@@ -378,6 +382,24 @@ class ExplicitSolver:
         """Add this rank's share of the interface forces' work over the step (J)."""
         self._w_if_n += normal
         self._w_if_t += tangential
+
+
+def _choose_step(s: ExplicitSolver) -> None:
+    """The coming step ``s.dt``: the stable step, or, with a landing time ahead (``s.landing``), the time to it
+    cut into the fewest equal steps no longer than the stable step, the last of which ends on it (central
+    differences take any shorter step; the stable step bounds it from above). Equal steps, not one short one
+    before each landing: a step that changes every interval pumps energy into the highest modes (a C3 run at
+    300 m/s, elastic: an energy error of 2.6e-3 with one short step per microsecond, 1.2e-5 without landing)."""
+    dt, s._land_at = s.dt_stable, -1.0
+    if s.landing is not None:
+        target = s.landing(s.t)
+        r = target - s.t
+        if r > LANDING_SLIVER * dt:
+            n = max(1, math.ceil(r / dt * (1.0 - 1e-12)))
+            dt = r / n
+            if n == 1:
+                s._land_at = target
+    s.dt = dt
 
 
 def calibrate_step(s: ExplicitSolver, iterations: int = 400, rtol: float = 1e-5) -> tuple[float, float]:
@@ -431,7 +453,7 @@ def calibrate_step(s: ExplicitSolver, iterations: int = 400, rtol: float = 1e-5)
     # round-off of ~1e-6 that depends on the partition; rounded, the step is the same on any number of
     # ranks (unless the gain falls within ~1e-6 of a multiple), and at most GAIN_QUANTUM / 2 smaller
     s.step_gain = max(math.floor(dt_crit / h_c / GAIN_QUANTUM) * GAIN_QUANTUM, GAIN_QUANTUM)
-    s.dt = s.dt0 = s.dt_min = s.stable_step()
+    s.dt = s.dt_stable = s.dt0 = s.dt_min = s.stable_step()
     return dt_crit, s.step_gain
 
 
@@ -537,7 +559,11 @@ def _clock(s: ExplicitSolver) -> None:
     s.step_gain = 1.0  # stable step = safety * step_gain * min(h/c); see calibrate_step
     s.t = s.dt_prev = 0.0
     s.step_count = 0
-    s.dt = s.dt0 = s.dt_min = s.stable_step()
+    s.dt = s.dt_stable = s.dt0 = s.dt_min = s.stable_step()
+    # the next time a step must end on, from the time now (fepen.runs.outputs.Landing), or None: every step
+    # the stable step; _land_at: the time the coming step ends on when it lands (else -1)
+    s.landing = None
+    s._land_at = -1.0
     # the work sums: each node's internal and external work (_work, summed exactly when asked: work_sums),
     # this rank's plastic work, heat, and the interface's normal and tangential work
     s._work = np.zeros((s.n_nodes, 2))

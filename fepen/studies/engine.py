@@ -203,8 +203,18 @@ def chunks(pending: list, batch: int, groups: int) -> list[list]:
     return [pending[j:j + size] for j in range(0, len(pending), size)]
 
 
+def bar_disabled(progress: bool = True) -> bool | None:
+    """tqdm's ``disable`` of a study's bar: hidden when ``progress`` is False or FEPEN_PROGRESS=0, shown with
+    FEPEN_PROGRESS=1 (fepen sweep sets it for the mpirun it starts: rank 0's stderr there is a pipe), else
+    None: shown only when stderr is a terminal."""
+    env = os.environ.get("FEPEN_PROGRESS")
+    if not progress or env == "0":
+        return True
+    return False if env == "1" else None
+
+
 def execute(n: int, scene_of, out, comm=None, ranks_per_shot: int = 1, keep=None, say=None,
-            desc: str = "shots", batch: int = 1) -> tuple[dict, int]:
+            desc: str = "shots", batch: int = 1, progress: bool = True) -> tuple[dict, int]:
     """Run the shots 0 … n−1 not yet recorded in OUT/shots.jsonl.
 
     Args:
@@ -212,6 +222,8 @@ def execute(n: int, scene_of, out, comm=None, ranks_per_shot: int = 1, keep=None
         comm: the communicator (None: COMM_WORLD). ranks_per_shot: ranks per group; divides comm.size.
         keep: Scene -> whether the shot writes its results directory OUT/shots/NNNNN (None: never for rigid
             shots). say: prints a line (rank 0). desc: the progress bar's label.
+        batch: the most rigid shots of one batch. progress: the bar of shots done over the total on rank 0's
+            stderr (bar_disabled: on a terminal, or FEPEN_PROGRESS=1).
 
     Returns:
         ({shot: record} of every finished shot on rank 0, {} elsewhere; the number of shots run now).
@@ -232,7 +244,8 @@ def execute(n: int, scene_of, out, comm=None, ranks_per_shot: int = 1, keep=None
     if comm.rank == 0:
         from tqdm import tqdm
 
-        bar = tqdm(total=len(pending), unit="shot", desc=desc, leave=False, disable=None) if pending else None
+        bar = tqdm(total=len(pending), unit="shot", desc=desc, leave=False, file=sys.stderr,
+                   disable=bar_disabled(progress)) if pending else None
         log = _Log(out, records, bar)
     quiet = logging.getLogger("fepen")
     level = quiet.level

@@ -451,8 +451,14 @@ def _fmt(v, digits: int) -> str:
     return "" if v is None else str(v)
 
 
-def write_table(sweep: Sweep, records: dict, out: Path) -> tuple[list, list]:
-    """sweep.csv (and sweep.parquet with pyarrow) and costs.csv; (columns, rows)."""
+def write_table(sweep: Sweep, records: dict, out: Path, say=None) -> tuple[list, list]:
+    """sweep.csv (and sweep.parquet with pyarrow: the extra ``parquet``) and costs.csv; (columns, rows).
+
+    Args:
+        sweep: the sweep. records: {shot: record}. out: the results directory.
+        say: prints the one line saying why sweep.parquet was not written (pyarrow absent, or failing to import,
+            as a release built for numpy 2 does beside numpy 1.24), or None.
+    """
     from fepen.atomic import replacing
 
     cols, rows = table_rows(sweep, records)
@@ -470,18 +476,34 @@ def write_table(sweep: Sweep, records: dict, out: Path) -> tuple[list, list]:
         w.writerow([i, f"{records[i].get('wall_s', float('nan')):.4g}", records[i].get("ranks", "")])
     with replacing(out / "costs.csv", ".csv") as tmp:
         tmp.write_text(buf.getvalue())
-    try:
+    why = parquet_unavailable()
+    if why is None:
         import pyarrow as pa
         import pyarrow.parquet as pq
-    except ImportError:
-        pass
-    else:  # pragma: no cover - pyarrow is optional
-        pq.write_table(pa.table({c: [r.get(c) for r in rows] for c in cols}), out / "sweep.parquet")
+
+        with replacing(out / "sweep.parquet", ".parquet") as tmp:
+            pq.write_table(pa.table({c: [r.get(c) for r in rows] for c in cols}), str(tmp))
+    elif say is not None:
+        say(f"sweep.parquet not written: {why}")
     return cols, rows
 
 
+def parquet_unavailable() -> str | None:
+    """Why sweep.parquet cannot be written here (one line), or None when pyarrow imports."""
+    try:
+        import pyarrow  # noqa: F401
+        import pyarrow.parquet  # noqa: F401
+    except ModuleNotFoundError:
+        return "pyarrow is not installed (pip install 'fepen[parquet]': a pyarrow that works with numpy 1.24)"
+    except Exception as err:  # noqa: BLE001 - an ImportError of a build for numpy 2, or anything it raises
+        text = " ".join(str(err).split()) or type(err).__name__
+        return f"pyarrow failed to import ({text}); pip install 'pyarrow>=14,<26' (the extra 'parquet')"
+    return None
+
+
 # -------------------------------------------------------------------------------------------------- run
-def run(path, out, comm=None, ranks_per_shot: int = 1, sets=(), fresh: bool = False, say=print) -> dict:
+def run(path, out, comm=None, ranks_per_shot: int = 1, sets=(), fresh: bool = False, say=print,
+        progress: bool = True) -> dict:
     """Read the sweep, run its missing shots on fepen.studies.engine, write the table, summary and figures.
 
     Args:
@@ -490,6 +512,7 @@ def run(path, out, comm=None, ranks_per_shot: int = 1, sets=(), fresh: bool = Fa
         ranks_per_shot: ranks of each shot's group. sets: --set overrides of the base scene.
         fresh: run every shot again (the records in OUT are discarded).
         say: prints one line (rank 0).
+        progress: the bar of shots done over the total (rank 0, stderr; fepen.studies.engine.bar_disabled).
 
     Returns:
         {"shots", "ran", "skipped", "wall_s", "statuses"} (every rank).
@@ -518,13 +541,14 @@ def run(path, out, comm=None, ranks_per_shot: int = 1, sets=(), fresh: bool = Fa
     rigid = sweep.base.get("effects.fidelity") == "rigid" and "effects.fidelity" not in sweep.keys and not keep
     records, ran = engine.execute(len(sweep.shots), sweep.scene, out, comm, ranks_per_shot,
                                   keep=lambda sc: keep or sc.effects.fidelity != "rigid", say=say,
-                                  batch=engine.BATCH if rigid else 1)  # rigid shots in batches
+                                  batch=engine.BATCH if rigid else 1,  # rigid shots in batches
+                                  progress=progress)
     wall = time.perf_counter() - t0
     statuses = {}
     if comm.rank == 0:
         for r in records.values():
             statuses[r["status"]] = statuses.get(r["status"], 0) + 1
-        cols, rows = write_table(sweep, records, out)
+        cols, rows = write_table(sweep, records, out, say)
         from fepen.studies import sweep_figures
 
         sweep_figures.write(sweep, cols, rows, out)

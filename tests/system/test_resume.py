@@ -28,6 +28,11 @@ WORN = ["--set", "effects.wear=true", "--set", "effects.erosion=true", "--set", 
         "--set", "projectile.material.B=1e8", "--set", "projectile.erosion.strain=0.01"]
 
 
+#: a node and a cell probe: probes.csv must come out whole across the kill and the resume
+PROBES = ["--set", 'output.probes=[{name = "tail", point = [0.0, 0.144, 0.0]}, '
+                   '{name = "wall", point = [0.0, 0.07, 0.009], kind = "cell"}]']
+
+
 def start(out, ranks, extra=()):
     return processes.start(["run", *SETS, *extra, "--out", out], ranks)
 
@@ -81,8 +86,8 @@ def check_valid_fields(out):
     return sum(1 for g in root.iter("Grid") if g.get("GridType") == "Uniform")  # one grid per output time
 
 
-@pytest.mark.parametrize("ranks,extra", [(1, []), (2, []), (2, CHARGED), (2, WORN)],
-                         ids=["1", "2", "2-charged", "2-worn"])
+@pytest.mark.parametrize("ranks,extra", [(1, PROBES), (2, []), (2, CHARGED), (2, WORN)],
+                         ids=["1-probes", "2", "2-charged", "2-worn"])
 def test_killed_run_resumes_to_the_same_results(tmp_path, ranks, extra):
     whole, cut = tmp_path / "whole", tmp_path / "cut"
     done = run_fepen("run", *SETS, *extra, "--out", whole, ranks=ranks)
@@ -106,6 +111,10 @@ def test_killed_run_resumes_to_the_same_results(tmp_path, ranks, extra):
               "max_peeq", "steps", "dt_s", "outcome", "mass_loss_kg", "eroded_cells", "length_change_mm"):
         assert a[k] == b[k], k  # the same operations: equal, not merely close
     assert (whole / "history.csv").read_text() == (cut / "history.csv").read_text()
+    if extra is PROBES:
+        rows = (whole / "probes.csv").read_text().splitlines()
+        assert len(rows) == len((whole / "history.csv").read_text().splitlines()) > 100
+        assert (cut / "probes.csv").read_text() == "\n".join(rows) + "\n"
     if extra is WORN:
         assert a["eroded_cells"] > 0 and a["mass_loss_kg"] > 0.0
     assert check_valid_fields(cut) == check_valid_fields(whole) > n_out

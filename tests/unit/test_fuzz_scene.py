@@ -120,7 +120,23 @@ def value(name: str, bad: bool = True) -> st.SearchStrategy:
         return st.one_of(st.booleans(), st.sampled_from([0, 1, "true", "yes", 1.0])) if bad else st.booleans()
     if key.kind is str:
         return _string(key, bad)
+    if name == "output.probes":
+        return _probes(bad)
     return _sections(bad) if name == "projectile.cavity_sections" else _layers(bad)
+
+
+def _probes(bad: bool) -> st.SearchStrategy:
+    """[[output.probes]] tables: names (repeated ones refused), points, kinds; bad ones with any text, short points,
+    unknown kinds and keys."""
+    point = st.lists(st.floats(-0.01, 0.2), min_size=3, max_size=3)
+    probe = {"name": st.sampled_from(["tail", "nose", "mid_1"]), "point": point}
+    optional = {"kind": st.sampled_from(["node", "cell"])}
+    if bad:
+        probe.update(name=st.one_of(st.sampled_from(["tail", "a b", ""]), TEXT),
+                     point=st.one_of(point, st.lists(st.floats(allow_nan=True), max_size=4), TEXT))
+        optional.update(kind=st.one_of(st.sampled_from(["node", "cell", "nodes"]), TEXT), where=st.just(1.0))
+    good = st.lists(st.fixed_dictionaries(probe, optional=optional), min_size=1, max_size=3)
+    return st.one_of(good, st.just([]), st.just([1, 2]), _wrong()) if bad else good
 
 
 def _unknown_key() -> st.SearchStrategy:
@@ -182,7 +198,7 @@ def toml_text(flat: dict, tables: bool) -> str:
 
 
 # ----------------------------------------------------------------------------------------------- property
-LISTED = re.compile(r"^(target\.layers|projectile\.cavity_sections)\[\d+\](\..*)?$")
+LISTED = re.compile(r"^(target\.layers|projectile\.cavity_sections|output\.probes)\[\d+\](\..*)?$")
 
 
 def _allowed_keys(given_keys) -> set:

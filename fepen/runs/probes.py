@@ -1,0 +1,177 @@
+"""The user's point and cell histories (``[[output.probes]]``; probes.csv, fepen.io.probes): where each probe
+is, and its values at every history row, on the meshed projectile (MeshProbes) or the rigid body
+(RigidProbes).
+
+A point outside the body is an input error: against the exact solid before any mesh (``check_inside``: the
+outside of revolution and its cavity, a CAD body's bounding cylinder), then against the mesh before any step
+(a node probe's nearest node at most mesh.size away, a cell probe's cell holding the point). The node and the
+cell are chosen the same on any partition (fepen.solver.probes), so probes.csv is the same on any number of
+ranks. The rigid fidelity has node probes only (fepen.scene.resolve refuses cell probes there): the rigid
+motion of the point, its acceleration from the force and moment at the row's state.
+"""
+
+from __future__ import annotations
+
+import numpy as np
+
+from fepen.errors import InputError
+from fepen.geometry.cad import CadBody
+from fepen.geometry.frames import unit_axis
+from fepen.io import probes as probes_io
+
+__all__ = ["check_inside", "Probes", "MeshProbes", "RigidProbes"]
+
+#: points this close outside the exact outline (m) are taken as on it
+OUTLINE_TOLERANCE = 1e-9
+
+
+def _outside_why(shape, point, charged: bool) -> str | None:
+    """Why a point (x, y, z) of the reference frame is outside the exact body, or None."""
+    x, y, z = point
+    r = float(np.hypot(x, z))
+    tol = OUTLINE_TOLERANCE
+    if not -tol <= y <= shape.length + tol:
+        return f"y = {y:g} m is outside the body's length [0, {shape.length:g}] m (nose tip at the origin, axis +y)"
+    if isinstance(shape, CadBody):
+        return None if r <= shape.radius + tol else f"its radius {r:g} m is past the body's {shape.radius:g} m"
+    outer = float(shape.outer_radius(y))
+    if r > outer + tol:
+        return f"its distance from the axis {r:g} m is past the outside's radius {outer:g} m at y = {y:g} m"
+    if not charged:
+        for z0, z1, rc in shape.cavity_sections():
+            if z0 < y < z1 and r < rc:
+                return f"it lies in the cavity (radius {rc:g} m between y = {z0:g} and {z1:g} m)"
+    return None
+
+
+def check_inside(shape, probes, charged: bool) -> None:
+    """InputError naming the first probe whose point is outside the exact body (before any mesh).
+
+    Args:
+        shape: the built Shape or CadBody. probes: the scene's output.probes. charged: the cavity holds the
+            charge (effects.charge): a point there is inside the body.
+    """
+    for i, p in enumerate(probes):
+        why = _outside_why(shape, p["point"], charged)
+        if why is not None:
+            raise InputError(f"output.probes[{i}].point", f"{p['point']} is outside the projectile: {why}")
+
+
+class Probes:
+    """The rows of the probes of one run (every rank holds them) and probes.csv.
+
+    Args:
+        specs: the scene's output.probes.
+    """
+
+    def __init__(self, specs):
+        self.specs = tuple(specs)
+        self.header = probes_io.columns(self.specs)
+        self.rows: list[list[float]] = []
+
+    def values(self, run) -> list[float]:
+        """The probes' values now, in the header's order (collective)."""
+        raise NotImplementedError
+
+    def record(self, run) -> None:
+        """Append the row of the run's time (collective)."""
+        self.rows.append([run.t, *self.values(run)])
+
+    def write(self, out, comm) -> None:
+        """probes.csv of the rows so far (collective)."""
+        probes_io.write(self.rows, out, self.header, comm)
+
+    def state(self) -> dict:
+        """The rows (a checkpoint's arrays)."""
+        return {"rows": np.array(self.rows, dtype=float).reshape(len(self.rows), len(self.header))}
+
+    def restore(self, state: dict) -> None:
+        """Put back what state() returned."""
+        self.rows = [list(r) for r in state["rows"]]
+
+
+class MeshProbes(Probes):
+    """The probes of a deformable run: the nearest node, the cell holding the point (located before any step,
+    collective).
+
+    Args:
+        specs: the scene's output.probes. solver: the ExplicitSolver at its initial state. size: mesh.size (m),
+            the farthest a node probe's node may be from its point.
+    """
+
+    def __init__(self, specs, solver, size: float):
+        from fepen.solver import probes as sp
+
+        super().__init__(specs)
+        self.nodes, self.cells = [], []
+        for i, p in enumerate(self.specs):
+            where = f"output.probes[{i}].point"
+            cell = sp.containing_cell(solver, p["point"])
+            if p["kind"] == "cell":
+                if cell[0] < 0:
+                    raise InputError(where, f"{p['point']} is in no cell of the meshed projectile (outside it, or "
+                                            "between the exact curved surface and the mesh's flat faces: move it "
+                                            "inward)")
+                self.cells.append(cell)
+                continue
+            node, dist = sp.nearest_node(solver, p["point"])
+            if cell[0] < 0 and dist > size:
+                raise InputError(where, f"{p['point']} is outside the meshed projectile: its nearest node is "
+                                        f"{dist:.3g} m away (more than mesh.size = {size:g} m)")
+            self.nodes.append(node)
+
+    def values(self, run) -> list[float]:
+        from fepen.solver import probes as sp
+
+        s = run.solver
+        x = s.positions()
+        nodes = cells = np.zeros((0, 0))
+        if self.nodes:
+            u = sp.node_values(s, self.nodes, x - s.X0)
+            v = sp.node_values(s, self.nodes, s.velocity_at_step())
+            a = sp.node_values(s, self.nodes, s.acc)
+            nodes = np.concatenate([u, v, a], axis=1)
+        if self.cells:
+            m = run.model
+            axis = unit_axis(sp.node_value(s, m.tip, x), sp.node_value(s, m.tail, x))
+            cells = sp.cell_values(s, self.cells, axis)
+        return _in_order(self.specs, nodes, cells)
+
+
+class RigidProbes(Probes):
+    """The node probes of a rigid run: the rigid motion of each point.
+
+    Args:
+        specs: the scene's output.probes (node probes only).
+    """
+
+    def __init__(self, specs):
+        super().__init__(specs)
+        self.X = np.array([p["point"] for p in self.specs], dtype=float).reshape(-1, 3)
+
+    def values(self, run) -> list[float]:
+        """Displacement c + R (X − c0) − X, velocity V + ω × r, acceleration F/m + α × r + ω × (ω × r), with
+        α = R I⁻¹ Rᵀ (M − ω × L) from the force and moment at this state (the next step's first stage's)."""
+        body, s = run.body, run.state
+        _, F, M = body.derivative(s, run.force_fn)
+        _, R, w, _ = body.at(s)
+        r = (self.X - body.centre0) @ np.asarray(R).T
+        u = s.c + r - self.X
+        v = s.V + np.cross(w, r)
+        alpha = R @ (body.I_body_inv @ (R.T @ (M - np.cross(w, s.L))))
+        a = F / body.mass + np.cross(alpha, r) + np.cross(w, np.cross(w, r))
+        return _in_order(self.specs, np.concatenate([u, v, a], axis=1), np.zeros((0, 0)))
+
+
+def _in_order(specs, nodes: np.ndarray, cells: np.ndarray) -> list[float]:
+    """The node and cell probes' value rows merged back into the scene's order."""
+    out: list[float] = []
+    i = j = 0
+    for p in specs:
+        if p["kind"] == "node":
+            out += [float(v) for v in nodes[i]]
+            i += 1
+        else:
+            out += [float(v) for v in cells[j]]
+            j += 1
+    return out
