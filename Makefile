@@ -36,7 +36,7 @@ test: setup
 # JupyterLab beside the kernel the set-up installs (fepen[notebook]: the pins that work with Debian's matplotlib);
 # then `.venv/bin/jupyter lab demos/` and open api_tour.py or rigid_study.py as a notebook
 notebook: setup
-	$(PY) -m pip install -q --disable-pip-version-check -c tools/constraints.txt -e ".[test,notebook]"
+	$(PY) -m pip install -q --disable-pip-version-check -c tools/constraints.txt -e ".[test,parquet,notebook]"
 	@echo "JupyterLab installed: .venv/bin/jupyter lab demos/   (right-click a .py demo: Open With > Notebook)"
 
 lint: setup

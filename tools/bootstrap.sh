@@ -57,5 +57,5 @@ if [ ! -x .venv/bin/python ]; then
   /usr/bin/python3 -m venv --system-site-packages .venv
 fi
 echo "[bootstrap] installing fepen and its PyPI dependencies into .venv"
-.venv/bin/python -m pip install -q --disable-pip-version-check -c tools/constraints.txt -e ".[test]"
+.venv/bin/python -m pip install -q --disable-pip-version-check -c tools/constraints.txt -e ".[test,parquet]"
 echo "$want" > "$stamp"
