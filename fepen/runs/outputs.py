@@ -181,7 +181,7 @@ class Progress:
     def __init__(self, end: float, t: float):
         from tqdm import tqdm
 
-        self.bar = tqdm(total=round(end * 1e6), initial=round(t * 1e6), unit="us", desc="fepen", leave=False)
+        self.bar = tqdm(total=round(end * 1e6), initial=round(t * 1e6), unit="µs", desc="fepen", leave=False)
 
     def due(self, run) -> bool:
         return run.step_count % self.EVERY == 0

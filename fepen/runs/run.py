@@ -165,12 +165,18 @@ class Run:
             raise
         finally:
             t_out = time.perf_counter()
-            self.close_outputs(completed)
-            if completed:
-                self.write_closing()
-            self.output_s += time.perf_counter() - t_out
-            if self.stop is not None and self.out is not None:
-                self.write_stop(self.stop)
+            try:
+                self.close_outputs(completed)
+                if completed:
+                    self.write_closing()
+            except BaseException as err:  # a full disk at history.csv's last write: the stop is recorded too
+                if self.stop is None:
+                    self.stop = err
+                raise
+            finally:
+                self.output_s += time.perf_counter() - t_out
+                if self.stop is not None and self.out is not None:
+                    self.write_stop(self.stop)
         try:
             return self.write_summary(outcome or "ended", time.perf_counter() - t_loop)
         except BaseException as err:  # a full disk at the last write: the stop's record, in the space held back

@@ -139,6 +139,21 @@ def test_full_disk_at_a_writer_then_resume(whole, tmp_path, monkeypatch, writer,
     check_same(out, whole[ranks])
 
 
+def test_full_disk_at_the_only_history_write_of_a_rigid_run(tmp_path):
+    """A rigid run writes history.csv once, at its close: ENOSPC there still leaves summary.json saying why
+    (it once left none: the close's error passed the stop's record by), exit 4 and one line."""
+    out = tmp_path / "rigid"
+    env = processes.mpi_env(FEPEN_INJECT_FAULT="history:1")
+    r = subprocess.run(processes.command(["run", "--set", "effects.fidelity=rigid", "--out", out], 1), env=env,
+                       capture_output=True, text=True, cwd=processes.ROOT, timeout=600)
+    assert r.returncode == 4, r.stderr[-2000:]
+    lines = fepen_lines(r.stderr)
+    assert len(lines) == 1 and "no space left on device" in lines[0] and "Traceback" not in r.stderr, lines
+    summary = json.loads((out / "summary.json").read_text())
+    assert summary["outcome"] == "fault" and "history.csv" in summary["stop_reason"] and "Hy_mm" not in summary
+    assert json.loads((out / "run.json").read_text())["exit_code"] == 4
+
+
 def test_full_disk_for_real_on_a_small_tmpfs(whole, tmp_path):
     """A real full disk: the run writes into a 2.5 MB tmpfs; after it is enlarged, the resume completes
     identically. Needs root (mount); skipped, saying why, where the machine does not allow it."""
