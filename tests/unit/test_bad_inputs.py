@@ -90,7 +90,7 @@ CASES = [
     row("misspelt-section", MESH, "[projectil]\ndiameter = 0.03\n", "projectil.diameter",
         r"unknown key \(did you mean 'projectile.diameter'\?\)"),
     row("unknown-section", MESH, "[solver]\ndt = 1e-7\n", "solver.dt",
-        r"unknown key \(sections: charge, effects, impact, mesh, projectile, run, target\)"),
+        r"unknown key \(sections: charge, effects, impact, mesh, output, projectile, run, target\)"),
     row("key-in-the-wrong-section", MESH, "[target]\ncrh = 3\n", "target.crh", r"did you mean 'projectile.crh'"),
     row("misspelt-layer-key", MESH, '[[target.layers]]\nmaterial = "concrete"\nthikness = 0.1\n',
         "target.layers[0].thikness", r"unknown key \(did you mean 'thickness'\?\)"),
