@@ -80,16 +80,19 @@ class Landing:
         intervals: the clocks' intervals (s); those <= 0 are never due and ignored.
         end: the time the run ends at the latest (s).
 
-    Calling it with the time now (s) returns that time (s).
+    Calling it with the time now (s) and the stable step (s) returns that time (s). An interval shorter than the
+    stable step is not landed on: its output is due at every step, at the steps' own times (landing on it
+    would cut every step to that interval: a row asked every 1e-11 s would take a million steps a microsecond).
     """
 
     def __init__(self, intervals, end: float):
         self.intervals = tuple(i for i in intervals if i > 0.0)
         self.end = end
 
-    def __call__(self, t: float) -> float:
-        target = min((next_multiple(i, t) for i in self.intervals), default=math.inf)
-        tol = GRID_TOLERANCE * min(self.intervals, default=0.0)
+    def __call__(self, t: float, dt: float = 0.0) -> float:
+        intervals = [i for i in self.intervals if i >= dt]
+        target = min((next_multiple(i, t) for i in intervals), default=math.inf)
+        tol = GRID_TOLERANCE * min(intervals, default=0.0)
         if t < self.end <= target + tol:
             return self.end
         return target

@@ -48,6 +48,16 @@ def test_landing_merges_the_grids_and_lands_on_the_end():
     assert outputs.Landing((1e-6,), end=3e-5)(29e-6) == 3e-5  # the end where it meets the grid
 
 
+def test_an_interval_below_the_stable_step_is_not_landed_on():
+    """A row at every step (an interval far below the step) must not cut the steps to that interval; the
+    other outputs and the end are still landed on."""
+    land = outputs.Landing((1e-11, 5e-6), end=6e-5)
+    assert land(0.0, dt=1e-8) == 5e-6
+    assert land(59.99e-6, dt=1e-8) == 6e-5
+    assert outputs.Landing((1e-11,), end=6e-5)(0.0, dt=1e-8) == 6e-5  # only the end
+    assert land(0.0) == 1e-11  # with no step given, every interval counts
+
+
 def test_grid_clock_restores_from_its_state():
     a = outputs.History(1e-6, grid=True)
     a.clock.advance(12e-6)
