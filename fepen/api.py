@@ -214,7 +214,7 @@ def sweep(spec, out=None, comm=None, sets=(), fresh: bool = False, ranks_per_sho
         out = comm.bcast(tempfile.mkdtemp(prefix="fepen-sweep-") if comm.rank == 0 else None, root=0)
     out = Path(out)
     say = (lambda *lines: print(*lines, sep="\n")) if progress and comm.rank == 0 else (lambda *lines: None)
-    fsweep.run(spec, out, comm, ranks_per_shot, sets, fresh, say=say)
+    fsweep.run(spec, out, comm, ranks_per_shot, sets, fresh, say=say, progress=progress)
     comm.barrier()
     table = pd.read_csv(out / "sweep.csv", keep_default_na=False, na_values=[""])
     table.attrs["out"] = out
