@@ -30,10 +30,25 @@ def run(args) -> int:
     else:
         result = api.run(api.Scene(args.scene, sets=args.sets), out=args.out, progress=True, force=args.force)
     summary, out = result.summary, result.out
-    keys = ("outcome", "Hx_mm", "Hy_mm", "Tx_mm", "Ty_mm", "length_mm", "residual_speed_m_s",
+    keys = ("outcome", "depth_mm", "Hx_mm", "Hy_mm", "Tx_mm", "Ty_mm", "length_mm", "residual_speed_m_s",
             *(("max_peeq",) if summary.get("fidelity") != "rigid" else ()), "energy_error", "steps", "dt_s", "wall_s")
     keys += tuple(k for k in ("mass_loss_kg", "mass_loss_percent") if k in summary)
     say(*(f"{k} = {summary[k]:.6g}" if isinstance(summary[k], float) else f"{k} = {summary[k]}"
-          for k in keys), f"written: {out}/summary.json, history.csv, history.png"
+          for k in keys), *prediction_lines(summary), f"written: {out}/summary.json, history.csv, history.png"
         + (", fields.xdmf" if result.fields is not None else ""))
     return 0
+
+
+def prediction_lines(summary: dict) -> list[str]:
+    """The intervals and the envelope's verdict of a summary, one line each (docs/uncertainty.md)."""
+    lines = []
+    info = summary.get("interval") or {}
+    pct = "-".join(f"{100 * p:g}" for p in info.get("levels", ())) + " %"
+    for name, quantity in (("depth_interval_mm", "depth"), ("lateral_interval_mm", "lateral")):
+        iv = summary.get(name)
+        if iv is not None:
+            where = "; extrapolated: the shot lies outside the validated envelope" if info.get("extrapolated") else ""
+            lines.append(f"{name} = {iv[0]:.4g} to {iv[1]:.4g} ({pct}: {info.get(quantity)}{where})")
+    if summary.get("envelope"):
+        lines.append(summary["envelope"]["line"])
+    return lines

@@ -4,7 +4,9 @@ docs/paper.md):
 - ``experiments``: the paper's Table 1 (table1.csv): ``SHOTS``, ``Shot``, ``shot``;
 - ``steels``: the named projectile steels (steels.toml), ``projectile.material.name``: ``STEELS``;
 - ``targets``: the named target materials (targets.toml), ``target.material``: ``TARGETS``, ``FAMILIES``,
-  ``CONSTANTS``.
+  ``CONSTANTS``;
+- ``prediction_errors``: fepen's errors on the public data (prediction_errors.csv), for the validated
+  envelope and the prediction intervals.
 
 ``depth/`` holds the depth data sets of ``fepen validate-depth`` (fepen.studies.depth). Plain Python and the
 standard library only: the scene and every layer above may import it.
@@ -15,5 +17,6 @@ from fepen.data.steels import STEELS
 from fepen.data.steels import names as steel_names
 from fepen.data.targets import CONSTANTS, FAMILIES, TARGETS
 
-__all__ = ["experiments", "steels", "targets", "SHOTS", "Shot", "shot", "STEELS", "steel_names", "TARGETS", "FAMILIES",
+__all__ = ["experiments", "steels", "targets", "prediction_errors",
+           "SHOTS", "Shot", "shot", "STEELS", "steel_names", "TARGETS", "FAMILIES",
            "CONSTANTS"]

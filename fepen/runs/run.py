@@ -272,6 +272,7 @@ class Run:
         summary = results.summary(self.shot.scene, self.shot.experiment, self.rows, outcome, extra)
         if self.crossings is not None:
             summary.update(self.crossings.summary(self.shot.law, 1e-3 * summary["depth_mm"]))
+        summary.update(prediction(self.shot.envelope, outcome, summary))
         if self.out is not None:
             results.write_summary(self.out, summary, self.comm)
         return summary
@@ -291,3 +292,15 @@ class Run:
                 files.write_json(self.out / "summary.json", summary, MPI.COMM_SELF)
             except OSError as e:
                 rundir.log_line(f"fepen: summary.json of the stop not written: {e}")
+
+
+def prediction(facts: dict, outcome: str, summary: dict) -> dict:
+    """The summary's validated-envelope verdict and intervals (docs/uncertainty.md): "envelope",
+    "depth_interval_mm", "lateral_interval_mm", "interval"."""
+    from fepen.post import envelope, interval
+
+    verdict = envelope.verdict(facts)
+    out = {"envelope": {**verdict, "line": envelope.line(verdict)}}
+    out.update(interval.predict(facts, verdict, outcome, 1e-3 * summary["depth_mm"], 1e-3 * summary["Hx_mm"]))
+    return out
+

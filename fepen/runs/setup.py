@@ -110,6 +110,9 @@ def material_law(scene, c: dict, thickness: float | None) -> tg.TargetLaw:
             sigma_s = float(tg.quasi_static_stress(Y, E, T, lam))
         ca, crush = tg.cavity_ratio(Y, E, T), get("crush_strain") or 1.0 - density / lock
         given_flag = given is not None or model != "cavity-expansion"
+    factor = scene.get("target.resistance_factor")  # the whole normal stress σ_s + B ρ (v·n)² times it
+    if factor != 1.0:
+        sigma_s, B, given_flag = sigma_s * factor, B * factor, True  # given: the free face scales it (§8.3)
     return tg.TargetLaw(
         density=density, Y=Y, E=E, T=T, lam=lam, sigma_s=sigma_s, B=B,
         thickness=thickness, crater=get("crater"), k=k,
@@ -277,7 +280,7 @@ def announce(scene, comm, built: Built | None = None) -> Built:
     if comm.rank == 0:
         import logging
 
-        for note in (built.note, friction_note(scene), thin_target_note(scene, built)):
+        for note in (built.note, friction_note(scene), thin_target_note(scene, built), envelope_note(scene, built)):
             if note:
                 logging.getLogger("fepen").warning(note)
     return built
@@ -384,3 +387,32 @@ def mesh_metrics(pm: fmesh.ProjectileMesh, scene) -> dict:
     speed = {tags.SHELL: tetra.dilatational_speed(p.youngs_modulus, p.poisson_ratio, projectile(scene).shell_density),
              tags.CHARGE: tetra.dilatational_speed(c.youngs_modulus, c.poisson_ratio, c.density)}
     return fmesh.metrics(pm, densities(scene), speed, scene.run.safety_factor, scene.mesh.size)
+
+
+def envelope_note(scene, built: Built | None = None) -> str:
+    """One line when the shot lies outside the validated envelope (fepen.post.envelope), else ""."""
+    from fepen.post import envelope
+
+    v = envelope.verdict(envelope_facts(scene, built))
+    return "" if v["inside"] else envelope.line(v)
+
+
+def envelope_facts(scene, built: Built | None = None) -> dict:
+    """What the validated envelope looks at (fepen.post.envelope.verdict), from the scene and its built
+    projectile (the calibre and length of a drawn or CAD body)."""
+    p, i, t = scene.projectile, scene.impact, scene.target
+    D = built.shape.diameter if built is not None else p.diameter
+    L = built.shape.length if built is not None else p.length
+    target = ("layered" if scene.get("target.layers") else "a rigid wall" if t.kind != "concrete" else t.material)
+    mass = scene.get("projectile.mass")  # absent for a fixed cavity or a CAD body: from the body
+    if mass is None and built is not None and isinstance(built.shape, Shape):  # a CAD body's: from its mesh
+        fill = scene.charge.material.density if scene.effects.charge else None
+        mass = built.shape.mass(built.shell_density, fill)
+    values = {"D_m": D, "L_over_D": L / D, "crh": scene.get("projectile.crh"), "mass_kg": mass, "V_m_s": i.velocity,
+              "fc_cylinder_Pa": tg.cylinder_strength(t.compressive_strength, t.strength_basis),
+              "rho_kg_m3": t.density, "obliquity_deg": i.obliquity_deg, "attack_deg": i.attack_deg}
+    return {"law": t.strength_model, "target": target, "nose": "CAD body" if p.get("cad") else p.nose,
+            "thickness_m": scene.get("target.thickness"), "fidelity": scene.effects.fidelity,
+            "steel_A_Pa": p.material.A, "reference_A_Pa": SCHEMA["projectile.material.A"].default,
+            "values": values}
+

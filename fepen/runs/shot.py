@@ -86,6 +86,7 @@ class Shot:
         body_key: what identifies the projectile (a sweep's shots share a body).
         probes: output.probes, the user's point and cell histories ({"name", "point", "kind"}, ...; each point
             checked inside the exact body: fepen.runs.probes.check_inside).
+        envelope: what the validated envelope looks at (fepen.runs.setup.envelope_facts).
     """
 
     fidelity: str
@@ -112,6 +113,7 @@ class Shot:
     body_key: tuple = field(repr=False, default=())
     scene_toml: str = field(repr=False, default="")
     probes: tuple = ()
+    envelope: dict = field(repr=False, default_factory=dict)
 
     @property
     def rigid(self) -> bool:
@@ -200,7 +202,7 @@ def resolve(scene, toml: bool = True) -> Shot:
         charge_friction=scene.charge.friction, rigid_step=scene.get("run.rigid_step"),
         nominal_diameter=scene.projectile.diameter,
         experiment=scene.get("impact.shot"), scene=scene.as_dict(), body_key=setup.body_key(scene),
-        scene_toml=to_toml(scene) if toml else "", probes=probes)
+        scene_toml=to_toml(scene) if toml else "", probes=probes, envelope=setup.envelope_facts(scene, built))
 
 
 def of(shot_or_scene) -> Shot:

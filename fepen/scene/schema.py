@@ -248,6 +248,10 @@ SCHEMA: dict[str, Key] = {
     "target.inertial_factor": number(1.0, "", 0.0, 10.0,
                                      doc="B of the normal stress sigma_n = sigma_s + B rho (v.n)^2 (v.n: the "
                                          "surface's speed into the target); metals 1.5"),
+    "target.resistance_factor": number(1.0, "", 0.05, 20.0,
+                                       doc="multiplies the normal stress sigma_n (sigma_s and B rho (v.n)^2) of "
+                                           "every target material: the model's own error, as fepen study "
+                                           "uncertainty draws it (docs/uncertainty.md); 1: the law as calibrated"),
     "target.friction": number(0.1, "", 0.0, 2.0, doc="Coulomb (static) coefficient, used when effects.friction"),
     "target.friction_dynamic": number(ABSENT, "", 0.0, 2.0,
                                       doc="mu_d of mu(v_t) = mu_d + (mu - mu_d) exp(-c v_t); absent: target.friction"),

@@ -3,4 +3,4 @@ fepen processes, the shot engine on MPI groups, sweeps and their figures, the li
 ricochet) and the closed forms they are checked against."""
 
 __all__ = ["validate", "depth", "calibration", "wear_calibration", "accuracy_cost", "processes", "engine",
-           "sweep", "sweep_figures", "limits", "closed_forms"]
+           "sweep", "sweep_figures", "limits", "closed_forms", "prediction_errors"]
