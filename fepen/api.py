@@ -79,8 +79,14 @@ class Result:
         if "Hx_mm" not in s:  # a run that stopped before its end
             return (f"fepen.Result({str(self.out)!r}, outcome={s.get('outcome')!r}, "
                     f"stop_reason={s.get('stop_reason')!r})")
+        extra = ""
+        if s.get("depth_interval_mm") is not None:
+            lo, hi = s["depth_interval_mm"]
+            extra += f", depth_mm={s['depth_mm']:.6g} (10-90 %: {lo:.4g} to {hi:.4g})"
+        if s.get("envelope") is not None:
+            extra += f", inside_envelope={s['envelope']['inside']}"
         return (f"fepen.Result({str(self.out)!r}, outcome={s.get('outcome')!r}, Hx_mm={s.get('Hx_mm'):.6g}, "
-                f"Hy_mm={s.get('Hy_mm'):.6g})")
+                f"Hy_mm={s.get('Hy_mm'):.6g}{extra})")
 
 
 def load(results_dir) -> Result:

@@ -13,13 +13,14 @@
     fepen sweep SWEEP.toml [--out DIR] [--ranks-per-shot K] [--workers W] [--set KEY=VALUE ...] [--fresh]
     fepen view DIR [--png FILE] [--time T] [--field NAME]
     fepen keys
+    fepen envelope [SCENE.toml] [--set KEY=VALUE ...]
     fepen --version
     fepen --debug COMMAND ...    (a traceback with every error, for developers)
 
 One module per command (``fepen.cli.run``, ``mesh``, ``validate``, ``validate_depth``, ``study``, ``sweep``,
-``view``, ``keys``), each with a docstring, ``HELP`` (its line in ``fepen --help``), ``add_arguments(parser)``
-and ``run(args) -> int``; ``COMMANDS`` below is the registry the parser is built from. A new command is a new
-module and one line there.
+``view``, ``keys``, ``envelope``), each with a docstring, ``HELP`` (its line in ``fepen --help``),
+``add_arguments(parser)`` and ``run(args) -> int``; ``COMMANDS`` below is the registry the parser is built from.
+A new command is a new module and one line there.
 
 Exit codes (fepen.errors, docs/results.md): 0 success; 2 bad input (one line naming the key or argument and
 what is allowed, before anything is written); 3 the simulation cannot go on (what, where, when); 4 a fault of
@@ -32,20 +33,20 @@ from __future__ import annotations
 import argparse
 import sys
 
-from fepen.cli import keys, mesh, run, study, sweep, validate, validate_depth, view
+from fepen.cli import envelope, keys, mesh, run, study, sweep, validate, validate_depth, view
 from fepen.cli.common import say
 from fepen.errors import InputError, Interrupted, MachineFault, SimulationError, describe_os_error, stop_outcome
 
 __all__ = ["main", "COMMANDS", "version_line", "common", "run", "mesh", "validate", "validate_depth", "study", "sweep",
-           "keys", "view"]
+           "keys", "view", "envelope"]
 
 #: the command modules by name, in the order of "name a command: ..."
 _MODULES = {"run": run, "mesh": mesh, "validate": validate, "validate-depth": validate_depth, "study": study,
-            "sweep": sweep, "keys": keys, "view": view}
+            "sweep": sweep, "keys": keys, "view": view, "envelope": envelope}
 #: what main calls: command name -> its module's run(args) -> exit code
 COMMANDS = {name: module.run for name, module in _MODULES.items()}
 #: the order of the commands in ``fepen --help`` and in argparse's "invalid choice" line
-_HELP_ORDER = ("run", "validate", "mesh", "validate-depth", "study", "sweep", "keys", "view")
+_HELP_ORDER = ("run", "validate", "mesh", "validate-depth", "study", "sweep", "keys", "envelope", "view")
 
 
 class _Parser(argparse.ArgumentParser):

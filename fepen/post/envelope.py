@@ -151,10 +151,13 @@ def line(v: dict) -> str:
     return "outside the validated envelope: " + "; ".join(parts)
 
 
-def markdown(law: str = "scaled-S") -> str:
-    """The envelope of a law as a Markdown table (docs/uncertainty.md; ``fepen envelope``)."""
+def markdown(law: str = "scaled-S", laws=None) -> str:
+    """The envelope of a law as a Markdown table (docs/uncertainty.md; ``fepen envelope``); ``laws``: the laws
+    that share it, named in its first line."""
     r = ranges(law)
-    lines = [f"Law `{law}`: {r['shots']} shots in {r['sets']} public sets (fepen/data/prediction_errors.csv).", "",
+    names = " and ".join(f"`{x}`" for x in (laws or [law]))
+    lines = [f"{'Laws' if laws and len(laws) > 1 else 'Law'} {names}: {r['shots']} shots in {r['sets']} public sets "
+             "(fepen/data/prediction_errors.csv).", "",
              "| dimension | low | high | unit |", "|---|---|---|---|"]
     for d in DIMENSIONS:
         lo, hi = r[d.column]

@@ -29,7 +29,7 @@ from dataclasses import dataclass, field
 import numpy as np
 
 __all__ = ["LEVELS", "SPEED_REGIME_M_S", "DEPTH_OUTCOMES", "ErrorModel", "regime", "fit", "fit_small", "model",
-           "coverage", "predict",
+           "coverage", "predict", "model_markdown", "coverage_markdown",
            "lateral_coverage", "interval", "quantile_z"]
 
 #: the interval's probabilities: 10 % and 90 %
@@ -259,3 +259,32 @@ def predict(facts: dict, verdict: dict, outcome: str, depth_m: float, lateral_m:
         out["lateral_interval_mm"] = sorted([1e3 * sign * lo, 1e3 * sign * hi])
         out["interval"]["lateral"] = lm.basis(speed)
     return out
+
+
+def model_markdown(models) -> str:
+    """Fitted models as one Markdown table: mu, tau, each regime's sigma and shots, and the interval's factors."""
+    lines = ["| quantity, law, fidelity | mu | tau | regime | sigma | shots | sets | 10 % factor | 90 % factor |",
+             "|---|---|---|---|---|---|---|---|---|"]
+    for m in models:
+        for g, s in m.sigma.items():
+            speed = 0.5 * SPEED_REGIME_M_S if g.startswith("below") or g == "all" else 2.0 * SPEED_REGIME_M_S
+            lo, hi = (math.exp(b) for b in m.log_bounds(speed))
+            lines.append(f"| {m.quantity}, {m.law}, {m.fidelity} | {m.mu:+.3f} | {m.tau:.3f} | {g} | {s:.3f} | "
+                         f"{m.shots[g]} | {m.sets} | {lo:.3f} | {hi:.3f} |")
+    return "\n".join(lines) + "\n"
+
+
+def coverage_markdown(table: list[dict]) -> str:
+    """The leave-one-set-out coverage table (coverage) as Markdown, with the pooled rows."""
+    lines = ["| set | role | shots | inside | below | above | coverage | bias of fepen |",
+             "|---|---|---|---|---|---|---|---|"]
+    for r in table:
+        lines.append(f"| {r['set']} | {r['role']} | {r['shots']} | {r['inside']} | {r['below']} | {r['above']} | "
+                     f"{100 * r['inside'] / r['shots']:.0f} % | {100 * r['bias']:+.1f} % |")
+    for label, rows in (("pooled, held-out sets", [r for r in table if r["role"] == "held-out"]),
+                        ("pooled, calibration sets", [r for r in table if r["role"] == "calibration"]),
+                        ("pooled, all sets", table)):
+        n, i = sum(r["shots"] for r in rows), sum(r["inside"] for r in rows)
+        b, a = sum(r["below"] for r in rows), sum(r["above"] for r in rows)
+        lines.append(f"| **{label}** | | {n} | {i} | {b} | {a} | **{100 * i / n:.1f} %** | |")
+    return "\n".join(lines) + "\n"
