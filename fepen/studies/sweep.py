@@ -409,14 +409,21 @@ def _check_shots(sweep: Sweep) -> None:
 
 
 # -------------------------------------------------------------------------------------------------- table
+#: the summary's words that the sweep table leaves to each shot's summary.json (the same on every row)
+WORDS = ("envelope.law", "envelope.checked_on", "envelope.line", "interval.depth", "interval.lateral")
+
+
 def _flatten_summary(summary: dict) -> dict:
     out = {}
     for k, v in summary.items():
         if k in MACHINE:
             continue
-        if isinstance(v, dict):
+        if k.endswith("_interval_mm"):  # [low, high] (or null): two columns
+            low, high = v if v is not None else (None, None)
+            out[f"{k}.low"], out[f"{k}.high"] = low, high
+        elif isinstance(v, dict):
             for k2, v2 in v.items():
-                if not isinstance(v2, (dict, list)):
+                if not isinstance(v2, (dict, list)) and f"{k}.{k2}" not in WORDS:
                     out[f"{k}.{k2}"] = v2
         elif not isinstance(v, list) and v is not None:
             out[k] = v
