@@ -24,6 +24,14 @@ def run(args) -> int:
     table = depth.validate_depth(args.data, args.sets, args.out, args.workers, shipped=not args.only)
     say(*(f"{r['set']}: {r['count']} shots; mean |error| default {100 * r['default mean_abs']:.1f} % "
           f"(bias {100 * r['default bias']:+.1f} %), forrestal-S {100 * r['forrestal-S mean_abs']:.1f} %, "
-          f"closed form {100 * r['closed form mean_abs']:.1f} %" for r in table),
+          f"closed form {100 * r['closed form mean_abs']:.1f} %" + _covered(r) for r in table),
         f"written: {args.out}/depth.csv, depth.md, depth.png")
     return 0
+
+
+def _covered(row: dict) -> str:
+    """"; 10-90 % interval holds N of M" (the interval fitted without a set of the same name), or ""."""
+    if "interval shots" not in row:
+        return ""
+    return f"; its 10-90 % interval holds {row['interval inside']} of {row['interval shots']}"
+

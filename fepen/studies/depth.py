@@ -27,7 +27,8 @@ from fepen.data import SHOTS
 from fepen.laws import target as tg
 
 __all__ = ["Row", "read_set", "table1_set", "shipped_sets", "scene_sets", "rigid_depth", "closed_form_depth",
-           "errors", "predict_sets", "gather_sets", "summary_table", "markdown", "figure", "validate_depth",
+           "errors", "predict_sets", "gather_sets", "summary_table", "interval_coverage", "markdown", "figure",
+           "validate_depth",
            "COLUMNS", "STRENGTH_BASES", "METHODS"]
 
 COLUMNS = ("shot", "d_mm", "m_kg", "crh", "L_mm", "v_ms", "fc_mpa", "rho_kgm3", "depth_m")
@@ -257,26 +258,59 @@ def gather_sets(paths=(), shipped: bool = True) -> dict[str, list[Row]]:
     return out
 
 
-def summary_table(results: dict[str, list[dict]]) -> list[dict]:
-    """Per set and method: count, mean |error|, bias, worst."""
+def summary_table(results: dict[str, list[dict]], law: str | None = "scaled-S") -> list[dict]:
+    """Per set and method: count, mean |error|, bias, worst; and, for the default method, how many measured
+    depths its 10-90 % interval holds ("interval inside", "interval shots": interval_coverage)."""
     rows = []
     for name, shots in results.items():
         row = {"set": name, "count": len(shots)}
         for method in METHODS:
             e = errors([s[method] for s in shots], [s["depth"] for s in shots])
             row.update({f"{method} {k}": v for k, v in e.items() if k != "count"})
+        row.update(interval_coverage(name, shots, law))
         rows.append(row)
     return rows
+
+
+def interval_coverage(name: str, shots: list[dict], law: str | None) -> dict:
+    """How many of a set's measured depths lie in the 10-90 % interval of the default method's depth
+    (fepen.post.interval), the model fitted without the set when the shipped errors hold a set of that name.
+
+    Returns:
+        {"interval inside": count, "interval shots": count} (shots the method could predict), or {} when the
+        law has no error model.
+    """
+    from fepen.data import prediction_errors
+    from fepen.post import interval
+
+    if law is None:
+        return {}
+    rows = [r for r in prediction_errors.read() if r["set"] != name]
+    try:
+        m = interval.fit(rows, "depth", law, "rigid")
+    except ValueError:  # no errors of this law
+        return {}
+    inside = n = 0
+    for s in shots:
+        if math.isfinite(s["default"]):
+            lo, hi = interval.interval(m, s["default"], s["V"])
+            inside += lo <= s["depth"] <= hi
+            n += 1
+    return {"interval inside": inside, "interval shots": n}
 
 
 def markdown(table: list[dict], header: str = "") -> str:
     """The summary table as Markdown: per set, mean |error| / bias / worst of each method."""
     cols = " | ".join(f"{m}: mean abs / bias / worst" for m in METHODS)
-    lines = ([header, ""] if header else []) + [f"| set | shots | {cols} |", "|---|---|" + "---|" * len(METHODS)]
+    cover = all("interval shots" in r for r in table)
+    extra = " default: in its 10-90 % interval |" if cover else ""
+    lines = ([header, ""] if header else []) + [f"| set | shots | {cols} |{extra}",
+                                                 "|---|---|" + "---|" * (len(METHODS) + cover)]
     for r in table:
         cells = " | ".join(f"{100 * r[f'{m} mean_abs']:.1f} % / {100 * r[f'{m} bias']:+.1f} % / "
                            f"{100 * r[f'{m} worst']:+.1f} %" for m in METHODS)
-        lines.append(f"| {r['set']} | {r['count']} | {cells} |")
+        tail = f" {r['interval inside']} of {r['interval shots']} |" if cover else ""
+        lines.append(f"| {r['set']} | {r['count']} | {cells} |{tail}")
     return "\n".join(lines) + "\n"
 
 
@@ -338,7 +372,7 @@ def validate_depth(paths=(), sets=(), out="results/validate-depth", workers: int
         for name, shots in results.items():
             for s in shots:
                 w.writerow({"set": name, **s})
-    table = summary_table(results)
+    table = summary_table(results, scene.load(None, ["effects.fidelity=rigid", *sets]).target.strength_model)
     note = (f"Rigid fidelity, default scene but for each shot's projectile, target strength and density"
             f"{' and ' + ', '.join(sets) if sets else ''}; errors P_pred/P_meas - 1.")
     (out / "depth.md").write_text(markdown(table, note))

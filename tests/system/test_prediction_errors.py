@@ -55,3 +55,25 @@ def test_the_plastic_rows_are_the_validation_table():
         m = re.search(rf"^\| {shot} \| [\d.]+ \| [\d.]+ / ([\d.]+) / ", text, re.M)
         assert m, shot
         assert math.isclose(1e3 * r["predicted_m"], float(m[1]), abs_tol=0.15), (shot, 1e3 * r["predicted_m"], m[1])
+
+
+def test_validate_depth_reports_the_interval_coverage_of_a_new_set(tmp_path):
+    """A user's set (four shots of frew2006 under another name): `fepen validate-depth --data` counts its measured
+    depths inside the 10-90 % interval of the model fitted on every shipped set (a shipped set's name would
+    leave that set out of the fit)."""
+    from fepen.post import interval
+
+    src = depth.shipped_sets()["frew2006"]
+    lines = src.read_text().splitlines()
+    mine = tmp_path / "mine.csv"
+    mine.write_text("\n".join(lines[:5]) + "\n")
+    table = depth.validate_depth([mine], out=tmp_path / "out", shipped=False)
+    row = table[0]
+    assert row["set"] == "mine" and row["interval shots"] == 4
+    full = interval.model("depth", "scaled-S", "rigid")
+    want = 0
+    for r in depth.read_set(mine):
+        lo, hi = interval.interval(full, depth.rigid_depth(r), r.V)
+        want += lo <= r.depth <= hi
+    assert row["interval inside"] == want
+    assert f"{want} of 4" in (tmp_path / "out" / "depth.md").read_text()
