@@ -46,6 +46,8 @@ def prediction_lines(summary: dict) -> list[str]:
     pct = "-".join(f"{100 * p:g}" for p in info.get("levels", ())) + " %"
     for name, quantity in (("depth_interval_mm", "depth"), ("lateral_interval_mm", "lateral")):
         iv = summary.get(name)
+        if iv is None and quantity == "depth" and info.get("depth"):
+            lines.append(f"{name} = {info['depth']}")  # "none: ..." and why
         if iv is not None:
             where = "; extrapolated: the shot lies outside the validated envelope" if info.get("extrapolated") else ""
             lines.append(f"{name} = {iv[0]:.4g} to {iv[1]:.4g} ({pct}: {info.get(quantity)}{where})")
