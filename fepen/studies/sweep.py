@@ -281,6 +281,11 @@ def read(path, sets=()) -> Sweep:
         if not isinstance(tab, dict) or not isinstance(tab.get("file"), str):
             raise InputError("table.file", "the CSV file of shots (a string)")
         keys, shots = _read_table((path.parent / tab["file"]).resolve())
+    if ("target.compressive_strength" in keys and "target.strength_basis" not in base
+            and "target.strength_basis" not in keys and resolved.get("target.layers") is None):
+        # a varied strength is on the base scene's basis (the default concrete's 40 MPa is a cube strength);
+        # given alone, each shot's value would be read as a cylinder strength (theory.md §8.1)
+        base["target.strength_basis"] = resolved.get("target.strength_basis")
     if any(k in IMPACT for k in keys) and "impact.shot" in base:
         # the shot's three impact values become plain keys, so that the varied ones may replace them
         del base["impact.shot"]
