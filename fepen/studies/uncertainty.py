@@ -465,23 +465,7 @@ def study(p: Plan, out, comm=None, ranks_per_shot: int = 1, fresh: bool = False,
     facts = setup.envelope_facts(sc, setup.check_supported(sc))
     verdict = envelope.verdict(facts)
     verdict["line"] = envelope.line(verdict)
-    m, why = model_of(sc) if p.model_scatter else (None, "--no-model-scatter")
-    response = draws = None
-    if m is not None:
-        res = None
-        if comm.rank == 0:
-            try:
-                res = calibrate(p.base)
-            except SimulationError as err:
-                res = err
-        res = comm.bcast(res, root=0)
-        if isinstance(res, SimulationError):
-            raise res
-        response = res
-        speeds = [s.get("impact.velocity", sc.impact.velocity) for s in p.inputs]
-        draws = draw_model_errors(m, speeds, p.seed)
-        lam = np.clip(response.inverse(np.exp(draws["eps"])), *LAMBDA_BOUNDS)
-        draws["lambda"] = lam
+    m, why, response, draws = _model_draws(p, sc, comm)
     combined = [{**s, RESISTANCE: float(draws["lambda"][i])} for i, s in enumerate(p.inputs)] if m is not None \
         else None
     run_inputs = m is None or p.rigid
@@ -496,26 +480,15 @@ def study(p: Plan, out, comm=None, ranks_per_shot: int = 1, fresh: bool = False,
         raise InputError(*err)
     out = files.prepare(out, comm)
     if comm.rank == 0:
-        files.write_json(out / "uncertainty_input.json", {"digest": digest, "scatter": p.scatter,
-                                                          "samples": p.samples, "seed": p.seed}, MPI.COMM_SELF)
-        if combined is not None:
-            files.write_text(out / "combined.csv", _csv(combined, [*p.keys, RESISTANCE]), MPI.COMM_SELF)
-            draw_rows = [{"shot": i, "speed_m_s": float(v), "b": float(draws["b"][i]), "e": float(draws["e"][i]),
-                          "eps": float(draws["eps"][i]), "sigma": float(draws["sigma"][i]),
-                          RESISTANCE: float(draws["lambda"][i])} for i, v in enumerate(speeds)]
-            files.write_text(out / "model_draws.csv", _csv(draw_rows, list(draw_rows[0])), MPI.COMM_SELF)
-        if inputs is not None and p.keys:
-            files.write_text(out / "inputs.csv", _csv(inputs, p.keys), MPI.COMM_SELF)
+        _write_tables(out, p, digest, combined, inputs, draws)
     comm.barrier()
-    runs = {}
     for name, rows, table in (("combined", combined, "combined.csv"), ("inputs", inputs, "inputs.csv")):
         if rows is None:
             continue
         spec = ({"base": dict(p.base), "table": {"file": str((out / table).resolve())}} if p.keys or name ==
                 "combined" else {"base": dict(p.base), "grid": {RESISTANCE: [1.0]}})
-        res = sweep.run(spec, out / name, comm, ranks_per_shot, fresh=fresh, progress=progress,
-                        say=lambda *ls, name=name: say(*(f"{name}: {x}" for x in ls)))
-        runs[name] = res
+        sweep.run(spec, out / name, comm, ranks_per_shot, fresh=fresh, progress=progress,
+                  say=lambda *ls, name=name: say(*(f"{name}: {x}" for x in ls)))
     wall = time.perf_counter() - t0
     result = None
     if comm.rank == 0:
@@ -526,6 +499,46 @@ def study(p: Plan, out, comm=None, ranks_per_shot: int = 1, fresh: bool = False,
         figure(result, out, _depths(out, combined, inputs, sc))
         say(*lines(result, out))
     return comm.bcast(result, root=0)
+
+
+def _model_draws(p: Plan, sc, comm) -> tuple:
+    """(the ErrorModel or None, why none or None, the Response, the draws with their "lambda") of the study:
+    the response calibrated on rank 0 (its error raised on every rank), the draws the same on every rank."""
+    m, why = model_of(sc) if p.model_scatter else (None, "--no-model-scatter")
+    if m is None:
+        return None, why, None, None
+    res = None
+    if comm.rank == 0:
+        try:
+            res = calibrate(p.base)
+        except SimulationError as err:
+            res = err
+    res = comm.bcast(res, root=0)
+    if isinstance(res, SimulationError):
+        raise res
+    speeds = [s.get("impact.velocity", sc.impact.velocity) for s in p.inputs]
+    draws = draw_model_errors(m, speeds, p.seed)
+    draws["speed_m_s"] = np.array(speeds, float)
+    draws["lambda"] = np.clip(res.inverse(np.exp(draws["eps"])), *LAMBDA_BOUNDS)
+    return m, None, res, draws
+
+
+def _write_tables(out: Path, p: Plan, digest: str, combined, inputs, draws) -> None:
+    """uncertainty_input.json (the study's digest), combined.csv, model_draws.csv, inputs.csv (rank 0)."""
+    from mpi4py import MPI
+
+    from fepen.io import files
+
+    files.write_json(out / "uncertainty_input.json", {"digest": digest, "scatter": p.scatter, "samples": p.samples,
+                                                      "seed": p.seed}, MPI.COMM_SELF)
+    if combined is not None:
+        files.write_text(out / "combined.csv", _csv(combined, [*p.keys, RESISTANCE]), MPI.COMM_SELF)
+        rows = [{"shot": i, "speed_m_s": float(draws["speed_m_s"][i]), "b": float(draws["b"][i]),
+                 "e": float(draws["e"][i]), "eps": float(draws["eps"][i]), "sigma": float(draws["sigma"][i]),
+                 RESISTANCE: float(draws["lambda"][i])} for i in range(len(combined))]
+        files.write_text(out / "model_draws.csv", _csv(rows, list(rows[0])), MPI.COMM_SELF)
+    if inputs is not None and p.keys:
+        files.write_text(out / "inputs.csv", _csv(inputs, p.keys), MPI.COMM_SELF)
 
 
 def _check_out(out: Path, digest: str, fresh: bool):
