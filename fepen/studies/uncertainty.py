@@ -124,14 +124,31 @@ def conditional_probability(hit, eps, mu: float, tau_p: float, sigma, b_star: fl
 
 
 def depth_quantiles(depth_mm) -> dict:
-    """{"P10_mm", "P50_mm", "P90_mm", "mean_mm", "shots"} of the finite depths (mm)."""
-    d = np.asarray(depth_mm, float)
-    d = d[np.isfinite(d)]
+    """The depth's quantiles (numpy's linear interpolation) and mean, in mm.
+
+    Args:
+        depth_mm: the shots' depths; NaN: no result (left out); +inf: a shot through the target (its depth lies
+            beyond it: a quantile that falls among those is None).
+
+    Returns:
+        {"P10_mm", "P50_mm", "P90_mm", "mean_mm" (of the shots that stopped), "shots", "stopped"}.
+    """
+    d = np.sort(np.asarray(depth_mm, float))
+    d = d[~np.isnan(d)]
     if not len(d):
         return {"shots": 0}
-    p10, p50, p90 = np.percentile(d, [10, 50, 90])
-    return {"P10_mm": float(p10), "P50_mm": float(p50), "P90_mm": float(p90), "mean_mm": float(d.mean()),
-            "shots": int(len(d))}
+    out = {}
+    for name, q in (("P10_mm", 0.1), ("P50_mm", 0.5), ("P90_mm", 0.9)):
+        h = (len(d) - 1) * q
+        lo = int(math.floor(h))
+        hi = min(lo + 1, len(d) - 1)
+        f = h - lo
+        out[name] = None if not np.isfinite(d[lo]) or (f > 0 and not np.isfinite(d[hi])) else float(
+            d[lo] + f * (d[hi] - d[lo]) if f > 0 else d[lo])
+    stopped = d[np.isfinite(d)]
+    out["mean_mm"] = float(stopped.mean()) if len(stopped) else None
+    out["shots"], out["stopped"] = int(len(d)), int(len(stopped))
+    return out
 
 
 # ------------------------------------------------------------------------------------------------- response
@@ -346,6 +363,11 @@ def plan(scene_path=None, scatter=None, sets=(), samples: int | None = None, see
         n, sd, lhs = (samples if samples is not None else 1000), (seed if seed is not None else 0), False
         keys, inputs, dists = [], [{} for _ in range(n)], {}
     shot = sweep_figures.measured_shot(SimpleNamespace(base=base, keys=[]))
+    if "target.compressive_strength" in keys and "target.strength_basis" not in base and not base.get(
+            "target.layers"):
+        # a given strength is read on cylinders unless its basis is given (fepen.scene): the drawn strengths
+        # keep the basis of the base scene's value, about which they scatter (the default's 40 MPa is on cubes)
+        base["target.strength_basis"] = resolved.get("target.strength_basis")
     label = _label(resolved, scene_path, path, spec)
     p = Plan(base, label, shot, keys, inputs, n, sd, lhs, dists, model_scatter,
              str(path.resolve()) if path is not None else None)
@@ -359,7 +381,7 @@ def _label(sc: fscene.Scene, scene_path, scatter_path, spec) -> str:
     name = sc.get("impact.shot")
     if name is None:
         src = scene_path or (spec.get("scene") if spec else None)
-        name = Path(src).stem if src else "default scene"
+        name = Path(src).name if src else "default scene"
     parts = [name]
     if sc.get("target.thickness") is not None:
         parts.append(f"{1e3 * sc.get('target.thickness'):.4g} mm slab")
@@ -404,7 +426,7 @@ def _sample_result(records: list, thickness: float | None, layers: list | None) 
     for r in records:
         statuses[r["status"]] = statuses.get(r["status"], 0) + 1
         s = r.get("summary") if r["status"] == "ok" else None
-        depth.append(s["depth_mm"] if s else np.nan)
+        depth.append((np.inf if s["outcome"] == "perforated" else s["depth_mm"]) if s else np.nan)
         perf.append(float(s["outcome"] == "perforated") if s else np.nan)
         if layers:
             ls = (s or {}).get("layers") or []
@@ -619,6 +641,11 @@ def _fmt_p(e: dict) -> str:
     return text
 
 
+def _mm(v) -> str:
+    """A depth in mm, or "through" (a quantile among the shots that perforated)."""
+    return "through" if v is None else f"{v:.1f} mm"
+
+
 def lines(res: dict, out) -> list[str]:
     """The few lines the command prints."""
     out_lines = []
@@ -627,8 +654,9 @@ def lines(res: dict, out) -> list[str]:
         if e is None or not e["depth"].get("shots"):
             continue
         q = e["depth"]
-        out_lines.append(f"depth ({what}, {q['shots']} shots): P10 {q['P10_mm']:.1f} mm, P50 {q['P50_mm']:.1f} mm, "
-                         f"P90 {q['P90_mm']:.1f} mm, mean {q['mean_mm']:.1f} mm")
+        out_lines.append(f"depth ({what}, {q['shots']} shots): P10 {_mm(q['P10_mm'])}, P50 {_mm(q['P50_mm'])}, "
+                         f"P90 {_mm(q['P90_mm'])}, mean {_mm(q['mean_mm'])}"
+                         + (f" (of the {q['stopped']} that stopped)" if q["stopped"] < q["shots"] else ""))
     if res["scene"]["test"]:
         t = res["scene"]["test"]
         out_lines.append(f"the test {t['shot']}: {t['depth_mm']:.1f} mm")
@@ -690,8 +718,11 @@ def report(res: dict) -> str:
         q = e["depth"]
         st = ", ".join(f"{k} {v}" for k, v in sorted(e["statuses"].items()))
         if q.get("shots"):
-            L.append(f"| {name} | {e['shots']} | {q['P10_mm']:.1f} | {q['P50_mm']:.1f} | {q['P90_mm']:.1f} | "
-                     f"{q['mean_mm']:.1f} | {st} |")
+            L.append(f"| {name} | {e['shots']} | " + " | ".join(_mm(q[c]).replace(" mm", "") for c in (
+                "P10_mm", "P50_mm", "P90_mm", "mean_mm")) + f" | {st} |")
+    if res["target"]["thickness_m"] is not None or res["target"]["layers"]:
+        L += ["", "A shot through the target has no depth: \"through\" is a quantile among them; the mean is of the "
+                  "shots that stopped."]
     if sc["test"]:
         L += ["", f"The test {sc['test']['shot']}: {sc['test']['depth_mm']:.1f} mm."]
     probs = [(name, "target", e["perforation"]) for name, e in res["samples"].items()
@@ -738,10 +769,13 @@ def figure(res: dict, out, depths: dict) -> Path:
         d = d[np.isfinite(d)]
         if not len(d):
             continue
-        ax.hist(d, bins=bins, alpha=0.45, color=colours[name], label=f"{names[name]} ({len(d)})")
         q = res["samples"][name]["depth"]
+        through = q["shots"] - q["stopped"]
+        ax.hist(d, bins=bins, alpha=0.45, color=colours[name], label=f"{names[name]} ({len(d)} stopped"
+                + (f", {through} through)" if through else ")"))
         for p in ("P10_mm", "P90_mm"):
-            ax.axvline(q[p], color=colours[name], ls="--", lw=1.2)
+            if q[p] is not None:
+                ax.axvline(q[p], color=colours[name], ls="--", lw=1.2)
     th = res["target"]["thickness_m"]
     if th is not None:
         ax.axvline(1e3 * th, color="k", lw=2, label=f"slab {1e3 * th:.4g} mm")
