@@ -10,6 +10,8 @@
                                 [--set KEY=VALUE ...] [--fresh]
     fepen study ricochet [SCENE.toml] [--out DIR] [--speeds V,...] [--tol DEG] [--obliquity-max DEG]
                          [--ranks-per-shot K] [--set KEY=VALUE ...] [--fresh]
+    fepen study uncertainty [SCENE.toml] [--scatter SWEEP.toml] [--samples N] [--seed S] [--no-model-scatter]
+                            [--set KEY=VALUE ...] [--out DIR] [--ranks-per-shot K] [--fresh]
     fepen sweep SWEEP.toml [--out DIR] [--ranks-per-shot K] [--workers W] [--set KEY=VALUE ...] [--fresh]
     fepen view DIR [--png FILE] [--time T] [--field NAME]
     fepen keys

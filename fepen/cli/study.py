@@ -1,14 +1,17 @@
-"""``fepen study accuracy-cost | ballistic-limit | ricochet`` (docs/studies.md), three sub-commands, each
-with only its own options:
+"""``fepen study accuracy-cost | ballistic-limit | ricochet | uncertainty`` (docs/studies.md), four
+sub-commands, each with only its own options:
 
     fepen study accuracy-cost [--out DIR] [--ranks N] [--quick] [--fresh]
     fepen study ballistic-limit [SCENE.toml] [--out DIR] [--speeds LOW,HIGH] [--tol M/S] [--ranks-per-shot K]
                                 [--set KEY=VALUE ...] [--fresh]
     fepen study ricochet [SCENE.toml] [--out DIR] [--speeds V,...] [--tol DEG] [--obliquity-max DEG]
                          [--ranks-per-shot K] [--set KEY=VALUE ...] [--fresh]
+    fepen study uncertainty [SCENE.toml] [--scatter SWEEP.toml] [--samples N] [--seed S] [--no-model-scatter]
+                            [--set KEY=VALUE ...] [--out DIR] [--ranks-per-shot K] [--fresh]
 
 accuracy-cost starts its own MPI jobs (fepen.studies.accuracy_cost); the limit studies
-(fepen.studies.limits) run on the ranks they were started on.
+(fepen.studies.limits) and the uncertainty study (fepen.studies.uncertainty) run on the ranks they were
+started on.
 """
 
 from __future__ import annotations
@@ -18,8 +21,8 @@ import math
 from fepen.cli.common import numbers, say, set_argument
 from fepen.errors import InputError
 
-HELP = ("accuracy-cost: what accuracy costs in time (study.md, pareto.png); ballistic-limit; ricochet "
-        "(docs/studies.md)")
+HELP = ("accuracy-cost: what accuracy costs in time (study.md, pareto.png); ballistic-limit; ricochet; "
+        "uncertainty (docs/studies.md)")
 FRESH = "run again what DIR already holds"
 
 
@@ -42,6 +45,18 @@ def add_arguments(parser) -> None:
                                                                             "m/s)")
     ri.add_argument("--tol", type=float, default=0.5, help="the bisection's final width in deg (default 0.5)")
     ri.add_argument("--obliquity-max", type=float, default=85.0, help="top of the bracket (deg)")
+    un = sub.add_parser("uncertainty", help="the scatter of the inputs and fepen's own error together: the depth's "
+                                            "distribution, P(perforation) with its intervals: uncertainty.json, "
+                                            "uncertainty.md, uncertainty.png")
+    _limit_arguments(un, "results/uncertainty")
+    un.add_argument("--scatter", metavar="SWEEP.toml", help="a sweep file whose [monte_carlo] gives the inputs' "
+                                                            "distributions (absent SCENE: its scene and [base] too)")
+    un.add_argument("--samples", type=int, default=None, metavar="N", help="samples (default: the --scatter "
+                                                                           "file's; without it 1000)")
+    un.add_argument("--seed", type=int, default=None, metavar="S", help="the seed (default: the --scatter file's; "
+                                                                        "without it 0)")
+    un.add_argument("--no-model-scatter", dest="model_scatter", action="store_false",
+                    help="the input scatter alone (fepen's own error not drawn)")
 
 
 def _limit_arguments(parser, out_default: str) -> None:
@@ -55,8 +70,8 @@ def _limit_arguments(parser, out_default: str) -> None:
 
 def run(args) -> int:
     """The study named by the sub-command."""
-    return {"accuracy-cost": _accuracy_cost, "ballistic-limit": _ballistic_limit, "ricochet": _ricochet}[
-        args.which](args)
+    return {"accuracy-cost": _accuracy_cost, "ballistic-limit": _ballistic_limit, "ricochet": _ricochet,
+            "uncertainty": _uncertainty}[args.which](args)
 
 
 def _accuracy_cost(args) -> int:
@@ -107,6 +122,19 @@ def _ricochet(args) -> int:
     limits.ricochet(args.scene, args.sets, args.out, comm, args.ranks_per_shot, speeds, args.obliquity_max,
                     args.tol, say=say)
     say(f"written: {args.out}/ricochet.json, ricochet.png")
+    return 0
+
+
+def _uncertainty(args) -> int:
+    """fepen study uncertainty, on the ranks it was started on: bad input in one line before any shot."""
+    from mpi4py import MPI
+
+    from fepen.studies import engine, uncertainty
+
+    comm = MPI.COMM_WORLD
+    engine.check_ranks_per_shot(args.ranks_per_shot, comm.size)
+    p = uncertainty.plan(args.scene, args.scatter, args.sets, args.samples, args.seed, args.model_scatter)
+    uncertainty.study(p, args.out, comm, args.ranks_per_shot, args.fresh, say=say)
     return 0
 
 

@@ -1,0 +1,180 @@
+"""fepen.studies.uncertainty's pieces: the resistance response and its inverse, the Wilson interval against
+published values, the importance reweighting against a conditional probability known in closed form, the
+model's draws against the model's moments, and bad options answered in one line with exit 2 before any shot."""
+
+import math
+import re
+
+import numpy as np
+import pytest
+from scipy.special import ndtr
+
+from fepen import cli
+from fepen.post import interval
+from fepen.studies import uncertainty as unc
+
+DEMO = unc.Path(__file__).resolve().parents[3] / "demos" / "studies" / "c3_scatter.toml"
+
+
+def power_response(exponent=-0.8):
+    lam = np.array(unc.LAMBDA_GRID)
+    return unc.Response(tuple(lam), tuple(lam**exponent), 0.35)
+
+
+def test_lambda_grid_is_log_spaced_with_one_in_it():
+    lam = np.array(unc.LAMBDA_GRID)
+    assert lam[0] == pytest.approx(0.2) and lam[-1] == pytest.approx(5.0) and 1.0 in unc.LAMBDA_GRID
+    assert np.allclose(np.diff(np.log(lam)), math.log(25.0) / 12, rtol=1e-12)
+
+
+def test_response_inverse_is_the_inverse():
+    """g(g^-1(x)) = x across and beyond the grid, and g^-1(g(lambda)) = lambda."""
+    r = unc.Response(tuple(unc.LAMBDA_GRID), (3.54, 2.95, 2.43, 1.97, 1.58, 1.25, 1.0, 0.795, 0.636, 0.512, 0.418,
+                                              0.345, 0.289), 0.3476)  # C3's, rounded
+    x = np.geomspace(0.2, 4.0, 201)  # 0.2 and 4 lie beyond g(5) = 0.289 and g(0.2) = 3.54: the straight ends
+    assert np.allclose(r.g(r.inverse(x)), x, rtol=1e-12)
+    lam = np.geomspace(0.1, 10.0, 101)
+    assert np.allclose(r.inverse(r.g(lam)), lam, rtol=1e-12)
+    assert r.g(1.0) == pytest.approx(1.0, abs=1e-15) and r.inverse(1.0) == pytest.approx(1.0, rel=1e-12)
+    assert np.all(np.diff(r.g(lam)) < 0)  # monotone between the nodes too (PCHIP)
+    assert np.allclose(r.g(np.array(unc.LAMBDA_GRID)), r.ratios, rtol=1e-13)  # through the nodes
+
+
+def test_a_power_law_response_inverts_exactly():
+    """ln g linear in ln lambda: PCHIP and the straight ends reproduce it, so g^-1(x) = x^(1/exponent)."""
+    r = power_response(-0.8)
+    x = np.geomspace(0.15, 5.0, 50)
+    assert np.allclose(r.inverse(x), x ** (-1.25), rtol=1e-10)
+
+
+def test_inverse_is_clipped_to_the_keys_range():
+    r = power_response(-0.8)
+    assert r.inverse(1e-6) == pytest.approx(unc.LAMBDA_BOUNDS[1]) and r.inverse(1e6) == pytest.approx(
+        unc.LAMBDA_BOUNDS[0])
+
+
+@pytest.mark.parametrize("x, n, low, high", [(81, 263, 0.2553, 0.3662), (15, 148, 0.0624, 0.1605),
+                                             (0, 20, 0.0, 0.1611), (1, 29, 0.0061, 0.1718)])
+def test_wilson_interval_matches_newcombe(x, n, low, high):
+    """Newcombe (1998), Statistics in Medicine 17:857, Table I, method 3 (Wilson's score interval)."""
+    lo, hi = unc.wilson(x, n)
+    assert lo == pytest.approx(low, abs=6e-5) and hi == pytest.approx(high, abs=6e-5)
+
+
+def test_wilson_interval_is_symmetric_and_shrinks_as_one_over_root_n():
+    lo, hi = unc.wilson(50, 100)
+    assert lo + hi == pytest.approx(1.0, abs=1e-12)
+    w1 = np.subtract(*unc.wilson(500, 1000)[::-1])
+    w2 = np.subtract(*unc.wilson(2000, 4000)[::-1])
+    assert w1 / w2 == pytest.approx(2.0, rel=0.01)
+
+
+def test_reweighting_recovers_a_known_conditional_probability():
+    """A slab perforated when eps + x > c (x: an independent input's effect): P(perforation | b) = 1 -
+    Phi((c - mu - b) / sqrt(sigma^2 + s_x^2)), recovered from one sample drawn over b."""
+    rng = np.random.default_rng(5)
+    n, mu, tau_p, sigma, s_x, c = 400_000, -0.07, 0.17, 0.125, 0.1, 0.05
+    b = tau_p * rng.standard_normal(n)
+    eps = mu + b + sigma * rng.standard_normal(n)
+    hit = (eps + s_x * rng.standard_normal(n) > c).astype(float)
+    for b_star in (-0.2, 0.0, 0.2):
+        p, ess = unc.conditional_probability(hit, eps, mu, tau_p, sigma, b_star)
+        exact = 1.0 - ndtr((c - mu - b_star) / math.hypot(sigma, s_x))
+        assert p == pytest.approx(exact, abs=0.01), (b_star, p, exact)
+        assert 0.1 * n < ess <= n
+    # no systematic spread: no reweighting
+    assert unc.conditional_probability(hit, eps, mu, 0.0, sigma, 0.3)[0] == pytest.approx(hit.mean())
+
+
+def test_model_draws_have_the_models_moments():
+    """eps = mu + b + e: its mean mu and its spread m.sd(V) in each speed regime; b and e independent."""
+    m = interval.model("depth", "scaled-S", "rigid")
+    speeds = np.r_[np.full(100_000, 600.0), np.full(100_000, 1200.0)]
+    d = unc.draw_model_errors(m, speeds, seed=3)
+    for sl, v in ((slice(0, 100_000), 600.0), (slice(100_000, None), 1200.0)):
+        eps = d["eps"][sl]
+        sd = m.sd(v)
+        assert eps.mean() == pytest.approx(m.mu, abs=4 * sd / math.sqrt(len(eps)))
+        assert eps.std() == pytest.approx(sd, rel=0.01)
+        assert np.allclose(d["sd"][sl], sd)
+    assert d["b"].std() == pytest.approx(m.tau * math.sqrt(1 + 1 / m.sets), rel=0.01)
+    assert abs(np.corrcoef(d["b"], d["e"])[0, 1]) < 0.01
+    again = unc.draw_model_errors(m, speeds[:10], seed=3)
+    assert np.array_equal(again["eps"], d["eps"][:10])  # seeded: the same draws
+    assert not np.array_equal(unc.draw_model_errors(m, speeds[:10], seed=4)["eps"], again["eps"])
+
+
+def test_depth_quantiles():
+    q = unc.depth_quantiles(np.r_[np.arange(1.0, 102.0), np.nan])
+    assert (q["P10_mm"], q["P50_mm"], q["P90_mm"], q["mean_mm"], q["shots"]) == (11.0, 51.0, 91.0, 51.0, 101)
+
+
+GRID = "[base]\neffects.fidelity = 'rigid'\n[grid]\n'impact.velocity' = [500.0]\n"
+BAD_VARY = "[monte_carlo]\nsamples = 10\n[monte_carlo.vary]\n'impact.speed' = { distribution = 'normal', std = 1.0 }\n"
+UNC = ["study", "uncertainty", "--out", "out", "--set", "effects.fidelity=rigid"]
+
+
+@pytest.mark.parametrize("argv, text, key, words", [
+    (UNC + ["--samples", "1"], None, "--samples", r"an integer in \[2, 10000000\], got 1"),
+    (UNC + ["--seed", "-3"], None, "--seed", r"a non-negative integer, got -3"),
+    (UNC + ["--samples", "many"], None, "command line", r"invalid int value: 'many'"),
+    (UNC + ["--scatter", "nowhere.toml"], None, "--scatter", r"cannot read nowhere.toml"),
+    (UNC + ["--scatter", "SWEEP"], GRID, "--scatter", r"must hold a \[monte_carlo\] section"),
+    (UNC + ["--scatter", "SWEEP"], BAD_VARY, "monte_carlo.vary.impact.speed", r"not a scene key"),
+    (UNC + ["--set", "target.resistance_factor=2"], None, "target.resistance_factor", r"the study draws it"),
+    (UNC + ["--set", "impact.velocity=-5"], None, "impact.velocity", r"got -5"),
+    (UNC + ["--ranks-per-shot", "2"], None, "--ranks-per-shot", r"must divide the number of ranks \(1\)"),
+    (UNC + ["--speeds", "1,2"], None, "command line", r"unrecognized arguments: --speeds"),
+    (["study", "uncertainty", "--set", "effects.fidelity=plastic", "--no-model-scatter"], None,
+     "--no-model-scatter", r"nothing would vary"),
+])
+def test_bad_options_are_one_line_and_exit_2(tmp_path, monkeypatch, capsys, argv, text, key, words):
+    from fepen.studies import engine
+
+    def ran(*args, **kwargs):
+        raise RuntimeError("the bad input got as far as running a shot")
+
+    monkeypatch.setattr(engine, "run_shots", ran)
+    monkeypatch.setattr(engine, "execute", ran)
+    monkeypatch.chdir(tmp_path)
+    if text is not None:
+        (tmp_path / "sweep.toml").write_text(text)
+    code = cli.main([str(tmp_path / "sweep.toml") if a == "SWEEP" else a for a in argv])
+    captured = capsys.readouterr()
+    lines = captured.err.splitlines()
+    assert code == 2 and len(lines) == 1, (code, captured.err)
+    prefix = f"fepen: bad input: {key}: "
+    assert lines[0].startswith(prefix), lines[0]
+    assert re.search(words, lines[0][len(prefix):]), lines[0]
+    assert not (tmp_path / "out").exists()
+
+
+def test_plan_of_the_shipped_scatter_takes_its_scene_and_overrides():
+    """The C3 scatter: its scene (shot C3) and [base], --samples and --seed over the file's; a --set of the
+    speed replaces the shot's (no conflict with impact.shot), and the scene is then no longer the test."""
+    p = unc.plan(None, DEMO, samples=20, seed=7)
+    assert p.samples == 20 and p.seed == 7 and len(p.inputs) == 20 and p.rigid
+    assert p.keys == ["impact.velocity", "impact.obliquity_deg", "impact.attack_deg", "target.compressive_strength"]
+    assert p.shot is not None and p.shot.name == "C3"
+    speeds = np.array([s["impact.velocity"] for s in p.inputs])
+    assert 584.3 - 20 < speeds.mean() < 584.3 + 20
+    slab = unc.plan(None, DEMO, ["target.thickness=0.15", "impact.velocity=315.0"], samples=20, seed=7)
+    assert slab.shot is None and slab.scene.impact.velocity == 315.0 and slab.scene.impact.obliquity_deg == 10.5
+    assert np.mean([s["impact.velocity"] for s in slab.inputs]) == pytest.approx(315.0, abs=15.0)
+
+
+def test_depth_quantiles_of_a_slab_say_through_beyond_the_stopped_shots():
+    """30 of 100 shots perforate (+inf): P10 and P50 are depths, P90 lies among the perforations."""
+    d = np.r_[np.arange(1.0, 71.0), np.full(30, np.inf)]
+    q = unc.depth_quantiles(d)
+    assert q["P10_mm"] == pytest.approx(np.percentile(d[:70], 10 * 99 / 69)) and q["P90_mm"] is None
+    assert q["P50_mm"] == pytest.approx(50.5) and q["mean_mm"] == pytest.approx(35.5)
+    assert (q["shots"], q["stopped"]) == (100, 70)
+
+
+def test_the_drawn_strengths_keep_the_base_scenes_basis():
+    """The default concrete's 40 MPa is a cube strength; a given strength is read on cylinders unless its basis
+    is given: the study pins the base's basis, so the strengths drawn about 40 MPa are cube strengths too."""
+    p = unc.plan(None, DEMO, samples=4, seed=1)
+    assert p.base["target.strength_basis"] == "cube"
+    assert p.shot is not None and p.shot.name == "C3"  # still the test
