@@ -27,11 +27,22 @@ run: setup
 	$(PY) -m fepen run scenes/default.toml --set effects.fidelity=rigid --out results/C3-rigid --force
 	$(PY) -m fepen mesh scenes/default.toml --out results/C3-mesh
 
+# The tests' meshes go to one cache per user, shared by every checkout ($(TEST_MESHES); a set FEPEN_MESH_CACHE
+# wins): CI on a kept machine and a fresh clone start warm instead of meshing everything again (a fresh clone
+# with a cold cache spends a third of the suite in gmsh). Sharing is safe because an entry's key holds all that
+# shapes its mesh: the exact shape record, the gmsh options, charge and mass, the gmsh version and a hash of
+# the code that builds it (fepen/geometry/mesh.py _key, _code_hash: gmsh_model, shape, profile, tetra, cad,
+# checks and the mass sizing), and an entry is read only after its sidecar's versions and SHA-256 match.
+# Only `make test` uses it: fepen run and fepen mesh keep the checkout's meshes/cache.
+TEST_MESHES ?= $(HOME)/.cache/fepen/test-meshes
+
 test: setup
 	$(PY) -m ruff check --no-cache fepen tests demos benchmarks tools
-	$(PY) -m pytest -q -m "not mpi" -n $(WORKERS) tests/unit
-	$(PY) -m pytest -q -m "not mpi" -n $(WORKERS) --dist loadgroup tests/system
-	mpirun -n $(NP) $(PY) -m pytest -q -m mpi -p no:cacheprovider tests
+	FEPEN_MESH_CACHE=$${FEPEN_MESH_CACHE:-$(TEST_MESHES)} $(PY) -m pytest -q -m "not mpi" -n $(WORKERS) tests/unit
+	FEPEN_MESH_CACHE=$${FEPEN_MESH_CACHE:-$(TEST_MESHES)} $(PY) -m pytest -q -m "not mpi" -n $(WORKERS) \
+	  --dist loadgroup tests/system
+	FEPEN_MESH_CACHE=$${FEPEN_MESH_CACHE:-$(TEST_MESHES)} mpirun -n $(NP) $(PY) -m pytest -q -m mpi \
+	  -p no:cacheprovider tests
 
 # JupyterLab beside the kernel the set-up installs (fepen[notebook]: the pins that work with Debian's matplotlib);
 # then `.venv/bin/jupyter lab demos/` and open api_tour.py or rigid_study.py as a notebook

@@ -1,5 +1,8 @@
 """Shared test helpers. Tests marked ``mpi`` compare 1 and 2 ranks: make test runs them under ``mpirun -n 2``
-only, and the serial lanes (``-m "not mpi"``) leave them out (see the Makefile)."""
+only, and the serial lanes (``-m "not mpi"``) leave them out (see the Makefile).
+
+The longest tests start first (pytest_collection_modifyitems): pytest-xdist hands tests out in collection
+order, so a 2-minute test collected last would keep one worker busy after the other has finished."""
 
 from pathlib import Path
 
@@ -23,3 +26,39 @@ def run_python(script, *args, ranks: int = 1, timeout: float = 600):
 @pytest.fixture
 def fepen_cli():
     return run_fepen
+
+
+#: the longest files and tests of a fresh clone (cold mesh cache, 2 workers; seconds, rounded), longest first.
+#: A module's tests stay together, so that its module-scoped runs are made once; a listed test moves to the
+#: front of its module only where the module has no module-scoped fixture.
+SLOW_MODULES = {
+    "tests/system/test_mesh.py": 400, "tests/system/test_resume.py": 200, "tests/system/test_rigid.py": 190,
+    "tests/system/test_demos.py": 170, "tests/system/test_faults.py": 160, "tests/system/test_api_runs.py": 135,
+    "tests/system/test_interface.py": 130, "tests/system/test_hard_cases.py": 100,
+    "tests/system/test_paraview.py": 90, "tests/system/test_charge.py": 60,
+    "tests/system/test_calibration_minimum.py": 45, "tests/unit/solver/test_explicit.py": 120,
+    "tests/unit/post/test_figures.py": 50, "tests/unit/test_bootstrap.py": 20,
+}
+SLOW_TESTS = {
+    "tests/system/test_mesh.py::test_default_mass_at_every_size[1.2]": 150,
+    "tests/system/test_mesh.py::test_mesh_json_quality[1.2]": 149,  # reads the mesh the one above made
+    "tests/system/test_mesh.py::test_charge_is_its_own_volume": 70,
+    "tests/system/test_mesh.py::test_split_wall_gives_the_charge_its_own_surface[self]": 50,
+    "tests/system/test_resume.py::test_killed_run_resumes_to_the_same_results[2-worn]": 85,
+    "tests/system/test_resume.py::test_killed_run_resumes_to_the_same_results[2]": 50,
+    "tests/system/test_resume.py::test_killed_run_resumes_to_the_same_results[2-charged]": 45,
+    "tests/system/test_demos.py::test_hard_cases_demo": 60,
+    "tests/system/test_demos.py::test_charge_demo_tied_against_frictional": 36,
+    "tests/system/test_interface.py::test_uniformly_decelerated_charge_loads_the_shell_with_its_inertia[2]": 110,
+    "tests/unit/solver/test_explicit.py::test_isochoric_plastic_flow_locking[plain-tet]": 66,
+}
+
+
+def pytest_collection_modifyitems(session, config, items):
+    """Longest first: modules by SLOW_MODULES, tests within a module by SLOW_TESTS (a stable sort: the rest
+    keep their order). The order is the same on every xdist worker, as xdist requires."""
+    def cost(item):
+        module = item.nodeid.split("::", 1)[0]
+        return -SLOW_MODULES.get(module, 0), module, -SLOW_TESTS.get(item.nodeid, 0)
+
+    items.sort(key=cost)

@@ -88,12 +88,24 @@ class _MeshBar:
 
 
 def _code_hash() -> str:
-    """Hash of the source that shapes meshes: a change to it rebuilds cached meshes."""
+    """Hash of the source that shapes meshes: a change to it rebuilds cached meshes. The modules whose code
+    decides the .msh a key stands for: gmsh_model (the model, the options, the seeds), shape and profile (the
+    exact outline gmsh revolves: a changed arc or point of profile.py changes the mesh of the same shape record),
+    tetra (the shortest altitude that picks the best seed), cad (a STEP body's import and its tracked ends),
+    checks (run on every cavity length the mass sizing tries), and of this module the mass sizing itself
+    (_build_on_root, _gmsh_mass and MASS_TOLERANCE: the cavity length the entry is cut to). mass_rule.py is
+    not needed: it only chooses the shape passed in, and that shape's whole record is in the key (_key)."""
+    import inspect
+
+    from fepen.geometry import cad, checks, profile, tetra
     from fepen.geometry import shape as _shape
 
     h = hashlib.sha256()
-    for mod in (gmsh_model, _shape):
+    for mod in (gmsh_model, _shape, profile, tetra, cad, checks):
         h.update(Path(mod.__file__).read_bytes())
+    for fn in (_build_on_root, _gmsh_mass):
+        h.update(inspect.getsource(fn).encode())
+    h.update(repr(MASS_TOLERANCE).encode())
     return h.hexdigest()[:12]
 
 
