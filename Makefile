@@ -3,10 +3,8 @@
 #               concrete target, default mesh) on $(NP) ranks into results/C3, the same shot with the rigid
 #               projectile into results/C3-rigid, and the mesh with its picture into results/C3-mesh
 #   make test   installs what is missing, lints, runs the fast unit lane and the system tests on $(WORKERS)
-#               pytest-xdist workers each, then the system tests that start 2-rank MPI runs (marked ranks2 by
-#               tests/conftest.py) one at a time, so that each run's two ranks have the two cores, then the MPI
-#               ones (marked mpi) on 2 ranks; the serial lanes leave the mpi-marked tests to that last lane (on
-#               one rank their two runs would be one run twice)
+#               pytest-xdist workers each, then the MPI ones (marked mpi) on 2 ranks; the serial lanes leave the
+#               mpi-marked tests to that last lane (on one rank their two runs would be one run twice)
 PY := .venv/bin/python
 NP ?= 2
 # the unit and system lanes' pytest-xdist workers (one per core; tests in one xdist_group share a worker)
@@ -41,9 +39,8 @@ TEST_MESHES ?= $(HOME)/.cache/fepen/test-meshes
 test: setup
 	$(PY) -m ruff check --no-cache fepen tests demos benchmarks tools
 	FEPEN_MESH_CACHE=$${FEPEN_MESH_CACHE:-$(TEST_MESHES)} $(PY) -m pytest -q -m "not mpi" -n $(WORKERS) tests/unit
-	FEPEN_MESH_CACHE=$${FEPEN_MESH_CACHE:-$(TEST_MESHES)} $(PY) -m pytest -q -m "not mpi and not ranks2" \
-	  -n $(WORKERS) --dist loadgroup tests/system
-	FEPEN_MESH_CACHE=$${FEPEN_MESH_CACHE:-$(TEST_MESHES)} $(PY) -m pytest -q -m "ranks2 and not mpi" tests/system
+	FEPEN_MESH_CACHE=$${FEPEN_MESH_CACHE:-$(TEST_MESHES)} $(PY) -m pytest -q -m "not mpi" -n $(WORKERS) \
+	  --dist loadgroup tests/system
 	FEPEN_MESH_CACHE=$${FEPEN_MESH_CACHE:-$(TEST_MESHES)} mpirun -n $(NP) $(PY) -m pytest -q -m mpi \
 	  -p no:cacheprovider tests
 

@@ -54,27 +54,6 @@ SLOW_TESTS = {
 }
 
 
-#: modules whose runs are mostly MPI subprocesses on 2 ranks, with module-scoped runs on both counts: the
-#: two-rank lane takes them whole (so those runs are still made once)
-TWO_RANK_MODULES = {"tests/system/test_faults.py", "tests/system/test_resume.py", "tests/system/test_interface.py",
-                    "tests/system/test_paraview.py"}
-#: further tests that start a 2-rank MPI subprocess (besides those parametrized with ranks = 2)
-TWO_RANK_TESTS = {"tests/system/test_demos.py::test_hard_cases_demo",
-                  "tests/system/test_demos.py::test_charge_demo_tied_against_frictional",
-                  "tests/system/test_sweep.py::test_deformable_shots_on_groups_of_one_and_two_ranks"}
-
-
-def two_rank(item) -> bool:
-    """Whether a test starts 2-rank MPI subprocesses (marked ``ranks2``: make test runs them in a lane of their
-    own, one at a time, so that each run's two ranks have the two cores instead of sharing them with the other
-    pytest-xdist worker's run)."""
-    module = item.nodeid.split("::", 1)[0]
-    if module in TWO_RANK_MODULES or item.nodeid in TWO_RANK_TESTS:
-        return True
-    callspec = getattr(item, "callspec", None)
-    return callspec is not None and callspec.params.get("ranks") == 2 and module.startswith("tests/system/")
-
-
 def pytest_collection_modifyitems(session, config, items):
     """Longest first: modules by SLOW_MODULES, tests within a module by SLOW_TESTS (a stable sort: the rest
     keep their order). The order is the same on every xdist worker, as xdist requires."""
@@ -83,6 +62,3 @@ def pytest_collection_modifyitems(session, config, items):
         return -SLOW_MODULES.get(module, 0), module, -SLOW_TESTS.get(item.nodeid, 0)
 
     items.sort(key=cost)
-    for item in items:
-        if two_rank(item):
-            item.add_marker(pytest.mark.ranks2)
