@@ -28,6 +28,24 @@ def fepen_cli():
     return run_fepen
 
 
+def check_bad_input_line(code: int, err: str, key: str, words: str) -> None:
+    """Bad input's contract: exit code 2 and one line on stderr, "fepen: bad input: KEY: ..." whose message
+    matches the regular expression ``words``."""
+    import re
+
+    lines = err.splitlines()
+    assert code == 2 and len(lines) == 1, (code, err)
+    prefix = f"fepen: bad input: {key}: "
+    assert lines[0].startswith(prefix), lines[0]
+    assert re.search(words, lines[0][len(prefix):]), lines[0]
+
+
+@pytest.fixture
+def bad_input_line():
+    """check_bad_input_line, for the tests of every command's bad input."""
+    return check_bad_input_line
+
+
 #: the longest files and tests of a fresh clone (cold mesh cache, 2 workers; seconds, rounded), longest first.
 #: A module's tests stay together, so that its module-scoped runs are made once; a listed test moves to the
 #: front of its module only where the module has no module-scoped fixture.

@@ -29,8 +29,8 @@ from mpi4py import MPI
 
 from fepen.errors import InputError, SimulationError
 
-__all__ = ["execute", "run_shot", "run_shots", "read_records", "check_directory", "check_ranks_per_shot", "RECORDS",
-           "BATCH", "chunks"]
+__all__ = ["execute", "run_shot", "run_shots", "read_records", "check_directory", "other_study",
+           "check_ranks_per_shot", "RECORDS", "BATCH", "chunks"]
 
 RECORDS = "shots.jsonl"
 _REQUEST, _REPLY = 7101, 7102
@@ -69,13 +69,19 @@ def check_directory(out: Path, digest: str, fresh: bool) -> tuple | None:
         if (out / "shots").is_dir():
             shutil.rmtree(out / "shots")
         return None
+    return other_study(out, meta, digest, "sweep")
+
+
+def other_study(out: Path, meta: Path, digest: str, what: str) -> tuple | None:
+    """The (key, message) of an InputError when ``meta`` (a study's record in OUT) holds another digest than
+    ``digest``, else None (no record, or the same study: resumable)."""
     if meta.is_file():
         try:
             old = json.loads(meta.read_text()).get("digest")
         except (OSError, ValueError):
             old = None
         if old != digest:
-            return ("--out", f"{out} holds the results of another sweep: give a new --out, or --fresh to "
+            return ("--out", f"{out} holds the results of another {what}: give a new --out, or --fresh to "
                              "replace them")
     return None
 

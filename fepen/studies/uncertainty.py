@@ -567,16 +567,11 @@ def _check_out(out: Path, digest: str, fresh: bool):
     """None when OUT is new, holds this study (resumable) or fresh; else (key, message) of an InputError."""
     if out.exists() and not out.is_dir():
         return ("--out", f"{out} is a file, not a results directory")
-    meta = out / "uncertainty_input.json"
-    if meta.is_file() and not fresh:
-        try:
-            old = json.loads(meta.read_text()).get("digest")
-        except (OSError, ValueError):
-            old = None
-        if old != digest:
-            return ("--out", f"{out} holds the results of another uncertainty study: give a new --out, or --fresh "
-                             "to replace them")
-    return None
+    if fresh:
+        return None
+    from fepen.studies import engine
+
+    return engine.other_study(out, out / "uncertainty_input.json", digest, "uncertainty study")
 
 
 def _depths(out: Path, combined, inputs, sc) -> dict:

@@ -5,7 +5,6 @@ to SCENE (None: no file), the key the line names, a regex the rest of the line m
 stands for the scene file's path; the working directory is an empty temporary one.
 """
 
-import re
 
 import pytest
 
@@ -231,17 +230,13 @@ def nothing_runs(tmp_path, monkeypatch):
 
 
 @pytest.mark.parametrize("argv, text, key, words", CASES)
-def test_bad_input_is_one_line_and_exit_2(nothing_runs, capsys, argv, text, key, words):
+def test_bad_input_is_one_line_and_exit_2(nothing_runs, capsys, bad_input_line, argv, text, key, words):
     scene = nothing_runs / "scene.toml"
     if text is not None:
         scene.write_bytes(text if isinstance(text, bytes) else text.encode())
     code = cli.main([str(scene) if a == "SCENE" else a for a in argv])
     captured = capsys.readouterr()
-    lines = captured.err.splitlines()
-    assert code == 2 and len(lines) == 1, (code, captured.err)
-    prefix = f"fepen: bad input: {key}: "
-    assert lines[0].startswith(prefix), lines[0]
-    assert re.search(words, lines[0][len(prefix):]), lines[0]
+    bad_input_line(code, captured.err, key, words)
     assert captured.out == "" and sorted(p.name for p in nothing_runs.iterdir()) == (["scene.toml"] if text is not
                                                                                       None else [])
 

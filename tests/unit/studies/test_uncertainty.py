@@ -3,7 +3,6 @@ published values, the importance reweighting against a conditional probability k
 model's draws against the model's moments, and bad options answered in one line with exit 2 before any shot."""
 
 import math
-import re
 
 import numpy as np
 import pytest
@@ -128,7 +127,7 @@ UNC = ["study", "uncertainty", "--out", "out", "--set", "effects.fidelity=rigid"
     (["study", "uncertainty", "--set", "effects.fidelity=plastic", "--no-model-scatter"], None,
      "--no-model-scatter", r"nothing would vary"),
 ])
-def test_bad_options_are_one_line_and_exit_2(tmp_path, monkeypatch, capsys, argv, text, key, words):
+def test_bad_options_are_one_line_and_exit_2(tmp_path, monkeypatch, capsys, bad_input_line, argv, text, key, words):
     from fepen.studies import engine
 
     def ran(*args, **kwargs):
@@ -140,12 +139,7 @@ def test_bad_options_are_one_line_and_exit_2(tmp_path, monkeypatch, capsys, argv
     if text is not None:
         (tmp_path / "sweep.toml").write_text(text)
     code = cli.main([str(tmp_path / "sweep.toml") if a == "SWEEP" else a for a in argv])
-    captured = capsys.readouterr()
-    lines = captured.err.splitlines()
-    assert code == 2 and len(lines) == 1, (code, captured.err)
-    prefix = f"fepen: bad input: {key}: "
-    assert lines[0].startswith(prefix), lines[0]
-    assert re.search(words, lines[0][len(prefix):]), lines[0]
+    bad_input_line(code, capsys.readouterr().err, key, words)
     assert not (tmp_path / "out").exists()
 
 
