@@ -427,10 +427,9 @@ def split_wall(n_nodes, cells, cell_values, facets, facet_values):
 def _model_to_mesh(comm, split: bool):
     """dolfinx.io.gmshio.model_to_mesh for tetrahedra, distributed with band_partitioner, the wall split
     when asked (split_wall). Returns (mesh, cell tags, facet tags)."""
-    from dolfinx import cpp as _cpp
-    from dolfinx.io import gmshio
-    from dolfinx.mesh import meshtags_from_entities
+    from fepen import dolfinx_api as dx
 
+    gmshio = dx.gmsh_io()
     TET, TRI = 4, 2  # gmsh element types
     links = None  # rank 0, a split wall: extra links between cells for the partitioner
     if comm.rank == 0:
@@ -438,7 +437,7 @@ def _model_to_mesh(comm, split: bool):
 
         model = gmsh.model
         x = gmshio.extract_geometry(model)
-        topo = gmshio.extract_topology_and_markers(model)
+        topo = dx.gmsh_topology(model)
         cells = np.asarray(topo[TET]["topology"], dtype=np.int64)
         cell_values = np.asarray(topo[TET]["cell_data"], dtype=np.int32)
         facets = np.asarray(topo[TRI]["topology"], dtype=np.int64)
@@ -464,19 +463,15 @@ def _model_to_mesh(comm, split: bool):
         cell_values = np.zeros(0, dtype=np.int32)
         facets = np.zeros((0, 3), dtype=np.int64)
         facet_values = np.zeros(0, dtype=np.int32)
-    domain = gmshio.ufl_mesh(TET, 3)
-    cells = cells[:, gmshio.cell_perm_array(_cpp.mesh.CellType.tetrahedron, 4)]
+    cells = cells[:, dx.cell_perm("tetrahedron", 4)]
     partitioner = functools.partial(band_partitioner, extra_links=links)
-    mesh = gmshio.create_mesh(comm, cells, x, domain, partitioner=_cpp.mesh.create_cell_partitioner(partitioner))
+    mesh = dx.tet_mesh(comm, cells, x, partitioner)
     tdim = 3
-    local, values = _cpp.io.distribute_entity_data(mesh._mesh, tdim, cells, cell_values)
-    mesh.topology.create_connectivity(tdim, 0)
-    ct = meshtags_from_entities(mesh, tdim, _cpp.graph.AdjacencyList_int32(local), values.astype(np.int32))
+    ct = dx.entity_tags(mesh, tdim, cells, cell_values)
     ct.name = "Cell tags"
-    facets = facets[:, gmshio.cell_perm_array(_cpp.mesh.CellType.triangle, 3)]
-    local, values = _cpp.io.distribute_entity_data(mesh._mesh, tdim - 1, facets, facet_values)
+    facets = facets[:, dx.cell_perm("triangle", 3)]
     mesh.topology.create_connectivity(tdim - 1, tdim)
-    ft = meshtags_from_entities(mesh, tdim - 1, _cpp.graph.AdjacencyList_int32(local), values.astype(np.int32))
+    ft = dx.entity_tags(mesh, tdim - 1, facets, facet_values)
     ft.name = "Facet tags"
     return mesh, ct, ft
 
@@ -500,9 +495,10 @@ def band_partitioner(comm, nparts: int, graph, ghosting: bool, extra_links=None)
     Returns:
         AdjacencyList_int32: per local row, the owner rank then the ghost ranks.
     """
-    from dolfinx import cpp as _cpp
     from scipy.sparse import csr_matrix
     from scipy.sparse.csgraph import breadth_first_order
+
+    from fepen import dolfinx_api as dx
 
     offsets = np.asarray(graph.offsets, dtype=np.int64)
     array = np.asarray(graph.array, dtype=np.int64)
@@ -538,13 +534,15 @@ def band_partitioner(comm, nparts: int, graph, ghosting: bool, extra_links=None)
             dest.append((np.array(data, dtype=np.int32), np.array(offs, dtype=np.int32)))
             lo += size
     data, offs = comm.scatter(dest, root=0)
-    return _cpp.graph.AdjacencyList_int32(data, offs)
+    return dx.adjacency_int32(data, offs)
 
 
 def cell_points(mesh) -> np.ndarray:
     """Node coordinates of the locally owned cells, shape (n_owned, 4, 3)."""
     n = mesh.topology.index_map(mesh.topology.dim).size_local
-    dofs = mesh.geometry.dofmap.array.reshape(-1, 4)[:n]
+    from fepen import dolfinx_api as dx
+
+    dofs = dx.geometry_dofs(mesh)[:n]
     return mesh.geometry.x[dofs]
 
 

@@ -8,9 +8,9 @@ from __future__ import annotations
 from dataclasses import dataclass
 
 import numpy as np
-from dolfinx import cpp as _cpp
 from mpi4py import MPI
 
+from fepen import dolfinx_api as dx
 from fepen.laws import energy
 from fepen.laws import materials as M
 from fepen.solver import assembly, kernels
@@ -271,4 +271,4 @@ def axial_stress(solver, axis: np.ndarray) -> np.ndarray:
 def assemble_form(solver, out: np.ndarray) -> None:
     """The solver's internal force through dolfinx: the compiled form assembled into ``out`` (the flat array
     of a V function, zeroed by the caller), no ghost sum (the reference, and the benchmarks' floor)."""
-    _cpp.fem.assemble_vector(out, solver.form, solver._consts, solver._coeffs)
+    dx.assemble_into(out, solver.form, solver._consts, solver._coeffs)

@@ -10,11 +10,11 @@ from typing import Protocol
 
 import numpy as np
 import ufl
-from dolfinx import cpp as _cpp
-from dolfinx import fem, la
+from dolfinx import fem
 from dolfinx import log as _log
 from mpi4py import MPI
 
+from fepen import dolfinx_api as dx
 from fepen.errors import SimulationError
 from fepen.laws import materials as M
 from fepen.solver import assembly, ckernel, failures, kernels, reference
@@ -128,7 +128,7 @@ class ExplicitSolver:
         (their force is zero, their velocity held at zero)."""
         materials = self.materials
         rho = np.array([m.density for m in materials])[self.mat]
-        mvec = la.vector(imap, bs=nm)
+        mvec = dx.new_vector(imap, bs=nm)
         arr = mvec.array.reshape(-1, nm)
         _per_material_to_nodes(self, 0.25 * rho * self.vol0, mvec)
         self.mass_by_material = arr[: self.n_nodes].copy()
@@ -144,7 +144,7 @@ class ExplicitSolver:
 
     # ------------------------------------------------------------------------------------------------
     def _ghost_sum(self, vec) -> None:
-        vec.scatter_reverse(la.ScatterMode.add)
+        dx.scatter_reverse_add(vec)
         vec.scatter_forward()
 
     def _volumes_to_nodes(self, cvol: np.ndarray, vec) -> None:
@@ -164,7 +164,7 @@ class ExplicitSolver:
             self._nodes.scatter_forces(self._cells._dofs, Fc, self.force_quantum, out)
         else:
             kernels.grid_scatter(self.dofs, self.mat, Fc, True, self.force_quantum, out)
-        self.fint_fn.x.scatter_reverse(la.ScatterMode.add)
+        dx.scatter_reverse_add(self.fint_fn.x)
 
     def positions(self) -> np.ndarray:
         """Current node positions (n_nodes, 3), ghosts included."""
@@ -498,21 +498,21 @@ def _per_material_to_nodes(s: ExplicitSolver, cell_values: np.ndarray, vec) -> N
 
 def _reference_body(s: ExplicitSolver, mesh) -> None:
     """The function spaces, the node and cell numbering, the reference positions and gradients."""
-    V = fem.VectorFunctionSpace(mesh, ("CG", 1))
-    Q = fem.TensorFunctionSpace(mesh, ("DG", 0))
+    V = dx.vector_space(mesh)
+    Q = dx.tensor_dg0_space(mesh)
     s.V, s.Q = V, Q
     imap = V.dofmap.index_map
     s.n_owned = imap.size_local
     s.n_nodes = imap.size_local + imap.num_ghosts
     n_cells = mesh.topology.index_map(mesh.topology.dim).size_local
     s.n_cells = n_cells
-    s.dofs = np.ascontiguousarray(V.dofmap.list.array.reshape(-1, 4)[:n_cells]).astype(np.int64)
+    s.dofs = np.ascontiguousarray(dx.cell_dofs(V)[:n_cells]).astype(np.int64)
     s.X = V.tabulate_dof_coordinates()[: s.n_nodes].copy()
     s.X0 = s.X.copy()  # X moves only where a surface recedes (fepen.solver.recession)
     # the mesh geometry's node of each dof, so that a moved reference reaches the assembled form
-    gdofs = mesh.geometry.dofmap.array.reshape(-1, 4)
+    gdofs = dx.geometry_dofs(mesh)
     s._geometry_node = np.zeros(s.n_nodes, dtype=np.int64)
-    s._geometry_node[V.dofmap.list.array.reshape(-1, 4).ravel()] = gdofs.ravel()
+    s._geometry_node[dx.cell_dofs(V).ravel()] = gdofs.ravel()
     s.geometry_x = mesh.geometry.x
     assert np.allclose(s.geometry_x[s._geometry_node, :3], s.X)
     s.X[:] = s.geometry_x[s._geometry_node, :3]  # the mesh's own numbers (tabulated ones may differ in
@@ -589,8 +589,8 @@ def _nodal_arrays(s: ExplicitSolver, V, imap, nm: int) -> None:
     s._du = np.zeros_like(s.fint)  # the displacement increment of the step (for the work of the forces)
     s.fixed = None  # (n_nodes, 3) bool: velocity components held at zero (symmetry planes)
     s.fext = np.zeros((s.n_nodes, 3))
-    s._nvol = la.vector(imap, bs=nm)
-    s._nvol0 = la.vector(imap, bs=nm)
+    s._nvol = dx.new_vector(imap, bs=nm)
+    s._nvol0 = dx.new_vector(imap, bs=nm)
     s.nodal_vol = s._nvol.array.reshape(-1, nm)
     s.nodal_vol0 = s._nvol0.array.reshape(-1, nm)
     s.nodal_p = np.zeros_like(s.nodal_vol0)
@@ -604,8 +604,7 @@ def _internal_force_form(s: ExplicitSolver, V, Q) -> None:
     s.P = fem.Function(Q, name="P")
     w = ufl.TestFunction(V)
     s.form = fem.form(ufl.inner(s.P, ufl.grad(w)) * ufl.dx)
-    s._consts = _cpp.fem.pack_constants(s.form)
-    s._coeffs = _cpp.fem.pack_coefficients(s.form)
+    s._consts, s._coeffs = dx.pack(s.form)
     key = next(iter(s._coeffs))
     s.P_packed = s._coeffs[key]
     assert s.P_packed.shape[1] == 9 and s.P_packed.shape[0] >= n_cells

@@ -24,10 +24,10 @@ from __future__ import annotations
 import numba
 import numpy as np
 import scipy.sparse as sp
-from dolfinx import la
 from dolfinx import mesh as dmesh
 from mpi4py import MPI
 
+from fepen import dolfinx_api as dx
 from fepen.laws import wear
 from fepen.solver import assembly, reference
 
@@ -55,8 +55,8 @@ class Recession:
         self.mu, self.efficiency, self.enthalpy, self.density = mu, efficiency, enthalpy, density
         self.every, self.layers = every, layers
         imap = solver.V.dofmap.index_map
-        self._vec3 = la.vector(imap, bs=3)
-        self._vec1 = la.vector(imap, bs=1)
+        self._vec3 = dx.new_vector(imap, bs=3)
+        self._vec1 = dx.new_vector(imap, bs=1)
         self.heat_nodes = np.zeros(solver.n_nodes)  # heat since the last application (J), this rank's facets
         self.heat_total = 0.0  # this rank's heat so far (J)
         # the heat since the last application, summed exactly (the contraction's: the same on any partition)
@@ -121,7 +121,7 @@ class Recession:
         """The sum over ranks of a nodal array (n_nodes, k), ghosts consistent."""
         arr = vec.array.reshape(len(values), -1)
         arr[:] = values.reshape(len(values), -1)
-        vec.scatter_reverse(la.ScatterMode.add)
+        dx.scatter_reverse_add(vec)
         vec.scatter_forward()
         return arr.reshape(values.shape).copy()
 
@@ -138,7 +138,7 @@ class Recession:
         f2v = mesh.topology.connectivity(tdim - 1, 0)
         c2v = mesh.topology.connectivity(tdim, 0).array.reshape(-1, 4)
         v2d = np.full(c2v.max() + 1, -1, dtype=np.int64)
-        v2d[c2v.ravel()] = s.V.dofmap.list.array.reshape(-1, 4).ravel()
+        v2d[c2v.ravel()] = dx.cell_dofs(s.V).ravel()
         flag = np.zeros(s.n_nodes)
         for f in facets:
             flag[v2d[f2v.links(f)]] = 1.0

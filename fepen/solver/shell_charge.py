@@ -26,23 +26,22 @@ class ShellChargeContact:
     """
 
     def __init__(self, solver, facet_tags, friction: float):
-        from dolfinx import la
-
+        from fepen import dolfinx_api as dx
         from fepen.errors import SimulationError
         from fepen.solver.surface import oriented_facets
 
         self.solver, self.mu = solver, float(friction)
         s = solver
         self.tri = oriented_facets(s.V, facet_tags, tags.CHARGE_FACE)
-        self._nvec = la.vector(s.V.dofmap.index_map, bs=3)
+        self._nvec = dx.new_vector(s.V.dofmap.index_map, bs=3)
         self.nodal_n = self._nvec.array.reshape(-1, 3)
         self._facet_n = np.zeros((len(self.tri), 3))
         self._wall_sum = assembly.NodalSum(s.comm, s.V.dofmap.index_map, self.tri,
                                            assembly.input_keys(self.tri, s.input_index))
         # wall nodes: those of the owned wall facets, marked and ghost-summed
-        mark = la.vector(s.V.dofmap.index_map, bs=1)
+        mark = dx.new_vector(s.V.dofmap.index_map, bs=1)
         mark.array[np.unique(self.tri)] = 1.0
-        mark.scatter_reverse(la.ScatterMode.add)
+        dx.scatter_reverse_add(mark)
         mark.scatter_forward()
         charge_wall = np.flatnonzero(mark.array[: s.n_nodes] > 0.0)
         # their twins: the local shell node at the same reference place (to round-off: the dof

@@ -11,6 +11,7 @@ import numba
 import numpy as np
 from mpi4py import MPI
 
+from fepen import dolfinx_api as dx
 from fepen.geometry import projection, tags
 from fepen.geometry.cad import CadBody
 
@@ -258,7 +259,7 @@ def node_positions(V) -> np.ndarray:
     mesh = V.mesh
     imap = V.dofmap.index_map
     geometry_node = np.zeros(imap.size_local + imap.num_ghosts, dtype=np.int64)
-    geometry_node[V.dofmap.list.array] = mesh.geometry.dofmap.array
+    geometry_node[dx.cell_dofs(V).ravel()] = dx.geometry_dofs(mesh).ravel()
     return mesh.geometry.x[geometry_node, :3].copy()
 
 
@@ -281,7 +282,7 @@ def oriented_facets(V, facet_tags, tag: int, with_cells: bool = False):
     f2c = mesh.topology.connectivity(tdim - 1, tdim)
     f2v = mesh.topology.connectivity(tdim - 1, 0)
     c2v = mesh.topology.connectivity(tdim, 0).array.reshape(-1, 4)
-    cdofs = V.dofmap.list.array.reshape(-1, 4)
+    cdofs = dx.cell_dofs(V)
     v2d = np.full(c2v.max() + 1, -1, dtype=np.int64)
     v2d[c2v.ravel()] = cdofs.ravel()
     imap = V.dofmap.index_map
@@ -298,7 +299,7 @@ def oriented_facets(V, facet_tags, tag: int, with_cells: bool = False):
             tri[i, [1, 2]] = tri[i, [2, 1]]
     # start each facet at its corner of the smallest input-mesh number (a turn: the orientation stays), so
     # that a facet's arithmetic (its centroid (x0 + x1 + x2) / 3, ...) is the same on any partition
-    gdofs = mesh.geometry.dofmap.array.reshape(-1, 4)
+    gdofs = dx.geometry_dofs(mesh)
     geometry_node = np.zeros(len(X), dtype=np.int64)
     geometry_node[cdofs.ravel()] = gdofs.ravel()
     first = np.argmin(np.asarray(mesh.geometry.input_global_indices, dtype=np.int64)[geometry_node][tri], axis=1)

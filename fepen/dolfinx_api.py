@@ -1,0 +1,170 @@
+"""The one place fepen touches dolfinx's API (issue 34): dolfinx 0.5.2 (Debian bookworm) and the current release
+(0.11), each call here in the form the running version takes, on public API where that version has it.
+
+Imported lazily (``import fepen`` loads no dolfinx). ``SUPPORTED`` names the versions fepen runs on;
+``check_version`` refuses any other in one line.
+"""
+
+from __future__ import annotations
+
+import functools
+
+import numpy as np
+
+__all__ = ["SUPPORTED", "version", "modern", "check_version", "gmsh_io", "gmsh_topology", "cell_perm", "tet_mesh",
+           "entity_tags", "adjacency_int32", "vector_space", "tensor_dg0_space", "cell_dofs", "geometry_dofs",
+           "new_vector",           "scatter_reverse_add", "pack", "assemble_into"]
+
+#: the dolfinx releases fepen is tested with (docs/install.md): (major, minor)
+SUPPORTED = ((0, 5), (0, 11))
+
+
+@functools.lru_cache(maxsize=1)
+def version() -> tuple:
+    """dolfinx's (major, minor, patch) as ints (a post-release suffix dropped)."""
+    import dolfinx
+
+    parts = dolfinx.__version__.split(".")[:3]
+    return tuple(int("".join(ch for ch in p if ch.isdigit()) or 0) for p in parts)
+
+
+def modern() -> bool:
+    """True for the current release's API (0.10 and later), False for 0.5."""
+    return version()[:2] >= (0, 10)
+
+
+def check_version() -> None:
+    """InputError (key "dolfinx") naming the supported releases when this dolfinx is not one of them."""
+    from fepen.errors import InputError
+
+    if version()[:2] not in SUPPORTED:
+        names = " and ".join(f"{a}.{b}" for a, b in SUPPORTED)
+        raise InputError("dolfinx", f"version {'.'.join(map(str, version()))} is not supported: fepen runs on "
+                                    f"dolfinx {names} (docs/install.md)")
+
+
+def gmsh_io():
+    """dolfinx's gmsh module: ``dolfinx.io.gmshio`` (0.5), ``dolfinx.io.gmsh`` (0.10 on)."""
+    if modern():
+        from dolfinx.io import gmsh as g
+    else:
+        from dolfinx.io import gmshio as g
+    return g
+
+
+def gmsh_topology(model) -> dict:
+    """{gmsh element type: {"topology", "cell_data"}} of the model's marked elements (0.11 returns the physical
+    groups beside it)."""
+    topo = gmsh_io().extract_topology_and_markers(model)
+    return topo[0] if isinstance(topo, tuple) else topo
+
+
+def cell_perm(name: str, nodes: int) -> list:
+    """The permutation from gmsh's node order to dolfinx's for a cell ("tetrahedron", "triangle")."""
+    from dolfinx import cpp
+
+    return gmsh_io().cell_perm_array(getattr(cpp.mesh.CellType, name), nodes)
+
+
+def tet_mesh(comm, cells: np.ndarray, x: np.ndarray, partitioner):
+    """A distributed mesh of linear tetrahedra from rank 0's cells (dolfinx order) and nodes.
+
+    Args:
+        comm: the communicator. cells, x: the cells (n, 4, int64) and node coordinates (m, 3) (empty on the
+            other ranks). partitioner: a graph partitioner (comm, nparts, graph, ghosting) -> AdjacencyList_int32.
+    """
+    from dolfinx import cpp
+
+    if modern():
+        from dolfinx import mesh as dmesh
+
+        domain = gmsh_io().ufl_mesh(4, 3, np.float64)
+        part = dmesh.create_cell_partitioner(partitioner, dmesh.GhostMode.none, 2)
+        return dmesh.create_mesh(comm, cells, domain, x, partitioner=part)
+    g = gmsh_io()
+    return g.create_mesh(comm, cells, x, g.ufl_mesh(4, 3), partitioner=cpp.mesh.create_cell_partitioner(partitioner))
+
+
+def entity_tags(mesh, dim: int, entities: np.ndarray, values: np.ndarray):
+    """MeshTags of dimension ``dim`` from rank 0's entities (by input node index) and their values."""
+    from dolfinx.mesh import meshtags_from_entities
+
+    if modern():
+        from dolfinx import graph, io
+
+        local, vals = io.distribute_entity_data(mesh, dim, entities, values)
+        mesh.topology.create_connectivity(dim, 0)
+        return meshtags_from_entities(mesh, dim, graph.adjacencylist(local), vals.astype(np.int32))
+    from dolfinx import cpp
+
+    local, vals = cpp.io.distribute_entity_data(mesh._mesh, dim, entities, values)
+    mesh.topology.create_connectivity(dim, 0)
+    return meshtags_from_entities(mesh, dim, cpp.graph.AdjacencyList_int32(local), vals.astype(np.int32))
+
+
+def adjacency_int32(data: np.ndarray, offsets: np.ndarray):
+    """The C++ AdjacencyList_int32 a partitioner returns."""
+    from dolfinx import cpp
+
+    return cpp.graph.AdjacencyList_int32(np.asarray(data, dtype=np.int32), np.asarray(offsets, dtype=np.int32))
+
+
+def vector_space(mesh):
+    """Continuous piecewise-linear vectors (3 components)."""
+    from dolfinx import fem
+
+    if modern():
+        return fem.functionspace(mesh, ("Lagrange", 1, (3,)))
+    return fem.VectorFunctionSpace(mesh, ("CG", 1))
+
+
+def tensor_dg0_space(mesh):
+    """Piecewise-constant 3x3 tensors."""
+    from dolfinx import fem
+
+    if modern():
+        return fem.functionspace(mesh, ("DG", 0, (3, 3)))
+    return fem.TensorFunctionSpace(mesh, ("DG", 0))
+
+
+def cell_dofs(V) -> np.ndarray:
+    """The cells' dofs (blocks), shape (cells, 4)."""
+    if modern():
+        return np.asarray(V.dofmaps(0).list if callable(getattr(V, "dofmaps", None)) else V.dofmap.list)
+    return V.dofmap.list.array.reshape(-1, 4)
+
+
+def geometry_dofs(mesh) -> np.ndarray:
+    """The cells' geometry nodes, shape (cells, 4)."""
+    if modern():
+        return np.asarray(mesh.geometry.dofmap)
+    return mesh.geometry.dofmap.array.reshape(-1, 4)
+
+
+def new_vector(index_map, bs: int):
+    """A distributed vector over an index map, block size bs."""
+    from dolfinx import la
+
+    return la.vector(index_map, bs=bs)
+
+
+def scatter_reverse_add(vec) -> None:
+    """Ghost contributions added to their owners."""
+    from dolfinx import la
+
+    vec.scatter_reverse(la.InsertMode.add if modern() else la.ScatterMode.add)
+
+
+def pack(form) -> tuple:
+    """(constants, coefficients) of a compiled form, packed (the coefficients' arrays are rewritten in place)."""
+    from dolfinx import cpp
+
+    f = getattr(form, "_cpp_object", form)
+    return cpp.fem.pack_constants(f), cpp.fem.pack_coefficients(f)
+
+
+def assemble_into(out: np.ndarray, form, constants, coefficients) -> None:
+    """The compiled vector form assembled into the flat array ``out`` (its packed constants and coefficients)."""
+    from dolfinx import cpp
+
+    cpp.fem.assemble_vector(out, getattr(form, "_cpp_object", form), constants, coefficients)
