@@ -255,6 +255,9 @@ def mesh(scene, out, comm=None, force: bool = False) -> dict:
     out = Path(out)
     if not force:
         _refuse_run_directory(out, comm)
+    from fepen import dolfinx_api
+
+    dolfinx_api.check_version()  # before anything is written
     setup.announce(sc, comm)  # geometry errors before anything is written
     pm = setup.mesh(sc, comm)
     info = setup.mesh_metrics(pm, sc)

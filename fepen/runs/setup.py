@@ -311,6 +311,10 @@ def check_supported(scene, built: Built | None = None) -> Built:
         The built projectile.
     """
     built = built or projectile(scene)
+    if scene.effects.fidelity != "rigid" or scene.get("mesh.rigid_panel") is not None:
+        from fepen import dolfinx_api
+
+        dolfinx_api.check_version()  # a mesh is made: only on the dolfinx releases fepen supports
     if scene.effects.fidelity == "rigid" and scene.target.kind != "concrete":
         raise InputError("effects.fidelity", "'rigid' runs against target.kind = 'concrete'; a rigid "
                                              "projectile on a rigid wall has nothing to compute")
