@@ -11,9 +11,9 @@ import functools
 
 import numpy as np
 
-__all__ = ["SUPPORTED", "version", "modern", "check_version", "gmsh_io", "gmsh_topology", "cell_perm", "tet_mesh",
-           "entity_tags", "adjacency_int32", "vector_space", "tensor_dg0_space", "cell_dofs", "geometry_dofs",
-           "new_vector",           "scatter_reverse_add", "pack", "assemble_into"]
+__all__ = ["SUPPORTED", "version", "modern", "check_version", "gmsh_io", "gmsh_topology", "model_to_mesh",
+           "cell_perm", "tet_mesh", "entity_tags", "adjacency_int32", "vector_space", "tensor_dg0_space", "cell_dofs",
+           "geometry_dofs", "new_vector", "scatter_reverse_add", "pack", "assemble_into"]
 
 #: the dolfinx releases fepen is tested with (docs/install.md): (major, minor)
 SUPPORTED = ((0, 5), (0, 11))
@@ -57,6 +57,12 @@ def gmsh_topology(model) -> dict:
     groups beside it)."""
     topo = gmsh_io().extract_topology_and_markers(model)
     return topo[0] if isinstance(topo, tuple) else topo
+
+
+def model_to_mesh(model, comm, rank: int = 0):
+    """dolfinx's own gmsh model to mesh (its default partitioner; for the tests' simple bodies): the mesh."""
+    out = gmsh_io().model_to_mesh(model, comm, rank, gdim=3)
+    return out.mesh if hasattr(out, "mesh") else out[0]
 
 
 def cell_perm(name: str, nodes: int) -> list:

@@ -5,9 +5,9 @@ import math
 
 import numpy as np
 import pytest
-from dolfinx import fem
 from mpi4py import MPI
 
+from fepen import dolfinx_api as dx
 from fepen import scene
 from fepen.geometry import mesh, revolution
 from fepen.io.results import COL
@@ -52,7 +52,7 @@ def test_nose_force_at_the_default_mesh(crh):
     force within 0.5 %; an unstructured mesh is not exactly symmetric: side force below 0.3 %."""
     sc = scene.load(None, [f"projectile.crh={crh}", *CLOSED_FORM])
     pm = setup.mesh(sc, MPI.COMM_SELF)
-    V = fem.VectorFunctionSpace(pm.mesh, ("CG", 1))
+    V = dx.vector_space(pm.mesh)
     g = surface.gather_global(surface.outer_surface(V, pm.facet_tags, pm.shape), MPI.COMM_SELF)
     law = setup.target_law(sc)
     for speed in (300.0, 900.0):

@@ -11,6 +11,7 @@ from hypothesis import given, settings
 from hypothesis import strategies as st
 from mpi4py import MPI
 
+from fepen import dolfinx_api as dx
 from fepen.solver import assembly as A
 
 
@@ -86,7 +87,7 @@ def test_nodal_sum_is_the_same_on_any_partition():
     def run(comm):
         m = dmesh.create_box(comm, [[0, 0, 0], [1, 1, 2]], [4, 4, 8], dmesh.CellType.tetrahedron)
         imap = m.geometry.index_map()
-        dofs = m.geometry.dofmap.array.reshape(-1, 4)[: m.topology.index_map(3).size_local].astype(np.int64)
+        dofs = dx.geometry_dofs(m)[: m.topology.index_map(3).size_local].astype(np.int64)
         inp = np.asarray(m.geometry.input_global_indices, dtype=np.int64)
         keys = A.input_keys(dofs, inp)
         vals = np.sin(keys[:, :, None] * np.array([0.37, 1.1, 2.3]) + keys.sum(axis=1)[:, None, None]) * 1e3

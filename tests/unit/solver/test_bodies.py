@@ -9,6 +9,7 @@ import numpy as np
 import pytest
 from mpi4py import MPI
 
+from fepen import dolfinx_api as dx
 from fepen import scene
 from fepen.laws import materials as M
 from fepen.runs import setup
@@ -27,7 +28,7 @@ def two_part_rod():
     pm = setup.mesh(sc, MPI.COMM_SELF)
     msh = pm.mesh
     n_cells = msh.topology.index_map(3).size_local
-    corners = msh.geometry.x[msh.geometry.dofmap.array.reshape(-1, 4)[:n_cells]]
+    corners = msh.geometry.x[dx.geometry_dofs(msh)[:n_cells]]
     cells = (corners[:, :, 1].mean(axis=1) > 0.5 * L).astype(np.int64)  # nose tip at y = 0, axis +y
     front = M.johnson_cook(COPPER["E"], COPPER["nu"], COPPER["density"], 90e6, 292e6, 0.31, 0.025, 1.09, 1356.0,
                            294.0, specific_heat=383.0)

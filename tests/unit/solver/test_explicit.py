@@ -106,7 +106,8 @@ def test_plastic_taylor_impact_closes_the_energy_balance():
 
 def hollow_sphere_octant(a0, b0, h, comm=MPI.COMM_SELF):
     import gmsh
-    from dolfinx.io import gmshio
+
+    from fepen import dolfinx_api as dx
 
     if comm.rank == 0:
         if not gmsh.isInitialized():
@@ -123,7 +124,7 @@ def hollow_sphere_octant(a0, b0, h, comm=MPI.COMM_SELF):
         gmsh.option.setNumber("Mesh.MeshSizeMin", h)
         gmsh.model.mesh.generate(3)
         gmsh.model.mesh.optimize("Netgen")
-    msh, _, _ = gmshio.model_to_mesh(gmsh.model if comm.rank == 0 else None, comm, 0, gdim=3)
+    msh = dx.model_to_mesh(gmsh.model if comm.rank == 0 else None, comm, 0)
     if comm.rank == 0:
         gmsh.clear()
     return msh
