@@ -13,7 +13,7 @@ import time
 import numpy as np
 from mpi4py import MPI
 
-from fepen.errors import Interrupted
+from fepen.errors import Interrupted, SimulationError
 from fepen.geometry import mesh as fmesh
 from fepen.geometry import revolution, tags
 from fepen.geometry.cad import CadBody
@@ -100,6 +100,10 @@ def default_body(sh: shot.Shot):
             _BODIES.clear()
         _BODIES[sh.body_key] = hit
     return hit
+
+
+#: the energy balance error (theory.md §6) beyond which a rigid run is unstable: a stable one stays under 1e-2
+UNSTABLE_ENERGY_ERROR = 0.1
 
 
 class RigidRun(Run):
@@ -223,9 +227,18 @@ class RigidRun(Run):
         return outcome
 
     def finish_loop(self) -> None:
-        """The final state's row, with the force at that state."""
+        """The final state's row, with the force at that state; a run whose energy balance has run away (the
+        target law only takes energy) stops with a SimulationError instead of reporting its numbers."""
         self.F = self.body.derivative(self.state, self.force_fn)[1]
         self.record()
+        removed = self.wear.kinetic_removed if self.wear is not None else 0.0
+        err = energy.balance_error(self.body.kinetic_energy(self.state), self.ke0, self.w_ext, removed_kinetic=removed)
+        if not err <= UNSTABLE_ENERGY_ERROR:
+            tip = self.body.to_world(self.state, self.tip_ref[None])[0]
+            raise SimulationError(f"the rigid body's motion ran away: energy balance error {err:.3g} (over "
+                                  f"{UNSTABLE_ENERGY_ERROR:g}) at t = {self.t * 1e6:.1f} us, step {self.step_count}, "
+                                  f"nose at ({tip[0] * 1e3:.4g}, {tip[1] * 1e3:.4g}) mm: the step is too long for "
+                                  "this shot (run.rigid_step)")
 
     def snapshot(self) -> Snapshot:
         s, body = self.state, self.body

@@ -178,3 +178,15 @@ def test_chunks_share_the_end_between_groups():
     assert [i for r in runs for i in r] == list(range(1000)) and max(map(len, runs)) == 32
     assert max(map(len, engine.chunks(list(range(10)), 32, 2))) == 2
     assert engine.chunks([], 32, 2) == []
+
+
+def test_a_runaway_is_stopped_not_reported(monkeypatch):
+    """A rigid run whose energy balance runs away (here: the guard lowered below a stable shot's error) stops
+    with a SimulationError naming the error, the time and the nose, on both paths alike."""
+    from fepen.runs import rigid as rigid_run
+
+    monkeypatch.setattr(rigid_run, "UNSTABLE_ENERGY_ERROR", 1e-9)
+    sc = rigid()
+    ref, got = single(sc), batch.summaries([sc])
+    assert isinstance(ref, SimulationError) and "energy balance error" in str(ref) and "nose at" in str(ref)
+    assert type(got[0]) is SimulationError and str(got[0]) == str(ref)
