@@ -284,15 +284,10 @@ def _refuse_run_directory(out: Path, comm) -> None:
 
 def _write_mesh(pm, out: Path, comm) -> None:
     """mesh.xdmf (with mesh.h5): the mesh, its cell tags and facet tags; mesh_facets.xdmf beside it."""
-    from dolfinx.io import XDMFFile
-
+    from fepen import dolfinx_api
     from fepen.io.fields import mesh_index
 
-    with XDMFFile(comm, str(out / "mesh.xdmf"), "w") as xdmf:
-        xdmf.write_mesh(pm.mesh)
-        pm.mesh.topology.create_connectivity(2, 3)
-        xdmf.write_meshtags(pm.cell_tags)
-        xdmf.write_meshtags(pm.facet_tags)
+    dolfinx_api.write_mesh_xdmf(comm, out / "mesh.xdmf", pm.mesh, (pm.cell_tags, pm.facet_tags))
     if comm.rank == 0:  # one dataset per file, as every reader wants it
         mesh_index(out / "mesh.h5", out / "mesh.xdmf", out / "mesh_facets.xdmf")
     comm.barrier()

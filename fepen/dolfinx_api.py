@@ -13,7 +13,8 @@ import numpy as np
 
 __all__ = ["SUPPORTED", "version", "modern", "check_version", "gmsh_io", "gmsh_topology", "model_to_mesh",
            "cell_perm", "tet_mesh", "entity_tags", "adjacency_int32", "vector_space", "tensor_dg0_space", "cell_dofs",
-           "geometry_dofs", "new_vector", "scatter_reverse_add", "pack", "assemble_into"]
+           "geometry_dofs", "new_vector", "scatter_reverse_add", "pack", "assemble_into", "quiet", "function",
+           "internal_force_form", "exterior_facets", "write_mesh_xdmf", "versions"]
 
 #: the dolfinx releases fepen is tested with (docs/install.md): (major, minor)
 SUPPORTED = ((0, 5), (0, 11))
@@ -174,3 +175,60 @@ def assemble_into(out: np.ndarray, form, constants, coefficients) -> None:
     from dolfinx import cpp
 
     cpp.fem.assemble_vector(out, getattr(form, "_cpp_object", form), constants, coefficients)
+
+
+def quiet() -> None:
+    """dolfinx's own log at warnings and above (its C++ info lines would drown fepen's on every rank)."""
+    from dolfinx import log
+
+    log.set_log_level(log.LogLevel.WARNING)
+
+
+def function(V, name: str | None = None):
+    """A finite element function on the space V (zero), named for the output files when ``name`` is given."""
+    from dolfinx import fem
+
+    return fem.Function(V, name=name) if name else fem.Function(V)
+
+
+def internal_force_form(P, V):
+    """The compiled vector form of the internal force, the integral of P : grad(w) over the body, for the cell
+    tensor function P and the test functions w of V."""
+    import ufl
+    from dolfinx import fem
+
+    w = ufl.TestFunction(V)
+    return fem.form(ufl.inner(P, ufl.grad(w)) * ufl.dx)
+
+
+def exterior_facets(mesh) -> np.ndarray:
+    """This rank's facets on the mesh's boundary (local indices; the facet-cell connectivity must exist)."""
+    from dolfinx import mesh as dmesh
+
+    return dmesh.exterior_facet_indices(mesh.topology)
+
+
+def write_mesh_xdmf(comm, path, mesh, tags) -> None:
+    """An XDMF file (with its .h5) holding the mesh and the MeshTags ``tags`` (cells, then facets)."""
+    from dolfinx.io import XDMFFile
+
+    with XDMFFile(comm, str(path), "w") as xdmf:
+        xdmf.write_mesh(mesh)
+        mesh.topology.create_connectivity(mesh.topology.dim - 1, mesh.topology.dim)
+        for t in tags:
+            if modern():
+                xdmf.write_meshtags(t, mesh.geometry)
+            else:
+                xdmf.write_meshtags(t)
+
+
+def versions() -> dict:
+    """{"dolfinx", "petsc"} of this process when it has imported dolfinx (a rigid run does not), else {}."""
+    import sys
+
+    if "dolfinx" not in sys.modules:
+        return {}
+    import dolfinx
+    from petsc4py import PETSc
+
+    return {"dolfinx": dolfinx.__version__, "petsc": ".".join(str(v) for v in PETSc.Sys.getVersion())}

@@ -67,13 +67,10 @@ def versions() -> dict[str, str]:
 
     import numpy
 
-    out = {"fepen": __version__, "numpy": numpy.__version__, "mpi": MPI.Get_library_version().splitlines()[0].strip()}
-    if "dolfinx" in sys.modules:
-        import dolfinx
-        from petsc4py import PETSc
+    from fepen import dolfinx_api
 
-        out["dolfinx"] = dolfinx.__version__
-        out["petsc"] = ".".join(str(v) for v in PETSc.Sys.getVersion())
+    out = {"fepen": __version__, "numpy": numpy.__version__, "mpi": MPI.Get_library_version().splitlines()[0].strip()}
+    out.update(dolfinx_api.versions())
     if "gmsh" in sys.modules:
         out["gmsh"] = sys.modules["gmsh"].__version__
     return out

@@ -50,8 +50,7 @@ def mesh_points(sh, comm) -> tuple[dict, tuple, int]:
     Returns:
         (points as fepen.geometry.revolution.load_points returns them, (mass, centre, inertia), cells).
     """
-    from dolfinx import fem
-
+    from fepen import dolfinx_api as dx
     from fepen.solver import surface
 
     sh = shot.of(sh)
@@ -68,7 +67,7 @@ def mesh_points(sh, comm) -> tuple[dict, tuple, int]:
     rho = np.concatenate([r for _, _, r in parts])[order]
     m, first, second = tet_mass_properties(p, rho)
     c, inertia = inertia_about_centre(m, first, second)
-    V = fem.VectorFunctionSpace(pm.mesh, ("CG", 1))
+    V = dx.vector_space(pm.mesh)
     points = surface.gather_global(surface.outer_surface(V, pm.facet_tags, pm.shape), comm)
     return points, (m, c, inertia), pm.mesh.topology.index_map(3).size_global
 

@@ -9,9 +9,6 @@ from time import perf_counter
 from typing import Protocol
 
 import numpy as np
-import ufl
-from dolfinx import fem
-from dolfinx import log as _log
 from mpi4py import MPI
 
 from fepen import dolfinx_api as dx
@@ -19,7 +16,7 @@ from fepen.errors import SimulationError
 from fepen.laws import materials as M
 from fepen.solver import assembly, ckernel, failures, kernels, reference
 
-_log.set_log_level(_log.LogLevel.WARNING)  # quiet dolfinx wherever the solver is used
+dx.quiet()  # quiet dolfinx wherever the solver is used
 
 
 @dataclass
@@ -579,11 +576,11 @@ def _clock(s: ExplicitSolver) -> None:
 
 def _nodal_arrays(s: ExplicitSolver, V, imap, nm: int) -> None:
     """Nodal vectors (ghosted, block size 3) and nodal scalars per material; the reference nodal volumes."""
-    s.u = fem.Function(V, name="displacement")
-    s.v = fem.Function(V, name="velocity")
-    s.fint_fn = fem.Function(V)
+    s.u = dx.function(V, "displacement")
+    s.v = dx.function(V, "velocity")
+    s.fint_fn = dx.function(V)
     s.U, s.Vel = s.u.x.array.reshape(-1, 3), s.v.x.array.reshape(-1, 3)
-    s.a_fn = fem.Function(V, name="acceleration")
+    s.a_fn = dx.function(V, "acceleration")
     s.acc = s.a_fn.x.array.reshape(-1, 3)
     s.fint = s.fint_fn.x.array.reshape(-1, 3)
     s._du = np.zeros_like(s.fint)  # the displacement increment of the step (for the work of the forces)
@@ -601,9 +598,8 @@ def _nodal_arrays(s: ExplicitSolver, V, imap, nm: int) -> None:
 def _internal_force_form(s: ExplicitSolver, V, Q) -> None:
     """The internal-force form, with P packed once and rewritten in place each step."""
     n_cells = s.n_cells
-    s.P = fem.Function(Q, name="P")
-    w = ufl.TestFunction(V)
-    s.form = fem.form(ufl.inner(s.P, ufl.grad(w)) * ufl.dx)
+    s.P = dx.function(Q, "P")
+    s.form = dx.internal_force_form(s.P, V)
     s._consts, s._coeffs = dx.pack(s.form)
     key = next(iter(s._coeffs))
     s.P_packed = s._coeffs[key]

@@ -24,7 +24,6 @@ from __future__ import annotations
 import numba
 import numpy as np
 import scipy.sparse as sp
-from dolfinx import mesh as dmesh
 from mpi4py import MPI
 
 from fepen import dolfinx_api as dx
@@ -134,7 +133,7 @@ class Recession:
         mesh.topology.create_connectivity(tdim - 1, tdim)
         mesh.topology.create_connectivity(tdim - 1, 0)
         mesh.topology.create_connectivity(tdim, 0)
-        facets = dmesh.exterior_facet_indices(mesh.topology)
+        facets = dx.exterior_facets(mesh)
         f2v = mesh.topology.connectivity(tdim - 1, 0)
         c2v = mesh.topology.connectivity(tdim, 0).array.reshape(-1, 4)
         v2d = np.full(c2v.max() + 1, -1, dtype=np.int64)

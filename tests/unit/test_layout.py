@@ -19,6 +19,18 @@ def test_laws_import_no_dolfinx_mpi_petsc_or_scene(module):
     assert not bad, f"{module} imports {sorted(bad)}"
 
 
+#: the FEniCSx packages whose API changes between releases: fepen reaches them through fepen.dolfinx_api alone
+FENICSX = ("dolfinx", "ufl", "basix", "ffcx", "petsc4py")
+
+
+def test_only_the_compatibility_layer_imports_dolfinx():
+    """fepen.dolfinx_api is the one place fepen touches dolfinx (0.5.2 and the current release): no other module
+    imports dolfinx, ufl, basix, ffcx or petsc4py, at the top or inside a function (docs/install.md)."""
+    bad = {m: sorted(d for d in layout.all_imports(m) if d.split(".")[0] in FENICSX)
+           for m in GRAPH if m != "fepen.dolfinx_api"}
+    assert not {m: d for m, d in bad.items() if d} and layout.all_imports("fepen.dolfinx_api") & {"dolfinx"}
+
+
 def test_only_runs_and_above_read_the_scene():
     """The scene reaches the physics through fepen.runs.setup alone."""
     readers = {m for m, deps in GRAPH.items() if "fepen.scene" in deps}
