@@ -17,7 +17,7 @@ export OMPI_MCA_rmaps_base_oversubscribe := 1
 export OMPI_MCA_mpi_yield_when_idle := 1
 export OMP_NUM_THREADS := 1
 
-.PHONY: setup run test lint bench clean notebook
+.PHONY: setup run test lint bench clean notebook setup-current test-current
 
 setup:
 	@bash tools/bootstrap.sh
@@ -43,6 +43,21 @@ test: setup
 	  --dist loadgroup tests/system
 	FEPEN_MESH_CACHE=$${FEPEN_MESH_CACHE:-$(TEST_MESHES)} mpirun -n $(NP) $(PY) -m pytest -q -m mpi \
 	  -p no:cacheprovider tests
+
+# The second stack (docs/install.md): the current dolfinx (0.11, PyPI's dolfinx-solver-real) on Python 3.12 with
+# numpy 2 and MPICH, in .venv-current (tools/bootstrap_current.sh). Its lane: the unit lane, the MPI lane on 2
+# ranks under MPICH's own mpiexec, and tests/stacks (Table 1 rigid and a short 4 mm deformable shot on both
+# stacks, the same numbers; it needs `make setup`'s .venv too). CI runs it after `make test` (.ci/run).
+CURRENT := .venv-current/bin/python
+
+setup-current:
+	@bash tools/bootstrap_current.sh
+
+test-current: setup setup-current
+	FEPEN_MESH_CACHE=$${FEPEN_MESH_CACHE:-$(TEST_MESHES)} $(CURRENT) -m pytest -q -m "not mpi" -n $(WORKERS) tests/unit
+	FEPEN_MESH_CACHE=$${FEPEN_MESH_CACHE:-$(TEST_MESHES)} .venv-current/bin/mpiexec -n $(NP) $(CURRENT) -m pytest -q \
+	  -m mpi -p no:cacheprovider tests
+	FEPEN_MESH_CACHE=$${FEPEN_MESH_CACHE:-$(TEST_MESHES)} $(CURRENT) -m pytest -q -p no:cacheprovider tests/stacks
 
 # JupyterLab beside the kernel the set-up installs (fepen[notebook]: the pins that work with Debian's matplotlib);
 # then `.venv/bin/jupyter lab demos/` and open api_tour.py or rigid_study.py as a notebook

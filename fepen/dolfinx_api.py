@@ -11,10 +11,14 @@ import functools
 
 import numpy as np
 
+# MPI before dolfinx: PyPI's dolfinx 0.11 links libmpi.so.12 without a search path to the MPICH wheel that mpi4py
+# loads; with mpi4py's MPI already loaded, dolfinx's import finds it (docs/install.md)
+from mpi4py import MPI  # noqa: F401
+
 __all__ = ["SUPPORTED", "version", "modern", "check_version", "gmsh_io", "gmsh_topology", "model_to_mesh",
            "cell_perm", "tet_mesh", "entity_tags", "adjacency_int32", "vector_space", "tensor_dg0_space", "cell_dofs",
            "geometry_dofs", "new_vector", "scatter_reverse_add", "pack", "assemble_into", "quiet", "function",
-           "internal_force_form", "exterior_facets", "write_mesh_xdmf", "versions"]
+           "internal_force_form", "exterior_facets", "write_mesh_xdmf", "versions", "stack"]
 
 #: the dolfinx releases fepen is tested with (docs/install.md): (major, minor)
 SUPPORTED = ((0, 5), (0, 11))
@@ -86,7 +90,9 @@ def tet_mesh(comm, cells: np.ndarray, x: np.ndarray, partitioner):
         from dolfinx import mesh as dmesh
 
         domain = gmsh_io().ufl_mesh(4, 3, np.float64)
-        part = dmesh.create_cell_partitioner(partitioner, dmesh.GhostMode.none, 2)
+        # shared_facet: the partitioner is asked for ghosts (ghosting=True), as 0.5's create_mesh asks it; a split
+        # wall's charge node then finds its shell twin on its own rank (fepen.solver.shell_charge)
+        part = dmesh.create_cell_partitioner(partitioner, dmesh.GhostMode.shared_facet, 2)
         return dmesh.create_mesh(comm, cells, domain, x, partitioner=part)
     g = gmsh_io()
     return g.create_mesh(comm, cells, x, g.ufl_mesh(4, 3), partitioner=cpp.mesh.create_cell_partitioner(partitioner))
@@ -232,3 +238,22 @@ def versions() -> dict:
     from petsc4py import PETSc
 
     return {"dolfinx": dolfinx.__version__, "petsc": ".".join(str(v) for v in PETSc.Sys.getVersion())}
+
+
+def stack() -> dict:
+    """The software a deformable run would use (dolfinx imported here): Python, numpy, mpi4py, the MPI library, and
+    dolfinx with PETSc and whether fepen supports it ("dolfinx" says why not when it does not import)."""
+    import platform
+
+    import mpi4py
+
+    out = {"python": platform.python_version(), "numpy": np.__version__, "mpi4py": mpi4py.__version__,
+           "mpi": " ".join(MPI.Get_library_version().splitlines()[0].split(",")[0].split())}
+    try:
+        import dolfinx  # noqa: F401
+    except ImportError as err:
+        out["dolfinx"] = f"not importable ({err})"
+        return out
+    out.update(versions())
+    out["supported"] = version()[:2] in SUPPORTED
+    return out

@@ -56,6 +56,19 @@ if [ ! -x .venv/bin/python ]; then
   echo "[bootstrap] creating .venv (system site packages visible)"
   /usr/bin/python3 -m venv --system-site-packages .venv
 fi
+# Debian's h5py 3.7.0 is installed under the distribution name h5py._debian_h5py_serial, which pip does not take for
+# "h5py": it would build PyPI's h5py from source against Debian's HDF5 (and fail) to meet fepen's "h5py>=3.7". A
+# record of the name pip looks for, pointing at nothing, says that Debian's is there (numpy, scipy, numba,
+# matplotlib and mpi4py need none: Debian records them under their own names).
+site=$(.venv/bin/python -c "import sysconfig; print(sysconfig.get_paths()['purelib'])")
+h5=$(/usr/bin/python3 -c "import h5py; print(h5py.__version__)")
+if [ ! -d "$site/h5py-$h5.dist-info" ]; then
+  mkdir -p "$site/h5py-$h5.dist-info"
+  printf 'Metadata-Version: 2.1\nName: h5py\nVersion: %s\nSummary: Debian'"'"'s python3-h5py (a record for pip)\n' "$h5" \
+    > "$site/h5py-$h5.dist-info/METADATA"
+  echo "debian" > "$site/h5py-$h5.dist-info/INSTALLER"
+  : > "$site/h5py-$h5.dist-info/RECORD"
+fi
 echo "[bootstrap] installing fepen and its PyPI dependencies into .venv"
 .venv/bin/python -m pip install -q --disable-pip-version-check -c tools/constraints.txt -e ".[test,parquet]"
 echo "$want" > "$stamp"

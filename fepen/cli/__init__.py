@@ -39,8 +39,8 @@ from fepen.cli import envelope, keys, mesh, run, study, sweep, validate, validat
 from fepen.cli.common import say
 from fepen.errors import InputError, Interrupted, MachineFault, SimulationError, describe_os_error, stop_outcome
 
-__all__ = ["main", "COMMANDS", "version_line", "common", "run", "mesh", "validate", "validate_depth", "study", "sweep",
-           "keys", "view", "envelope"]
+__all__ = ["main", "COMMANDS", "version_line", "stack_line", "common", "run", "mesh", "validate", "validate_depth",
+           "study", "sweep", "keys", "view", "envelope"]
 
 #: the command modules by name, in the order of "name a command: ..."
 _MODULES = {"run": run, "mesh": mesh, "validate": validate, "validate-depth": validate_depth, "study": study,
@@ -62,7 +62,8 @@ def _parser() -> argparse.ArgumentParser:
                  epilog="Exit codes: 0 success, 2 bad input, 3 the simulation cannot go on, 4 a fault of the "
                         "machine (disk full, permission, SIGTERM/SIGINT after a checkpoint), 1 a bug. "
                         "--debug (anywhere): tracebacks.")
-    ap.add_argument("--version", action="store_true", help="print fepen's version and code revision and exit")
+    ap.add_argument("--version", action="store_true", help="print fepen's version and code revision, and the "
+                    "dolfinx, PETSc, MPI, numpy and Python it runs on, and exit")
     sub = ap.add_subparsers(dest="command", parser_class=_Parser)
     for name in _HELP_ORDER:
         _MODULES[name].add_arguments(sub.add_parser(name, help=_MODULES[name].HELP))
@@ -76,6 +77,19 @@ def version_line() -> str:
 
     rev = revision()
     return f"fepen {__version__}" + (f" (revision {rev})" if rev else "")
+
+
+def stack_line() -> str:
+    """``dolfinx 0.5.2 (supported), PETSc 3.18.5, Open MPI v4.1.4, mpi4py 3.1.4, numpy 1.24.2, Python 3.11.2``: the
+    software this fepen runs on (fepen.dolfinx_api.stack); an unsupported dolfinx names the supported ones."""
+    from fepen import dolfinx_api as dx
+
+    s = dx.stack()
+    names = " and ".join(f"{a}.{b}" for a, b in dx.SUPPORTED)
+    head = f"dolfinx {s['dolfinx']}" if "supported" not in s else \
+        f"dolfinx {s['dolfinx']} ({'supported' if s['supported'] else 'not supported: fepen runs on ' + names}), " \
+        f"PETSc {s['petsc']}"
+    return f"{head}, {s['mpi']}, mpi4py {s['mpi4py']}, numpy {s['numpy']}, Python {s['python']}"
 
 
 def main(argv: list[str] | None = None) -> int:
@@ -99,7 +113,7 @@ def _main(argv: list[str]) -> int:
     try:
         args = _parser().parse_args(argv)
         if args.version:
-            say(version_line())
+            say(version_line(), stack_line())
             return 0
         if args.command is None:
             raise InputError("command line", "name a command: " + ", ".join(COMMANDS) + " (fepen --help)")

@@ -25,7 +25,6 @@ def add_arguments(parser) -> None:
 def run(args) -> int:
     """The sweep here, or under mpirun -n W when started on one rank with W > 1 workers and mpirun at hand."""
     import os
-    import shutil
     import sys
 
     from mpi4py import MPI
@@ -36,7 +35,7 @@ def run(args) -> int:
     if args.workers is not None and args.workers < 1:
         raise InputError("--workers", f"must be at least 1, got {args.workers}")
     workers = args.workers if args.workers is not None else (os.cpu_count() or 1)
-    if world.size == 1 and workers > 1 and shutil.which("mpirun"):
+    if world.size == 1 and workers > 1 and processes.launcher():
         engine.check_ranks_per_shot(args.ranks_per_shot, workers)
         sweep.read(args.sweep, args.sets)  # bad input here, in one line, before mpirun starts
         # the bar of rank 0 under mpirun writes into a pipe: shown there when this process is on a terminal

@@ -63,13 +63,15 @@ def agree(comm: MPI.Comm, what: str, fn, root_only: bool = True):
 def versions() -> dict[str, str]:
     """Versions of fepen and of the libraries that shaped this process's numbers (dolfinx and PETSc only
     when the run imported them: a rigid run does not)."""
+    import platform
     import sys
 
     import numpy
 
     from fepen import dolfinx_api
 
-    out = {"fepen": __version__, "numpy": numpy.__version__, "mpi": MPI.Get_library_version().splitlines()[0].strip()}
+    out = {"fepen": __version__, "python": platform.python_version(), "numpy": numpy.__version__,
+           "mpi": MPI.Get_library_version().splitlines()[0].strip()}
     out.update(dolfinx_api.versions())
     if "gmsh" in sys.modules:
         out["gmsh"] = sys.modules["gmsh"].__version__

@@ -293,7 +293,10 @@ class RunDirectory:
 
     def _close(self, outcome: str, code: int, message: str | None) -> None:
         last = self.record["resumes"][-1] if self.record.get("resumes") else self.record
-        last.update(end=_now(), outcome=outcome, exit_code=code, **({"message": message} if message else {}))
+        from fepen.io.files import versions
+
+        last.update(end=_now(), outcome=outcome, exit_code=code, **({"message": message} if message else {}),
+                    versions=versions())  # at the end: dolfinx and PETSc are named when the run imported them
         if "resumes" in self.record:  # the first invocation's record stays; the whole run's verdict beside it
             self.record.update(final_outcome=outcome, final_exit_code=code)
         (self.out / RESERVE).unlink(missing_ok=True)

@@ -20,10 +20,24 @@ def mpi_env(**extra) -> dict:
                 OMPI_MCA_rmaps_base_oversubscribe="1", PYTHONPATH=path, **extra)
 
 
+def launcher(python: str | Path | None = None) -> str | None:
+    """The MPI launcher of a Python's MPI (default: this one's): ``mpiexec`` beside the interpreter when its
+    environment holds an MPI of its own (PyPI's MPICH wheel, a conda environment), else ``mpirun`` on the PATH
+    (Debian's Open MPI), else None. An Open MPI mpirun starting ranks linked to MPICH would start singletons, not
+    one run."""
+    import shutil
+
+    here = Path(python or sys.executable).parent
+    for name in ("mpiexec", "mpirun"):
+        if (here / name).is_file() and os.access(here / name, os.X_OK):
+            return str(here / name)
+    return shutil.which("mpirun")
+
+
 def command(args, ranks: int = 1, fepen: bool = True) -> list[str]:
-    """``python -m fepen ARGS`` (or ``python ARGS`` with fepen=False), under mpirun when ranks > 1."""
+    """``python -m fepen ARGS`` (or ``python ARGS`` with fepen=False), under the launcher when ranks > 1."""
     cmd = [sys.executable, *(["-m", "fepen"] if fepen else []), *map(str, args)]
-    return ["mpirun", "-n", str(ranks), *cmd] if ranks > 1 else cmd
+    return [launcher() or "mpirun", "-n", str(ranks), *cmd] if ranks > 1 else cmd
 
 
 def run(args, ranks: int = 1, fepen: bool = True, cwd=None, timeout: float | None = None, check: bool = False):

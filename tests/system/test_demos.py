@@ -7,6 +7,8 @@ import sys
 import pytest
 from conftest import ROOT
 
+from fepen.studies import processes
+
 
 def test_taylor_demo_against_the_4340_experiment(tmp_path):
     """Acceptance 3 on the coarsest mesh: the 4340 steel Taylor rod's final length within 5 % of the test."""
@@ -63,7 +65,7 @@ def test_layered_structure_demo(tmp_path, ranks):
     """Two slabs 1 m apart over soil, rigid, on 1 and 2 ranks: perforates both, stops in the soil."""
     cmd = [sys.executable, "demos/targets/layered_structure.py", "--out", str(tmp_path)]
     if ranks > 1:
-        cmd = ["mpirun", "-n", str(ranks), *cmd]
+        cmd = [processes.launcher(), "-n", str(ranks), *cmd]
     r = subprocess.run(cmd, cwd=ROOT, capture_output=True, text=True, env=dict(os.environ, PYTHONPATH=str(ROOT)),
                        timeout=600)
     assert r.returncode == 0, r.stderr[-2000:]
@@ -78,7 +80,7 @@ def test_metal_plate_demo(tmp_path, ranks):
     """The rod into 6061-T6511 at 800 m/s: within 1 % of Forrestal and Warren's closed form."""
     cmd = [sys.executable, "demos/targets/metal_plate.py", "--out", str(tmp_path), "--speeds", "800"]
     if ranks > 1:
-        cmd = ["mpirun", "-n", str(ranks), *cmd]
+        cmd = [processes.launcher(), "-n", str(ranks), *cmd]
     r = subprocess.run(cmd, cwd=ROOT, capture_output=True, text=True, env=dict(os.environ, PYTHONPATH=str(ROOT)),
                        timeout=600)
     assert r.returncode == 0, r.stderr[-2000:]

@@ -93,6 +93,13 @@ def test_bad_command_lines_are_one_line_exit_2(argv, pattern, capsys, tmp_path, 
 def test_version_and_debug(capsys, tmp_path):
     code, out, err = fepen(capsys, "--version")
     assert code == 0 and out.startswith("fepen ") and not err
+    import dolfinx
+    import numpy as np
+    from petsc4py import PETSc
+
+    stack = out.splitlines()[1]  # the software it runs on: dolfinx (supported), PETSc, the MPI library, numpy
+    assert stack.startswith(f"dolfinx {dolfinx.__version__} (supported), PETSc {PETSc.Sys.getVersion()[0]}.")
+    assert ("Open MPI" in stack or "MPICH" in stack) and f"numpy {np.__version__}" in stack
     code, _, err = fepen(capsys, "--debug", "run", "--out", "/etc/hostname", *RIGID)
     assert code == 2 and any("Traceback" in ln for ln in err) and err[-1].startswith("fepen: bad input:")
 
