@@ -24,6 +24,20 @@ def test_an_unsupported_dolfinx_is_refused_in_one_line(monkeypatch, capsys, tmp_
     assert not out.exists()
 
 
+def test_an_unsupported_dolfinx_can_be_tried_when_asked(monkeypatch, caplog):
+    """FEPEN_UNSUPPORTED_DOLFINX=try: one warning naming the version and the supported ones, and no refusal."""
+    monkeypatch.setattr(dx, "version", lambda: (0, 12, 0))
+    monkeypatch.setenv(dx.TRY_UNSUPPORTED, "try")
+    with caplog.at_level("WARNING", logger="fepen"):
+        dx.check_version()
+    assert [r.getMessage() for r in caplog.records] == [
+        "dolfinx 0.12.0 is not supported (fepen runs on dolfinx 0.5 and 0.11): tried as FEPEN_UNSUPPORTED_DOLFINX=try "
+        "asks; check its numbers"]
+    monkeypatch.setenv(dx.TRY_UNSUPPORTED, "yes")  # only "try" lets it through
+    with pytest.raises(Exception, match="is not supported"):
+        dx.check_version()
+
+
 def test_a_rigid_run_needs_no_supported_dolfinx(monkeypatch, tmp_path):
     """The rigid fidelity makes no mesh: it runs whatever dolfinx is installed."""
     monkeypatch.setattr(dx, "version", lambda: (0, 8, 0))
