@@ -23,12 +23,14 @@ from fepen.scene.resolve import (
     read_toml,
     registered_checks,
     resolve,
+    set_item,
     unknown_key,
 )
 from fepen.scene.schema import LAYER_FIELDS, LAYER_KEYS, SCHEMA, SECTIONS
 from fepen.scene.writing import describe, to_toml
 
-__all__ = ["keys", "schema", "writing", "Scene", "Section", "load", "resolve", "read_toml", "parse_set", "flatten",
+__all__ = ["keys", "schema", "writing", "Scene", "Section", "load", "resolve", "read_toml", "parse_set", "set_item",
+           "flatten",
            "unknown_key", "to_toml", "describe", "SCHEMA", "SECTIONS", "LAYER_KEYS", "LAYER_FIELDS", "Key",
            "ABSENT", "display_name",
            "CROSS_CHECKS", "CHECKS_AFTER_RESOLUTION", "CAD_EXCLUDES", "cross_check", "registered_checks"]

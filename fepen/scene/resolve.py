@@ -544,6 +544,34 @@ def parse_set(item: str) -> tuple[str, Any]:
     return key, value
 
 
+def set_item(key: str, value) -> str:
+    """``KEY=VALUE`` as ``--set`` and ``Scene(sets=...)`` read it: a number (numpy's too: numpy 2 writes its
+    scalars as ``np.float64(...)``, which TOML does not read), a boolean or a text, in TOML.
+
+    Args:
+        key: the dotted scene key. value: bool, int, float (or a numpy scalar of them) or str.
+
+    Returns:
+        The item, e.g. ``"impact.velocity=800.0"``.
+    """
+    import json
+    import numbers
+
+    import numpy as np
+
+    if isinstance(value, (bool, np.bool_)):
+        text = "true" if value else "false"
+    elif isinstance(value, numbers.Integral):
+        text = str(int(value))
+    elif isinstance(value, numbers.Real):
+        text = repr(float(value))  # nan and inf are TOML's words too
+    elif isinstance(value, str):
+        text = json.dumps(value)  # a TOML basic string
+    else:
+        raise TypeError(f"{key}: a scene value is a number, a boolean or a text, not {type(value).__name__}")
+    return f"{key}={text}"
+
+
 def read_toml(path: str | Path) -> dict[str, Any]:
     """Read a scene file into a flat {dotted key: value} dict, without validating the keys.
 

@@ -93,8 +93,8 @@ def _one(job) -> tuple:
     from fepen.runs.rigid import RigidRun
 
     name, row, S, node, extra = job
-    sets = [*_scene_sets(name, row), f"target.quasi_static_stress={S * _cylinder(row)!r}",
-            *[f"{k}={v!r}" for k, v in node.items()], *extra]
+    sets = [*_scene_sets(name, row), scene.set_item("target.quasi_static_stress", S * _cylinder(row)),
+            *[scene.set_item(k, v) for k, v in node.items()], *extra]
     s = RigidRun(scene.load(None, sets), None, MPI.COMM_SELF).run()
     return tuple(s[k] / 1e3 for k in ("Hx_mm", "Hy_mm", "Tx_mm", "Ty_mm"))
 

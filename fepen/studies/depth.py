@@ -106,11 +106,13 @@ def shipped_sets() -> dict[str, Path]:
 def scene_sets(row: Row) -> list[str]:
     """The --set lines of a rigid scene for one shot: the projectile's outside and mass, the target's
     strength and density only (everything else from fepen's defaults), the striking conditions."""
-    return ["effects.fidelity=rigid", f"projectile.diameter={row.D!r}", f"projectile.length={row.L!r}",
-            f"projectile.crh={row.crh!r}", f"projectile.mass={row.mass!r}", f"impact.velocity={row.V!r}",
-            f"impact.obliquity_deg={row.obliquity_deg!r}", f"impact.attack_deg={row.attack_deg!r}",
-            f"target.compressive_strength={row.fc!r}", f"target.strength_basis={row.strength_basis!r}",
-            f"target.density={row.rho!r}"]
+    from fepen.scene import set_item
+
+    return ["effects.fidelity=rigid", *(set_item(k, v) for k, v in (
+        ("projectile.diameter", row.D), ("projectile.length", row.L), ("projectile.crh", row.crh),
+        ("projectile.mass", row.mass), ("impact.velocity", row.V), ("impact.obliquity_deg", row.obliquity_deg),
+        ("impact.attack_deg", row.attack_deg), ("target.compressive_strength", row.fc),
+        ("target.strength_basis", row.strength_basis), ("target.density", row.rho)))]
 
 
 def rigid_depth(row: Row, sets=()) -> float:

@@ -40,6 +40,29 @@ def command(args, ranks: int = 1, fepen: bool = True) -> list[str]:
     return [launcher() or "mpirun", "-n", str(ranks), *cmd] if ranks > 1 else cmd
 
 
+def rank_pids(launcher_pid: int) -> list[int]:
+    """The ranks a launcher started: the Python processes below it, however deep (Open MPI's mpirun starts them
+    as its children; MPICH's mpiexec under a hydra_pmi_proxy of its own). Linux (/proc); sorted."""
+    children: dict[int, list[int]] = {}
+    for stat in Path("/proc").glob("[0-9]*/stat"):
+        try:
+            text = stat.read_text()
+        except OSError:  # gone meanwhile
+            continue
+        ppid = int(text.rsplit(")", 1)[1].split()[1])
+        children.setdefault(ppid, []).append(int(stat.parent.name))
+    out, todo = [], [launcher_pid]
+    while todo:
+        for pid in children.get(todo.pop(), []):
+            todo.append(pid)
+            try:
+                if Path(f"/proc/{pid}/exe").resolve().name.startswith("python"):
+                    out.append(pid)
+            except OSError:
+                pass
+    return sorted(out)
+
+
 def run(args, ranks: int = 1, fepen: bool = True, cwd=None, timeout: float | None = None, check: bool = False):
     """Run a whole process to its end; its CompletedProcess (output captured as text)."""
     return subprocess.run(command(args, ranks, fepen), cwd=cwd or ROOT, capture_output=True, text=True,

@@ -36,7 +36,9 @@ TARGET_MASS_LOSS = 0.045
 
 def wear_sets(eta: float) -> tuple[str, ...]:
     """The scene settings of wear at the efficiency η."""
-    return ("effects.wear=true", f"projectile.wear.efficiency={eta!r}")
+    from fepen.scene import set_item
+
+    return ("effects.wear=true", set_item("projectile.wear.efficiency", eta))
 
 
 def _one(job) -> dict:
@@ -46,7 +48,8 @@ def _one(job) -> dict:
     from fepen.runs.rigid import RigidRun
 
     name, sigma, extra = job
-    sets = ["effects.fidelity=rigid", f'impact.shot="{name}"', f"target.quasi_static_stress={sigma!r}", *extra]
+    sets = ["effects.fidelity=rigid", scene.set_item("impact.shot", name),
+            scene.set_item("target.quasi_static_stress", sigma), *extra]
     return RigidRun(scene.load(None, sets), None, MPI.COMM_SELF).run()
 
 

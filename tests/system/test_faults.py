@@ -100,9 +100,8 @@ def test_sigterm_at_a_random_time_then_resume(whole, tmp_path, ranks):
     if proc.poll() is not None:
         pytest.skip(f"seed {seed}: the run ended before the signal (a faster machine)")
     target = proc.pid
-    if ranks > 1:  # one rank of mpirun's two: the other learns it at the next check
-        children = subprocess.run(["pgrep", "-P", str(proc.pid)], capture_output=True, text=True).stdout.split()
-        target = int(random.Random(seed).choice(children))
+    if ranks > 1:  # one rank of the launcher's two: the other learns it at the next check
+        target = random.Random(seed).choice(processes.rank_pids(proc.pid))
     os.kill(target, signal.SIGTERM)
     _, stderr = proc.communicate(timeout=300)
     assert proc.returncode == 4, f"seed {seed}: {stderr[-2000:]}"

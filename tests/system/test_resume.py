@@ -53,10 +53,7 @@ def kill_after_checkpoints(proc, out, n=2, timeout=300):
         assert proc.poll() is None, f"the run ended before it could be killed: {proc.stderr.read()}"
         time.sleep(0.01)
     time.sleep(0.05)
-    import subprocess
-
-    ranks = [int(p) for p in subprocess.run(["pgrep", "-P", str(proc.pid)], capture_output=True,
-                                            text=True).stdout.split()]  # mpirun gives them groups of their own
+    ranks = processes.rank_pids(proc.pid)  # the launcher may give them groups of their own
     os.killpg(proc.pid, signal.SIGKILL)
     for pid in ranks:
         try:

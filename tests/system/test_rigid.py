@@ -6,6 +6,7 @@ import math
 import numpy as np
 import pytest
 from mpi4py import MPI
+from scipy.integrate import trapezoid
 
 from fepen import dolfinx_api as dx
 from fepen import scene
@@ -255,7 +256,7 @@ def test_rigid_wear_off_or_without_melting_changes_nothing():
     sc = scene.load(None, [])
     shp, rho = setup.projectile_shape(sc), sc.projectile.material.density
     z = np.linspace(0.0, shp.nose_length, 20001)
-    zone = np.pi * np.trapz(shp.outer_radius(z) ** 2, z)  # the nose's volume ahead of the shoulder
+    zone = np.pi * trapezoid(shp.outer_radius(z) ** 2, z)  # the nose's volume ahead of the shoulder
     per_kg = shp.nose_length / (rho * zone)  # m of length per kg: exact for the contraction
     assert -worn["length_change_mm"] * 1e-3 == pytest.approx(per_kg * worn["mass_loss_kg"], rel=1e-6)
     assert -worn["length_change_mm"] / worn["mass_loss_percent"] == pytest.approx(1.95, rel=0.05)  # about

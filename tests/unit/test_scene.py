@@ -1,5 +1,6 @@
 """Scenes: defaults, --set, validation; bad input gives one line, exit code 2, nothing written."""
 
+import numpy as np
 import pytest
 
 from fepen import scene
@@ -157,3 +158,15 @@ def test_named_steels_fill_the_material_and_explicit_keys_win():
     assert m.A == 800e6 and m.B == STEELS["aisi-4340"]["B"]
     with pytest.raises(InputError, match="projectile.material.name"):
         scene.load(None, ["projectile.material.name=unobtainium"])
+
+
+@pytest.mark.parametrize("value", [np.float64(160181857.99361405), np.float32(0.25), np.int64(3), 1e-300,
+                                   float("inf"), np.bool_(True), False, 7, 'C3 "quoted"', "a\\b"])
+def test_set_item_gives_back_the_value_whatever_its_type(value):
+    """scene.set_item writes a value as --set reads it: numpy 2's scalars (repr np.float64(...), not TOML), numpy's
+    booleans and integers, and text with quotes and backslashes come back equal."""
+    key, back = scene.parse_set(scene.set_item("target.quasi_static_stress", value))
+    plain = value.item() if isinstance(value, np.generic) else value
+    assert key == "target.quasi_static_stress" and back == plain and type(back) is type(plain)
+    with pytest.raises(TypeError, match="target.density"):
+        scene.set_item("target.density", [1.0])
