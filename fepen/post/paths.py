@@ -97,7 +97,8 @@ def _panel(ax, name: str, paths: Mapping[str, dict], colours: Mapping[str, str])
         notes.append("{}: {:+.0f} mm; {:.1f}°".format(label, *offsets(final, s.obliquity_deg)))
     x0, x1 = min(xs), max(xs)
     pad = 0.06 * max(x1 - x0, depth)
-    ax.set_xlim(x0 - pad, x1 + pad)
+    # the x range follows from the depth's at equal scales (adjustable="datalim" widens it about the paths):
+    # setting it too would be dropped, with a warning from matplotlib 3.8 on
     ax.set_ylim(depth + pad, -0.12 * depth)  # depth downward; the flight above the face cut short
     ax.set_aspect("equal", adjustable="datalim")
     ax.text(0.03, 0.02, "\n".join(notes), transform=ax.transAxes, fontsize=7.5, va="bottom", ha="left",
