@@ -175,17 +175,29 @@ def run(scene, out=None, comm=None, progress: bool = False, force: bool = False)
 def resume(results_dir, comm=None, progress: bool = False) -> Result:
     """Continue a killed or interrupted deformable run from its last checkpoint (same number of ranks), or run
     a stopped rigid run again; its Result."""
-    from fepen.runs import checkpoint, run_in_directory
+    from fepen.io import rundir
+    from fepen.runs import checkpoint, resolve, run_in_directory, shot
 
     comm = _comm(comm)
     _record_call("resume", results_dir)
     out = Path(results_dir)
     if not (out / "scene.toml").exists():
         raise InputError("--resume", f"{out} is not a results directory (no scene.toml)")
+    record, foreign = rundir.read_record(out) if comm.rank == 0 else (None, None)
+    record, foreign = comm.bcast((record, foreign), root=0) if comm.size > 1 else (record, foreign)
+    if record is None:
+        raise InputError("--resume", f"{out} holds no fepen run to resume (run.json is {foreign or 'absent'})")
     sc = Scene(out / "scene.toml")
+    sh = resolve(sc)
+    changed = shot.inputs_changed(record.get("inputs"), sh.inputs)
     rigid = sc.effects.fidelity == "rigid"  # seconds to run: a stopped rigid run runs again from the start
     state = None if rigid else checkpoint.read_state(out, comm)
-    run_in_directory(sc, out, comm, "resume", progress=progress, resume=state)
+    if changed is None and state is not None and state.get("inputs_sha256") not in (None, sh.inputs["sha256"]):
+        changed = "the checkpoint's inputs digest differs from the scene's"
+    if changed:
+        raise InputError("--resume", f"{out} was run with other inputs: {changed}; a resume continues the same "
+                                     "shot: run the new one into another --out (or --force)")
+    run_in_directory(sc, out, comm, "resume", progress=progress, resume=state, sh=sh)
     return load(out)
 
 
@@ -238,55 +250,48 @@ def mesh(scene, out, comm=None, force: bool = False) -> dict:
         scene: a Scene, or anything Scene() takes.
         out: the results directory (created).
         comm: the MPI communicator; None: COMM_WORLD.
-        force: write into a directory that holds a run's results (its scene.toml becomes the mesh's); without
-            it, InputError before anything is meshed or written.
+        force: write into a directory that holds a run's results, removing exactly the files that run wrote
+            (its manifest); without it, InputError before anything is meshed or written. An earlier mesh's files
+            in ``out`` are replaced without it; a user's own files are never touched.
 
     Returns:
         The content of mesh.json: cells, nodes, mass_kg, volume_m3, min_quality, shortest_altitude_m,
         stable_dt_s, altitude_over_size, ..., versions.
     """
     from fepen import scene as fscene
-    from fepen.io import files
+    from fepen.io import files, rundir
     from fepen.post import figures
     from fepen.runs import setup
 
     comm = _comm(comm)
+    _record_call("mesh", scene, out=str(out), **({"force": True} if force else {}))
     sc = scene if isinstance(scene, Scene) else Scene(scene)
     out = Path(out)
-    if not force:
-        _refuse_run_directory(out, comm)
     from fepen import dolfinx_api
 
     dolfinx_api.check_version()  # before anything is written
     setup.announce(sc, comm)  # geometry errors before anything is written
-    pm = setup.mesh(sc, comm)
-    info = setup.mesh_metrics(pm, sc)
-    files.prepare(out, comm)
-    info["versions"] = files.versions()
-    files.write_json(out / "mesh.json", info, comm)
-    files.write_text(out / "scene.toml", fscene.to_toml(sc), comm)
-    _write_mesh(pm, out, comm)
-    figures.mesh_picture(pm, out / "mesh.png",
-                         f"{info['cells']} tets, h = {1e3 * sc.mesh.size:g} mm, {1e3 * info['mass_kg']:.2f} g")
+    setup.check_mesh_cost(sc, comm)  # a mesh past the machine's memory, before gmsh starts
+    with rundir.RunDirectory(out, comm, "force" if force else "new", kind="mesh"):
+        pm = setup.mesh(sc, comm)
+        info = setup.mesh_metrics(pm, sc)
+        info["versions"] = files.versions()
+        files.write_json(out / "mesh.json", info, comm)
+        files.write_text(out / "scene.toml", fscene.to_toml(sc), comm)
+        _write_mesh(pm, out, comm)
+        figures.mesh_picture(pm, out / "mesh.png",
+                             f"{info['cells']} tets, h = {1e3 * sc.mesh.size:g} mm, {1e3 * info['mass_kg']:.2f} g")
     return info
-
-
-def _refuse_run_directory(out: Path, comm) -> None:
-    """InputError on every rank when ``out`` holds a run's results (fepen.io.rundir.MARKERS)."""
-    from fepen.io import rundir
-
-    found = [m for m in rundir.MARKERS if (out / m).exists()] if comm.rank == 0 else None
-    found = comm.bcast(found, root=0) if comm.size > 1 else found
-    if found:
-        raise InputError("out", f"{out} holds a run's results ({', '.join(found)}): the mesh's scene.toml would "
-                                "replace the run's; name another directory, or give force=True")
 
 
 def _write_mesh(pm, out: Path, comm) -> None:
     """mesh.xdmf (with mesh.h5): the mesh, its cell tags and facet tags; mesh_facets.xdmf beside it."""
     from fepen import dolfinx_api
+    from fepen.atomic import guard
     from fepen.io.fields import mesh_index
 
+    for name in ("mesh.xdmf", "mesh.h5"):  # dolfinx writes them by name: fepen's or new, never through a link
+        guard(out / name)
     dolfinx_api.write_mesh_xdmf(comm, out / "mesh.xdmf", pm.mesh, (pm.cell_tags, pm.facet_tags))
     if comm.rank == 0:  # one dataset per file, as every reader wants it
         mesh_index(out / "mesh.h5", out / "mesh.xdmf", out / "mesh_facets.xdmf")

@@ -131,10 +131,19 @@ def _main(argv: list[str]) -> int:
         return code
 
 
+#: the longest error line: a longer one (a value of megabytes echoed) keeps its start, which names the key, and
+#: its end, which says what is allowed
+LINE_MAX = 500
+
+
 def _verdict(err: BaseException) -> tuple[int, str]:
-    """The exit code and the one line of an error (whitespace, newlines in a path included, collapsed)."""
+    """The exit code and the one line of an error (whitespace, newlines in a path included, collapsed; cut in
+    the middle to LINE_MAX characters)."""
     code, line = _verdict_line(err)
-    return code, " ".join(line.split())
+    line = " ".join(line.split())
+    if len(line) > LINE_MAX:
+        line = f"{line[:LINE_MAX - 160]} [... {len(line) - LINE_MAX + 9} characters cut ...] {line[-140:]}"
+    return code, line
 
 
 def _verdict_line(err: BaseException) -> tuple[int, str]:

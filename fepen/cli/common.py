@@ -18,6 +18,19 @@ def say(*lines: str) -> None:
             rundir.log_line(line)
 
 
+def written_line(out) -> str:
+    """``written: OUT/ a, b, c``: the files the directory's manifest lists (run.json's "files"), as they are."""
+    import os
+    from pathlib import Path
+
+    from fepen.io import rundir
+
+    record, _ = rundir.read_record(Path(out))
+    names = sorted(n for n in (rundir.manifest(record) or ()) if os.path.lexists(Path(out) / n)
+                   and n != rundir.RESERVE) if record else []
+    return f"written: {out}/ " + ", ".join(n + ("/" if (Path(out) / n).is_dir() else "") for n in names)
+
+
 def scene_arguments(parser, out_default: str) -> None:
     """SCENE (optional), --out (default ``out_default``) and --set."""
     parser.add_argument("scene", nargs="?", help="scene file (TOML); absent: the default scene")

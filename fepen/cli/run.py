@@ -3,7 +3,7 @@ simulation (fepen.api.run, fepen.api.resume), its summary printed."""
 
 from __future__ import annotations
 
-from fepen.cli.common import say, scene_arguments
+from fepen.cli.common import say, scene_arguments, written_line
 from fepen.errors import InputError
 
 HELP = "one simulation: summary.json, history.csv, fields.xdmf, figures"
@@ -34,8 +34,7 @@ def run(args) -> int:
             *(("max_peeq",) if summary.get("fidelity") != "rigid" else ()), "energy_error", "steps", "dt_s", "wall_s")
     keys += tuple(k for k in ("mass_loss_kg", "mass_loss_percent") if k in summary)
     say(*(f"{k} = {summary[k]:.6g}" if isinstance(summary[k], float) else f"{k} = {summary[k]}"
-          for k in keys), *prediction_lines(summary), f"written: {out}/summary.json, history.csv, history.png"
-        + (", fields.xdmf" if result.fields is not None else ""))
+          for k in keys), *prediction_lines(summary), written_line(out))
     return 0
 
 

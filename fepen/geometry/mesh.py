@@ -233,9 +233,49 @@ def _check_entry(msh: Path, side: Path) -> Shape | CadBody:
     return _from_record(meta["shape"])
 
 
-def _read_entry(key: str, msh: Path, side: Path) -> Shape | CadBody | None:
-    """Rank 0: open a checked cache entry in gmsh and return its shape; or, for an entry that fails a check
-    or cannot be read, log one warning, delete the entry and return None (the caller meshes afresh)."""
+#: how far a cached mesh's volume may lie from its exact body's (the faceting of a coarse mesh: -0.35 % at
+#: 2.5 mm on the default body, a few per cent at the coarsest size)
+VOLUME_TOLERANCE = 0.1
+
+
+def _verify_model(shape: Shape | CadBody, charge: bool, mass, rho_s, rho_c) -> None:
+    """Rank 0: the mesh in gmsh against what the shot asks for (_BadEntry when it disagrees): its tags (a shell,
+    a charge when asked, the outer surface), its mass (within 1 % of the one asked for: the sizing stops after five
+    tries, within MASS_TOLERANCE or not), and for an
+    exact body its volume (within VOLUME_TOLERANCE) and extent (the nodes within the calibre, from the tip at
+    y = 0 to the base at y = length, to 1e-6 of the length): an entry forged or damaged with a valid checksum is
+    not used."""
+    import gmsh
+
+    groups = set(gmsh.model.getPhysicalGroups())
+    need = {(3, tags.SHELL), (2, tags.OUTER)} | ({(3, tags.CHARGE)} if charge else set())
+    if need - groups:
+        raise _BadEntry(f"it lacks the tags {sorted(t for _, t in need - groups)}")
+    if charge != ((3, tags.CHARGE) in groups):
+        raise _BadEntry("its charge does not match the shot's")
+    if mass is not None and not isinstance(shape, CadBody) and shape.has_cavity:
+        got = _gmsh_mass(rho_s, rho_c)
+        if abs(got - mass) > max(MASS_TOLERANCE, 0.01 * mass):  # the sizing may stop short of its tolerance
+            raise _BadEntry(f"its mass is {got:.6g} kg, the shot's {mass:.6g} kg")
+    if isinstance(shape, CadBody):
+        return
+    volume = gmsh_model.tet_volumes(tags.SHELL).sum() + (gmsh_model.tet_volumes(tags.CHARGE).sum() if charge else 0.0)
+    exact = shape.outer_volume() if charge else shape.shell_volume()
+    if abs(volume / exact - 1.0) > VOLUME_TOLERANCE:
+        raise _BadEntry(f"its volume is {volume:.6g} m^3, the body's {exact:.6g} m^3")
+    x = np.asarray(gmsh.model.mesh.getNodes()[1]).reshape(-1, 3)
+    tol = 1e-6 * shape.length
+    radius = np.hypot(x[:, 0], x[:, 2])
+    if (abs(radius.max() - 0.5 * shape.diameter) > tol or abs(x[:, 1].min()) > tol
+            or abs(x[:, 1].max() - shape.length) > tol):
+        raise _BadEntry(f"its nodes span radius {radius.max():.6g} m and y {x[:, 1].min():.6g} to "
+                        f"{x[:, 1].max():.6g} m, the body's {0.5 * shape.diameter:.6g} m and 0 to {shape.length:.6g} m")
+
+
+def _read_entry(key: str, msh: Path, side: Path, verify: tuple) -> Shape | CadBody | None:
+    """Rank 0: open a checked cache entry in gmsh, verify it against the shot (_verify_model, with ``verify``:
+    charge, mass and densities) and return its shape; or, for an entry that fails a check or cannot be read,
+    log one warning, delete the entry and return None (the caller meshes afresh)."""
     import gmsh
 
     opened = False
@@ -245,6 +285,7 @@ def _read_entry(key: str, msh: Path, side: Path) -> Shape | CadBody | None:
         gmsh.open(str(msh))
         if 4 not in gmsh.model.mesh.getElementTypes(3):  # 4: tetrahedra
             raise _BadEntry(f"{msh.name} holds no tetrahedra")
+        _verify_model(shape, *verify)
         return shape
     except Exception as e:  # whatever is wrong with an entry, it is rebuilt
         why = str(e) if isinstance(e, _BadEntry) else f"cannot be read ({type(e).__name__}: {e})"
@@ -260,6 +301,24 @@ def _read_entry(key: str, msh: Path, side: Path) -> Shape | CadBody | None:
             except OSError:
                 pass
         return None
+
+
+_warned_shared: set[str] = set()
+
+
+def _warn_if_shared(folder: Path) -> None:
+    """One warning per process when the cache directory can be written by other users: its entries are used
+    only after _verify_model's checks, as every entry is."""
+    import stat
+
+    try:
+        mode = folder.stat().st_mode
+    except OSError:
+        return
+    if mode & (stat.S_IWGRP | stat.S_IWOTH) and str(folder) not in _warned_shared:
+        _warned_shared.add(str(folder))
+        logging.getLogger("fepen").warning(f"mesh cache {folder} can be written by other users: each entry is used "
+                                           "only after its mass, volume, extent and tags match the shot's")
 
 
 def _write_entry(msh: Path, side: Path, shape: Shape | CadBody, seconds: float) -> None:
@@ -296,7 +355,8 @@ def _mesh_on_root(shape: Shape | CadBody, opts, charge: bool, mass, rho_s, rho_c
     key = _key(shape, opts, charge, mass, rho_s, rho_c)
     msh, side = folder / f"{key}.msh", folder / f"{key}.json"
     if use_cache and side.is_file():
-        cached = _read_entry(key, msh, side)
+        _warn_if_shared(folder)
+        cached = _read_entry(key, msh, side, (charge, mass, rho_s, rho_c))
         if cached is not None:
             return cached, 0.0, True
 

@@ -14,7 +14,7 @@ from xml.sax.saxutils import quoteattr
 import numpy as np
 from mpi4py import MPI
 
-from fepen.atomic import replacing
+from fepen.atomic import make_dir, replacing
 
 #: what fields.xdmf says of its own frame and units (an Information element of its Domain)
 FRAME = ("fepen field output. Frame: the target's, in metres; the target face is the plane y = 0 and the target "
@@ -65,7 +65,7 @@ class FieldWriter:
         geom = self._gather(solver.X0[: self._n_owned])  # the undeformed, unworn body
         if self.comm.rank == 0:
             assert sum(counts_n) == self.n_nodes_global and sum(counts_c) == self.n_cells_global
-            self.dir.mkdir(parents=True, exist_ok=True)
+            make_dir(self.dir)  # fepen's or new, never a link
             mesh_file = self.dir / "mesh.h5"
             if not self.times or not mesh_file.exists():
                 self._write_h5(mesh_file, {"geometry": geom, "topology": topo})

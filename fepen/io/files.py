@@ -14,7 +14,8 @@ from fepen.errors import InputError, MachineFault, describe_os_error
 from fepen.version import __version__
 
 #: the environment variable that injects a write fault (tests): ``KIND:K[,KIND:K...]`` raises ENOSPC at the
-#: K-th write of KIND in this process ("history", "fields", "checkpoint", "summary")
+#: K-th write of KIND in this process ("history", "fields", "checkpoint", "summary", "reserve": the space a run
+#: holds back, "figure": a picture)
 INJECT = "FEPEN_INJECT_FAULT"
 _writes: dict[str, int] = {}
 
@@ -47,16 +48,21 @@ def agree(comm: MPI.Comm, what: str, fn, root_only: bool = True):
     Raises:
         MachineFault: on every rank, when the write raised an OSError on any rank (disk full, permission);
             the file it was replacing is left as it was (fepen.atomic).
+        InputError: on every rank, when the write was refused on any rank (fepen.atomic.ForeignFile: a file
+            fepen did not write, or a link, in its way).
     """
     result, error = None, None
     if comm.rank == 0 or not root_only:
         try:
             result = fn()
+        except InputError as err:  # a file fepen did not write in the way (fepen.atomic.ForeignFile)
+            error = ("input", err.key, err.message)
         except OSError as err:
-            error = f"{describe_os_error(err)} writing {what}"
+            error = ("fault", None, f"{describe_os_error(err)} writing {what}")
     errors = [e for e in comm.allgather(error) if e] if comm.size > 1 else [e for e in (error,) if e]
     if errors:
-        raise MachineFault(errors[0])
+        kind, key, message = errors[0]
+        raise InputError(key, message) if kind == "input" else MachineFault(message)
     return result
 
 
@@ -71,7 +77,7 @@ def versions() -> dict[str, str]:
     from fepen import dolfinx_api
 
     out = {"fepen": __version__, "python": platform.python_version(), "numpy": numpy.__version__,
-           "mpi": MPI.Get_library_version().splitlines()[0].strip()}
+           "mpi": MPI.Get_library_version().replace("\0", "").splitlines()[0].strip()}
     out.update(dolfinx_api.versions())
     if "gmsh" in sys.modules:
         out["gmsh"] = sys.modules["gmsh"].__version__

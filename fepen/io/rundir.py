@@ -1,24 +1,30 @@
-"""A results directory that cannot be mistaken (docs/results.md, "What a run directory holds"):
+"""A results directory fepen owns by manifest (docs/results.md, "What a run directory holds"):
 
-- a run into a directory that holds another run's results refuses (InputError naming --force and --resume),
-  or, with force, first removes what a fepen run writes there (OUTPUT_NAMES; nothing else);
+- ``run.json`` records the run: the command line, ranks, fepen version and code revision, host, start and end
+  time, outcome and exit code (of the first run and of every resume), the digest of its inputs, and ``files``:
+  the manifest, every top-level name this run (and the runs it resumes) wrote, updated as each new name is
+  written (fepen.atomic.Claim);
+- a run into a directory that holds another run's results refuses (InputError naming --force and --resume);
+  with force it first removes exactly the names that run's manifest lists, never by pattern, and nothing in a
+  directory that holds no fepen run; a directory whose last run ended before it wrote any result (a full disk at
+  its claim) is taken over;
+- no run writes over, or through, a name it does not own: a user's file or link with a name a run writes is
+  refused before the run starts (RUN_NAMES), and any other at its write (fepen.atomic.ForeignFile);
 - a lock file ``.fepen.lock`` (host, pid, start) keeps a second run out while the first goes on; a lock left
   by a process that no longer exists on this host is stale and taken over with a warning;
-- ``run.json``: the command line, ranks, fepen version and code revision, host, start and end time, outcome
-  and exit code (of the first run and of every resume);
 - ``fepen.log``: what the console showed on rank 0 (the lines said before the directory was claimed
-  included), plus the warnings of any rank.
+  included), plus the warnings of any rank; opened without following links.
 """
 
 from __future__ import annotations
 
 import errno
-import fnmatch
 import json
 import logging
 import os
 import shutil
 import socket
+import stat
 import subprocess
 import sys
 import time
@@ -26,21 +32,31 @@ from pathlib import Path
 
 from mpi4py import MPI
 
+from fepen import atomic
 from fepen.atomic import replacing
 from fepen.errors import InputError, MachineFault, describe_os_error
+from fepen.io.files import _make_directory, inject
 from fepen.version import __version__
 
 LOCK = ".fepen.lock"
 #: space held back while a run goes on, given back to write the record of a stop on a full disk
 RESERVE, RESERVE_BYTES = ".fepen.reserve", 256 * 1024
-#: a directory holding one of these holds a run's results
-MARKERS = ("summary.json", "run.json", "history.csv", "fields.xdmf", "checkpoint")
-#: what a fepen run writes into its directory: ``--force`` removes these and nothing else
-OUTPUT_NAMES = ("summary.json", "run.json", "fepen.log", "scene.toml", "history.csv", "history.png", "checkpoint",
-                "probes.csv",
-                "fields.xdmf", "fields.h5", "fields.d", "fields_*.xdmf", "fields_*.h5", "view.py", "*.png",
-                "accelerations.csv", "gauges*.csv", "hazard*.csv", "sections*.csv", "charge*.csv", "charge*.json",
-                "nose_profile*.csv", "profile*.csv", "strains*.csv", "*.vtu", "*.tmp*", "run.log", RESERVE)
+#: the names of a run's record: a directory whose manifest holds nothing else holds no results
+RECORD_NAMES = frozenset({"run.json", "fepen.log", RESERVE})
+#: every top-level name a fepen run may write into its directory (a user's file or link of one of these names
+#: is refused before the run starts; any other name is checked when written)
+RUN_NAMES = frozenset({
+    "summary.json", "run.json", "fepen.log", "scene.toml", RESERVE, "history.csv", "history.png", "probes.csv",
+    "fields.xdmf", "fields.h5", "fields.d", "checkpoint", "view.py", "accelerations.csv", "hazard.csv",
+    "hazard.png", "strains.csv", "nose_profile.csv", "nose_profile.png", "stress_maps_peak.png",
+    "stress_maps_peak.vtu", "stress_maps_end.png", "stress_maps_end.vtu", "trajectory.png", "deformed.png",
+    "charge_sections.csv", "charge_histories.png", "stress_maps.png", "stress_maps.vtu", "cross_sections.png",
+    "cross_sections.vtu", "interface.png"})
+#: what ``fepen mesh`` writes
+MESH_NAMES = frozenset({"run.json", "fepen.log", RESERVE, "mesh.json", "scene.toml", "mesh.xdmf", "mesh.h5",
+                        "mesh.vtu", "mesh_facets.xdmf", "mesh_facets.vtu", "mesh.png"})
+#: the largest run.json or lock file read back (bytes): a record is small; anything larger is not fepen's
+RECORD_MAX = 4 << 20
 
 _log_path: Path | None = None
 _transcript: list[str] = []
@@ -78,7 +94,15 @@ def forget() -> None:
 def release_reserve() -> None:
     """Give back the space the run held (rank 0): the record of a stop fits in it on a full disk."""
     if _log_path is not None:
-        (_log_path.parent / RESERVE).unlink(missing_ok=True)
+        _remove_reserve(_log_path.parent)
+
+
+def _remove_reserve(out: Path) -> None:
+    """Remove the reserve file (a name, never what a link there points to)."""
+    try:
+        os.unlink(out / RESERVE)
+    except FileNotFoundError:
+        pass
 
 
 def log_line(line: str) -> None:
@@ -93,9 +117,9 @@ def log_line(line: str) -> None:
 
 def _append(path: Path, lines) -> None:
     try:
-        with open(path, "a") as f:
+        with atomic.open_append(path) as f:  # never through a link
             f.write("".join(f"{ln}\n" for ln in lines))
-    except OSError:  # the log is a record, never a reason to stop a run
+    except (OSError, atomic.ForeignFile):  # the log is a record, never a reason to stop a run
         pass
 
 
@@ -152,34 +176,91 @@ def _alive(pid: int) -> bool:
     return True
 
 
+def _plain_name(name) -> bool:
+    """A manifest entry fepen can have written: one name in the directory, no path."""
+    return (isinstance(name, str) and name not in ("", ".", "..", LOCK) and "/" not in name and "\0" not in name
+            and "\\" not in name)
+
+
+def read_record(out: Path) -> tuple[dict | None, str | None]:
+    """The record (run.json) of the last fepen command in ``out``: (record, None); (None, None) when there is
+    none; (None, why) when a run.json there is not one fepen wrote (a link, not JSON, not a record, too large)."""
+    path = Path(out) / "run.json"
+    try:
+        st = os.lstat(path)
+    except FileNotFoundError:
+        return None, None
+    if stat.S_ISLNK(st.st_mode) or not stat.S_ISREG(st.st_mode):
+        return None, "a link or not a regular file"
+    if st.st_size > RECORD_MAX:
+        return None, f"{st.st_size} bytes, not a record fepen wrote"
+    try:
+        rec = json.loads(path.read_text())
+    except (OSError, ValueError):
+        return None, "not a record fepen wrote (not JSON)"
+    if not isinstance(rec, dict) or not isinstance(rec.get("command"), list) or "fepen" not in rec:
+        return None, "not a record fepen wrote"
+    return rec, None
+
+
+def manifest(record: dict) -> set[str] | None:
+    """The names a record's runs wrote (its "files"), or None when it keeps no valid manifest (an earlier fepen)."""
+    files = record.get("files")
+    if not isinstance(files, list) or not all(_plain_name(f) for f in files):
+        return None
+    return set(files)
+
+
+def results_in(record: dict) -> list[str]:
+    """The result files a record lists (its manifest without the record itself and the scene)."""
+    return sorted((manifest(record) or set()) - RECORD_NAMES - {"scene.toml"})
+
+
+def _names(names) -> str:
+    names = sorted(names)
+    return ", ".join(names[:4]) + (f" and {len(names) - 4} more" if len(names) > 4 else "")
+
+
 class RunDirectory:
-    """The claim of one run on its results directory (rank 0 does the file work; every rank gets the verdict).
+    """The claim of one command on its results directory (rank 0 does the file work; every rank gets the
+    verdict and the claim of fepen.atomic that guards every write).
 
     Args:
         out: the results directory.
         comm: the run's communicator.
-        mode: "new" (refuse a directory holding results), "force" (remove them first) or "resume".
+        mode: "new" (refuse a directory holding results), "force" (remove the files its manifest lists first)
+            or "resume".
         command: the command line to record (default: the one begin_command set, else this process's).
+        kind: what the command is ("run", "mesh"): a new "mesh" replaces an earlier mesh's files as a new run
+            never replaces a run's.
+        inputs: the digest of the run's inputs, recorded (a resume compares its own with it).
     """
 
-    def __init__(self, out, comm=MPI.COMM_WORLD, mode: str = "new", command: list[str] | None = None):
-        self.out, self.comm, self.mode = Path(out), comm, mode
+    def __init__(self, out, comm=MPI.COMM_WORLD, mode: str = "new", command: list[str] | None = None,
+                 kind: str = "run", inputs: dict | None = None):
+        self.out, self.comm, self.mode, self.kind = Path(out), comm, mode, kind
         if command is None:
             command = _command_line or [Path(sys.argv[0]).name, *sys.argv[1:]]
         self.command = list(command)
+        self.names = MESH_NAMES if kind == "mesh" else RUN_NAMES
+        self.inputs = inputs
         self.record: dict = {}
+        self.claim: atomic.Claim | None = None
 
     # ------------------------------------------------------------------------------------------------
     def __enter__(self) -> RunDirectory:
         global _log_path
         _log_path = None  # lines from here on belong to this run
         tee_logging(self.comm.rank)
-        problem = self._claim() if self.comm.rank == 0 else None
+        verdict = self._claim() if self.comm.rank == 0 else None
         if self.comm.size > 1:
-            problem = self.comm.bcast(problem, root=0)
+            verdict = self.comm.bcast(verdict, root=0)
+        problem, owned = verdict
         if problem is not None:
             kind, key, message = problem
             raise MachineFault(message) if kind == "fault" else InputError(key, message)
+        if self.comm.rank != 0:  # links only: rank 0 makes and records every top-level name
+            self.claim = atomic.claim(self.out, owned, strict=False)
         _log_path = self.out / "fepen.log"
         if self.comm.rank == 0:
             _append(_log_path, [f"# {_now()} {self.mode}: {' '.join(self.command)}", *_transcript])
@@ -194,39 +275,110 @@ class RunDirectory:
         else:
             o = stop_outcome(err)
             outcome, code = o.name, o.exit_code
-        if self.comm.rank == 0:
-            self._close(outcome, code, None if err is None else str(err).splitlines()[0] if str(err) else kind.__name__)
+        try:
+            if self.comm.rank == 0:
+                self._close(outcome, code,
+                            None if err is None else str(err).splitlines()[0] if str(err) else kind.__name__)
+        finally:
+            atomic.release(self.claim)
+
+    @property
+    def written(self) -> list[str]:
+        """The names the directory's manifest lists that are there now (rank 0), sorted."""
+        if self.claim is None:
+            return []
+        return sorted(n for n in self.claim.owned if n != RESERVE and os.path.lexists(self.out / n))
 
     # ------------------------------------------------------------------------------------------------
-    def _claim(self) -> tuple | None:
-        """Rank 0: check, lock and record. None, or (kind, key, message) of the refusal."""
-        from fepen.io.files import _make_directory
-
+    def _claim(self) -> tuple:
+        """Rank 0: check, lock, clear (force) and record. (None, the owned names), or ((kind, key, message) of
+        the refusal, ())."""
         made = _make_directory(self.out)
         if made is not None:
-            return made[0], "--out", made[1]
+            return (made[0], "--out", made[1]), ()
         key = "--resume" if self.mode == "resume" else "--out"
         try:
             held = self._lock()
             if held:
-                return "input", key, held
-            if self.mode == "new":
-                found = [m for m in MARKERS if (self.out / m).exists()]
-                if found:
-                    self._unlock()
-                    return "input", "--out", (f"{self.out} holds another run's results ({', '.join(found)}): "
-                                              "add --force to clear them first, or continue that run with "
-                                              f"`fepen run --resume {self.out}`, or name another --out")
-            elif self.mode == "force":
-                self._clear()
+                return ("input", key, held), ()
+            refused = self._previous()
+            if isinstance(refused, str):
+                self._unlock()
+                return ("input", key, refused), ()
+            owned = refused
+            self.claim = atomic.claim(self.out, owned, on_new=self._new_name)
+            for name in ("run.json", "fepen.log", RESERVE):
+                self.claim.owned.add(name)
             self._write_record()
-            with open(self.out / RESERVE, "wb") as f:
-                f.write(b"\0" * RESERVE_BYTES)
         except OSError as err:
             self._unlock()
+            atomic.release(self.claim)
             bad = err.errno in (errno.ENOSPC, errno.EDQUOT, errno.EIO)
-            return ("fault" if bad else "input"), key, f"{describe_os_error(err)} in {self.out}"
-        return None
+            return (("fault" if bad else "input"), key, f"{describe_os_error(err)} in {self.out}"), ()
+        try:
+            _remove_reserve(self.out)  # a killed run's (its manifest's: a foreign one or a link was refused above)
+            with atomic.create_new(self.out / RESERVE) as f:
+                f.write(b"\0" * (RESERVE_BYTES // 2))
+                inject("reserve")
+                f.write(b"\0" * (RESERVE_BYTES - RESERVE_BYTES // 2))
+        except OSError as err:  # a disk too small for the reserve: the record says so, and nothing is left
+            message = f"{describe_os_error(err)} in {self.out} (holding back {RESERVE_BYTES >> 10} KiB for the record)"
+            self._abandon(message)
+            return ("fault", key, message), ()
+        return None, set(self.claim.owned)
+
+    def _previous(self) -> set[str] | str:
+        """Rank 0, the lock held: the names of the earlier command's files that this one may replace (removed
+        first by force, or when that command left no results), or the refusal's message."""
+        rec, foreign = read_record(self.out)
+        if foreign:
+            return (f"{self.out / 'run.json'} is {foreign}: fepen writes its record there and never replaces a "
+                    "file it did not write; move it away or name another --out")
+        owned: set[str] = set()
+        if rec is not None:
+            files = manifest(rec)
+            if files is None:
+                return (f"{self.out} holds the results of an earlier fepen, which kept no manifest of its files: "
+                        "fepen removes only what a manifest lists; remove them by hand, or name another --out")
+            results = results_in(rec)
+            same_kind = rec.get("kind", "run") == self.kind == "mesh"
+            if self.mode == "new" and results and not same_kind:
+                return (f"{self.out} holds another run's results ({_names(results)}): add --force to remove "
+                        f"them first (exactly the files that run wrote), or continue that run with "
+                        f"`fepen run --resume {self.out}`, or name another --out")
+            owned = files
+        elif self.mode == "resume":
+            return f"{self.out} holds no fepen run to resume (no run.json)"
+        blocking = [n for n in sorted(self.names | owned) if os.path.lexists(self.out / n)
+                    and (n not in owned or os.path.islink(self.out / n))]
+        if blocking:
+            what = ", ".join(f"{n} (a link)" if os.path.islink(self.out / n) else n for n in blocking[:4])
+            return (f"{self.out} holds {what}, which fepen did not write and this {self.kind} would replace: fepen "
+                    "never overwrites a file it did not write; move it away or name another --out")
+        if rec is not None and self.mode != "resume":
+            if self.mode == "new":
+                logging.getLogger("fepen").info(f"{self.out}: the files of its last {rec.get('kind', 'run')} "
+                                                f"({rec.get('outcome')}) are replaced")
+            self._clear(owned)
+            owned = set()
+        return owned
+
+    def _new_name(self, name: str) -> None:
+        """A name newly written into the directory: the manifest in run.json at once (rank 0)."""
+        if self.record:
+            self._save()
+
+    def _abandon(self, message: str) -> None:
+        """A claim that cannot go on (a full disk at the reserve): no reserve, the record's outcome, no lock."""
+        _remove_reserve(self.out)
+        self.claim.owned.discard(RESERVE)
+        self.record.update(end=_now(), outcome="fault", exit_code=4, message=message)
+        try:
+            self._save()
+        except OSError:
+            pass
+        self._unlock()
+        atomic.release(self.claim)
 
     def _lock(self) -> str | None:
         """Take the lock file; a message when another live run holds it."""
@@ -234,12 +386,16 @@ class RunDirectory:
         mine = {"host": socket.gethostname(), "pid": os.getpid(), "start": _now(), "command": self.command}
         for _ in range(2):
             try:
-                fd = os.open(path, os.O_CREAT | os.O_EXCL | os.O_WRONLY, 0o644)
+                fd = os.open(path, os.O_CREAT | os.O_EXCL | os.O_WRONLY | getattr(os, "O_NOFOLLOW", 0), 0o644)
             except FileExistsError:
+                st = os.lstat(path)
+                if stat.S_ISLNK(st.st_mode) or not stat.S_ISREG(st.st_mode) or st.st_size > RECORD_MAX:
+                    return f"{path} is not a lock fepen wrote (a link or another file): move it away"
                 try:
                     other = json.loads(path.read_text())
                 except (OSError, ValueError):
                     other = {}
+                other = other if isinstance(other, dict) else {}
                 host, pid = other.get("host"), other.get("pid")
                 if host == mine["host"] and isinstance(pid, int) and not _alive(pid):
                     logging.getLogger("fepen").warning(f"{path}: a stale lock of process {pid} (no longer "
@@ -258,25 +414,29 @@ class RunDirectory:
     def _unlock(self) -> None:
         path = self.out / LOCK
         try:
-            if json.loads(path.read_text()).get("pid") == os.getpid():
+            if not path.is_symlink() and json.loads(path.read_text()).get("pid") == os.getpid():
                 path.unlink()
-        except (OSError, ValueError):
+        except (OSError, ValueError, AttributeError):
             pass
 
-    def _clear(self) -> None:
-        """Remove what a fepen run writes (OUTPUT_NAMES), nothing else."""
-        for entry in self.out.iterdir():
-            if entry.name != LOCK and any(fnmatch.fnmatch(entry.name, p) for p in OUTPUT_NAMES):
-                shutil.rmtree(entry) if entry.is_dir() and not entry.is_symlink() else entry.unlink()
+    def _clear(self, names: set[str]) -> None:
+        """Remove exactly ``names`` (the earlier command's manifest; links among them were refused before)."""
+        for name in sorted(names):
+            path = self.out / name
+            try:
+                st = os.lstat(path)
+            except FileNotFoundError:
+                continue
+            if stat.S_ISDIR(st.st_mode):
+                shutil.rmtree(path)  # never follows a link inside
+            else:
+                path.unlink()
 
     def _write_record(self) -> None:
         path = self.out / "run.json"
         earlier = {}
         if self.mode == "resume" and path.is_file():
-            try:
-                earlier = json.loads(path.read_text())
-            except ValueError:
-                earlier = {}
+            earlier, _ = read_record(self.out)
         this = {"command": self.command, "cwd": os.getcwd(), "ranks": self.comm.size, "fepen": __version__,
                 "revision": revision(), "host": socket.gethostname(), "pid": os.getpid(), "start": _now(),
                 "end": None, "outcome": "running", "exit_code": None}
@@ -284,10 +444,11 @@ class RunDirectory:
             self.record = dict(earlier)
             self.record.setdefault("resumes", []).append(this)
         else:
-            self.record = this
+            self.record = {"kind": self.kind, **this, **({"inputs": self.inputs} if self.inputs else {})}
         self._save()
 
     def _save(self) -> None:
+        self.record["files"] = sorted(self.claim.owned)
         with replacing(self.out / "run.json") as tmp:
             tmp.write_text(json.dumps(self.record, indent=1) + "\n")
 
@@ -297,9 +458,11 @@ class RunDirectory:
 
         last.update(end=_now(), outcome=outcome, exit_code=code, **({"message": message} if message else {}),
                     versions=versions())  # at the end: dolfinx and PETSc are named when the run imported them
-        if "resumes" in self.record:  # the first invocation's record stays; the whole run's verdict beside it
+        refused = self.mode == "resume" and outcome == "bad-input"  # a refused resume leaves the run as it was
+        if "resumes" in self.record and not refused:  # the first invocation's record stays; the whole run's beside it
             self.record.update(final_outcome=outcome, final_exit_code=code)
-        (self.out / RESERVE).unlink(missing_ok=True)
+        _remove_reserve(self.out)
+        self.claim.owned.discard(RESERVE)
         try:
             self._save()
         except OSError:  # a full disk: run.json keeps its "running" record; the lock goes all the same

@@ -127,11 +127,22 @@ class Gauges:
         if self.comm.rank:
             return
         out = Path(out)
-        np.savetxt(out / "strains.csv", np.array(self.rows), delimiter=",", header=",".join(self.columns),
-                   comments="", fmt="%.9g")
-        np.savetxt(out / "hazard.csv", np.column_stack(haz), delimiter=",",
-                   header="axial_from_nose_mm,max_surface_peeq,peak_surface_von_mises_Pa", comments="", fmt="%.6g")
+        save_table(out / "strains.csv", np.array(self.rows), ",".join(self.columns), "%.9g")
+        save_table(out / "hazard.csv", np.column_stack(haz),
+                   "axial_from_nose_mm,max_surface_peeq,peak_surface_von_mises_Pa", "%.6g")
         hazard_figure(out, haz, np.array(self.rows), self.columns)
+
+
+def save_table(path: Path, rows: np.ndarray, header: str, fmt: str) -> None:
+    """A CSV table (one header line), replaced whole (fepen.atomic)."""
+    import io
+
+    from fepen.atomic import replacing
+
+    buf = io.StringIO()
+    np.savetxt(buf, rows, delimiter=",", header=header, comments="", fmt=fmt)
+    with replacing(path) as tmp:
+        tmp.write_text(buf.getvalue())
 
 
 def hazard_figure(out: Path, haz, rows: np.ndarray, columns: list[str]) -> Path:
@@ -258,7 +269,10 @@ def deformed_picture(solver, path: Path, title: str = "", peak_von_mises: np.nda
     plotter.view_vector((0.0, 0.0, 1.0), viewup=(0.0, 1.0, 0.0))
     head = run_title(Path(path).parent, "the deformed projectile, cut in the plane of incidence")
     plotter.add_text("\n".join(t for t in (head, title, scale) if t), font_size=10, color="black")
-    plotter.screenshot(str(path))
+    from fepen.atomic import replacing
+
+    with replacing(path, ".png") as tmp:
+        plotter.screenshot(str(tmp))
     plotter.close()
 
 
@@ -419,5 +433,4 @@ class ChargeSections:
     def write(self, out: Path) -> None:
         """charge_sections.csv (rank 0)."""
         if self.comm.rank == 0:
-            np.savetxt(Path(out) / "charge_sections.csv", np.array(self.rows), delimiter=",",
-                       header=",".join(self.columns), comments="", fmt="%.9g")
+            save_table(Path(out) / "charge_sections.csv", np.array(self.rows), ",".join(self.columns), "%.9g")

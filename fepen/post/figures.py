@@ -65,7 +65,10 @@ def mesh_picture(pm: fmesh.ProjectileMesh, path: Path, title: str = "") -> None:
     plotter.camera.zoom(1.6)
     if title:
         plotter.add_text(title, font_size=10, color="black")
-    plotter.screenshot(str(path))
+    from fepen.atomic import replacing
+
+    with replacing(path, ".png") as tmp:
+        plotter.screenshot(str(tmp))
     plotter.close()
 
 
@@ -100,10 +103,12 @@ def save_figure(fig, path, dpi: int = 110) -> Path:
         path.
     """
     from fepen.atomic import replacing
+    from fepen.io.files import inject
 
     path = Path(path)
     with replacing(path, ".png") as tmp:
         fig.savefig(tmp, dpi=dpi, format="png")
+        inject("figure")
     return path
 
 

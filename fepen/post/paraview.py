@@ -273,7 +273,10 @@ def plot(out: Path, field: str = "von_mises_Pa", time: float | None = None, png:
     plotter.camera.azimuth = 20
     plotter.camera.elevation = 15
     if png is not None:
-        plotter.screenshot(str(png))
+        from fepen.atomic import replacing
+
+        with replacing(png, ".png") as tmp:
+            plotter.screenshot(str(tmp))
         plotter.close()
     else:
         plotter.show()

@@ -1,6 +1,7 @@
 """Runs: one scene into one results directory.
 
     shot         the scene resolved once (Shot): the only reader of the scene in fepen.runs
+    budget       what a shot will cost, before it starts: mesh cells and memory, the rigid step
     setup        the builders of every law, shape and mesh from a scene (used by shot)
     run          the Run skeleton both fidelities share: loop, stop, summary, history rows
     rigid        RigidRun: the rigid body (no mesh by default)
@@ -23,8 +24,9 @@ from fepen.runs import setup, shot
 from fepen.runs.rigid import RigidRun
 from fepen.runs.shot import Shot, resolve
 
-__all__ = ["shot", "setup", "run", "rigid", "batch", "model", "deformable", "closing", "events", "outputs", "probes",
-           "checkpoint", "interrupts", "run_scene", "run_in_directory", "expected_end", "resolve", "Shot", "RigidRun"]
+__all__ = ["shot", "budget", "setup", "run", "rigid", "batch", "model", "deformable", "closing", "events", "outputs",
+           "probes", "checkpoint", "interrupts", "run_scene", "run_in_directory", "expected_end", "resolve", "Shot",
+           "RigidRun"]
 
 
 def expected_end(scene, sh: Shot) -> float:
@@ -88,15 +90,18 @@ def run_in_directory(scene, out, comm=MPI.COMM_WORLD, mode: str = "new", progres
 
     out = Path(out)
     sh = sh or resolve(scene)
-    with rundir.RunDirectory(out, comm, mode):
+    with rundir.RunDirectory(out, comm, mode, inputs=sh.inputs):
         if mode != "resume":
             files.agree(comm, "scene.toml", lambda: files.write_text(out / "scene.toml", sh.scene_toml, comm))
         try:
-            return run_scene(scene, out, comm, progress=progress, resume=resume, sh=sh)
-        finally:
-            if (out / "history.csv").exists():  # a full disk leaves the last one
+            summary = run_scene(scene, out, comm, progress=progress, resume=resume, sh=sh)
+        except BaseException:
+            if comm.rank == 0 and (out / "history.csv").is_file():  # the history a stop left, drawn
                 try:
-                    figures.history_figure(out, sh.experiment, comm)
-                except OSError:
-                    pass
+                    figures.history_figure(out, sh.experiment, MPI.COMM_SELF)
+                except Exception as err:  # noqa: BLE001 - the stop's own error is the one to report
+                    rundir.log_line(f"fepen: while stopping, history.png not drawn: {err}")
+            raise
+        finally:
             comm.barrier()
+    return summary

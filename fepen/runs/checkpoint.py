@@ -18,7 +18,7 @@ from pathlib import Path
 
 import numpy as np
 
-from fepen.atomic import replacing, sha256_file
+from fepen.atomic import make_dir, replacing, sha256_file
 from fepen.errors import InputError
 from fepen.io import files
 from fepen.version import __version__
@@ -44,7 +44,7 @@ def write(out: Path, comm, step: int, t: float, arrays: dict, meta: dict) -> Non
         meta: rank 0's small state (JSON-serialisable), stored in state.json.
     """
     d = Path(out) / "checkpoint"
-    files.agree(comm, f"{d}", lambda: d.mkdir(exist_ok=True))
+    files.agree(comm, f"{d}", lambda: make_dir(d))  # fepen's or new, never a link
     name = f"step{step:09d}-rank{comm.rank}.npz"
     digest = files.agree(comm, f"{d / name}", lambda: _save(d / name, arrays), root_only=False)
     digests = comm.gather(digest, root=0)

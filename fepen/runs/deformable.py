@@ -262,7 +262,8 @@ class DeformableRun(Run):
         big, small = self.components()
         arrays = {f"{name}.{k}": v for name, c in big.items() for k, v in c.state().items()}
         arrays["rows"] = np.array(self.rows, dtype=float)
-        meta = {"wall_s": self.wall_s, "components": {name: c.state() for name, c in small.items()},
+        meta = {"wall_s": self.wall_s, "inputs_sha256": self.shot.inputs.get("sha256"),
+                "components": {name: c.state() for name, c in small.items()},
                 "tip": self._tip_reference(),
                 "field_times_s": list(self.fields.times) if self.fields is not None else []}
         checkpoint.write(self.out, self.comm, self.solver.step_count, self.solver.t, arrays, meta)

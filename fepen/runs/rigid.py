@@ -27,14 +27,10 @@ from fepen.laws.rigid_body import (
     matrix_to_quat,
     tet_mass_properties,
 )
+from fepen.runs import budget, setup, shot
 from fepen.runs import probes as run_probes
-from fepen.runs import setup, shot
 from fepen.runs.run import Removal, Run, Snapshot
 
-#: default RK4 step: the time to travel this fraction of a diameter at the striking speed, and at most
-#: 1/STOP_STEPS of the time the quasi-static force alone would take to stop the projectile
-STEP_FRACTION = 0.2
-STOP_STEPS = 150
 #: load points per ring of the default (mesh-free) rigid body
 RING_SECTORS = 12
 
@@ -150,9 +146,7 @@ class RigidRun(Run):
         self.v0 = sh.speed
         self.state = RigidState(R @ c0, matrix_to_quat(R), v.copy(), np.zeros(3))
         self.crater = sh.crater(self.mass)
-        a = 0.5 * sh.nominal_diameter
-        t_stop = self.mass * self.v0 / (self.law.sigma_s * np.pi * a * a)
-        self.dt = sh.rigid_step or min(STEP_FRACTION * sh.nominal_diameter / self.v0, t_stop / STOP_STEPS)
+        self.dt = sh.rigid_step or budget.default_step(self.mass, self.v0, sh.nominal_diameter, self.law)
         self.tip_ref = np.zeros(3)
         self.tail_ref = np.array([0.0, self.shape.length, 0.0])
         self.tip_arm = self.tip_ref - self.body.centre0  # the tip about the centre, body frame

@@ -273,7 +273,11 @@ class Run:
         if self.crossings is not None:
             summary.update(self.crossings.summary(self.shot.law, 1e-3 * summary["depth_mm"]))
         summary.update(prediction(self.shot.envelope, outcome, summary))
-        if self.out is not None:
+        if self.out is not None:  # the figure first: summary.json is the last file of a run that ended well
+            from fepen.post import figures
+
+            files.agree(self.comm, "history.png",
+                        lambda: figures.history_figure(self.out, self.shot.experiment, MPI.COMM_SELF))
             results.write_summary(self.out, summary, self.comm)
         return summary
 

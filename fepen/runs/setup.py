@@ -315,10 +315,22 @@ def check_supported(scene, built: Built | None = None) -> Built:
         from fepen import dolfinx_api
 
         dolfinx_api.check_version()  # a mesh is made: only on the dolfinx releases fepen supports
+    if scene.effects.fidelity != "rigid" or isinstance(built.shape, CadBody):  # a volume mesh is made
+        check_mesh_cost(scene, MPI.COMM_WORLD, built)
     if scene.effects.fidelity == "rigid" and scene.target.kind != "concrete":
         raise InputError("effects.fidelity", "'rigid' runs against target.kind = 'concrete'; a rigid "
                                              "projectile on a rigid wall has nothing to compute")
     return built
+
+
+def check_mesh_cost(scene, comm, built: Built | None = None) -> dict:
+    """The mesh's expected cells and memory, refused before gmsh starts when too coarse for the body or past
+    mesh.max_cells or the machine's memory (fepen.runs.budget.check_mesh)."""
+    from fepen.runs import budget
+
+    built = built or projectile(scene)
+    return budget.check_mesh(built.shape, scene.mesh.size, scene.get("mesh.nose_size"), bool(scene.effects.charge),
+                             scene.mesh.max_cells, comm.size)
 
 
 def body_key(scene) -> tuple:

@@ -87,6 +87,8 @@ class Shot:
         probes: output.probes, the user's point and cell histories ({"name", "point", "kind"}, ...; each point
             checked inside the exact body: fepen.runs.probes.check_inside).
         envelope: what the validated envelope looks at (fepen.runs.setup.envelope_facts).
+        inputs: what the shot was made of (inputs_record): the resolved scene, the files it read by content and
+            their digest, recorded in run.json and in every checkpoint (a resume compares its own with it).
     """
 
     fidelity: str
@@ -114,6 +116,7 @@ class Shot:
     scene_toml: str = field(repr=False, default="")
     probes: tuple = ()
     envelope: dict = field(repr=False, default_factory=dict)
+    inputs: dict = field(repr=False, default_factory=dict)
 
     @property
     def rigid(self) -> bool:
@@ -190,6 +193,14 @@ def resolve(scene, toml: bool = True) -> Shot:
     R, v = setup.placement(scene)
     end = scene.get("run.end_time")
     materials = () if rigid else tuple(setup.materials(scene, built))
+    from fepen.runs import budget
+
+    if not rigid:
+        budget.check_outputs(_hard_end(law, end, float(np.linalg.norm(v)), "deformable"), scene.run.output_interval,
+                             bool(scene.run.fields), scene.run.checkpoint_interval)
+    else:
+        budget.check_rigid_step(scene.get("run.rigid_step"), built.shape, built.shell_density,
+                                float(np.linalg.norm(v)), law)
     e = scene.projectile.erosion
     probes = tuple(scene.get("output.probes") or ())
     run_probes.check_inside(built.shape, probes, scene.effects.charge)
@@ -202,7 +213,55 @@ def resolve(scene, toml: bool = True) -> Shot:
         charge_friction=scene.charge.friction, rigid_step=scene.get("run.rigid_step"),
         nominal_diameter=scene.projectile.diameter,
         experiment=scene.get("impact.shot"), scene=scene.as_dict(), body_key=setup.body_key(scene),
-        scene_toml=to_toml(scene) if toml else "", probes=probes, envelope=setup.envelope_facts(scene, built))
+        scene_toml=to_toml(scene) if toml else "", probes=probes, envelope=setup.envelope_facts(scene, built),
+        inputs=inputs_record(scene) if toml else {})
+
+
+def inputs_record(scene) -> dict:
+    """What a shot is made of, for run.json and its checkpoints: ``scene`` (every resolved key, flat), ``files``
+    ({path: SHA-256} of every file the projectile was read from: projectile.cad, .profile, .inner_profile) and
+    ``sha256``, the digest of both."""
+    import hashlib
+    import json
+    import os
+
+    from fepen.atomic import sha256_file
+    from fepen.scene import flatten
+
+    flat = flatten(scene.as_dict())
+    read = {}
+    for key in setup.FILE_KEYS:
+        path = scene.get(key)
+        if path:
+            path = os.path.abspath(path)
+            try:
+                read[path] = sha256_file(path)
+            except OSError as err:
+                from fepen.errors import InputError
+
+                raise InputError(key, f"cannot be read: {err.strerror or err} ({path})") from None
+    blob = json.dumps({"scene": flat, "files": read}, sort_keys=True, default=repr)
+    return {"sha256": hashlib.sha256(blob.encode()).hexdigest(), "scene": flat, "given": sorted(scene.explicit),
+            "files": read}
+
+
+def inputs_changed(recorded: dict | None, now: dict) -> str | None:
+    """What differs between a run's recorded inputs (inputs_record) and a resume's, in one phrase; None when the
+    same (or nothing was recorded: a run of an earlier fepen)."""
+    if not recorded or recorded.get("sha256") == now.get("sha256"):
+        return None
+    from fepen.scene.keys import shown
+
+    before, after = recorded.get("scene") or {}, now.get("scene") or {}
+    given = set(recorded.get("given") or ()) | set(now.get("given") or ())
+    keys = sorted((k for k in set(before) | set(after) if before.get(k) != after.get(k)),
+                  key=lambda k: (k not in given, k))  # the keys a user gives first, what follows from them after
+    parts = [f"{k} {shown(before.get(k, 'absent'))} -> {shown(after.get(k, 'absent'))}" for k in keys[:3]]
+    parts += [f"{len(keys) - 3} more keys"] if len(keys) > 3 else []
+    old_files, new_files = recorded.get("files") or {}, now.get("files") or {}
+    parts += [f"{path} changed since the run began" for path in sorted(set(old_files) | set(new_files))
+              if old_files.get(path) != new_files.get(path)][:2]
+    return "; ".join(parts) or "the inputs' digest differs"
 
 
 def of(shot_or_scene) -> Shot:

@@ -9,6 +9,7 @@ from __future__ import annotations
 
 import copy
 import difflib
+import os
 import tomllib
 from collections.abc import Callable
 from pathlib import Path
@@ -17,7 +18,7 @@ from typing import Any
 from fepen.data import CONSTANTS, STEELS, TARGETS, shot
 from fepen.errors import InputError
 from fepen.laws.target import a_over_c_cubed, cylinder_strength, youngs_modulus_aci
-from fepen.scene.keys import ABSENT, display_name
+from fepen.scene.keys import ABSENT, display_name, shown
 from fepen.scene.schema import SCHEMA, SECTIONS
 
 __all__ = ["Section", "Scene", "load", "resolve", "read_toml", "parse_set", "flatten", "unknown_key",
@@ -447,6 +448,10 @@ def _resolve_target(flat: dict, given: dict) -> None:
                                                            flat.get("target.strength_basis"))
 
 
+#: the keys that name a file the projectile is read from
+FILE_KEYS = ("projectile.cad", "projectile.profile", "projectile.inner_profile")
+
+
 def resolve(given: dict[str, Any]) -> Scene:
     """Validate user-given keys and fill in every default.
 
@@ -466,6 +471,9 @@ def resolve(given: dict[str, Any]) -> Scene:
         elif key.default is not ABSENT:
             flat[name] = key.default
 
+    for name in FILE_KEYS:  # a file is named by its absolute path: a run's scene.toml reads the same file from
+        if flat.get(name):  # any working directory (fepen run --resume)
+            flat[name] = os.path.abspath(flat[name])
     _resolve_shot(flat, given)
     _resolve_steel(flat, given)
     _resolve_target(flat, given)
@@ -533,10 +541,10 @@ def parse_set(item: str) -> tuple[str, Any]:
         (dotted key, value).
     """
     if "=" not in item:
-        raise InputError("--set", f"expected KEY=VALUE, got {item!r}")
+        raise InputError("--set", f"expected KEY=VALUE, got {shown(item)}")
     key, text = (s.strip() for s in item.split("=", 1))
     if not key:
-        raise InputError("--set", f"expected KEY=VALUE, got {item!r}")
+        raise InputError("--set", f"expected KEY=VALUE, got {shown(item)}")
     try:
         value = tomllib.loads(f"v = {text}")["v"]
     except ValueError:  # TOMLDecodeError, or an integer past Python's 4300 digits: a bare word
@@ -572,6 +580,24 @@ def set_item(key: str, value) -> str:
     return f"{key}={text}"
 
 
+#: the largest scene file read (bytes): a scene is a page of text; a larger file is refused before it is parsed
+SCENE_MAX = 1 << 20
+
+
+def read_capped(path: Path, limit: int, key: str, what: str) -> bytes:
+    """The bytes of a user's text file, refused (InputError naming ``key``) when larger than ``limit``: never
+    more than ``limit`` + 1 bytes are read."""
+    try:
+        with open(path, "rb") as fh:
+            data = fh.read(limit + 1)
+    except OSError as err:
+        raise InputError(key, f"cannot read {display_name(str(path), 200)}: {err.strerror or err}") from None
+    if len(data) > limit:
+        raise InputError(key, f"{display_name(str(path), 200)} is larger than {limit >> 10} KiB, the most {what} "
+                              "may be")
+    return data
+
+
 def read_toml(path: str | Path) -> dict[str, Any]:
     """Read a scene file into a flat {dotted key: value} dict, without validating the keys.
 
@@ -588,9 +614,9 @@ def read_toml(path: str | Path) -> dict[str, Any]:
         found = False
     if not found:
         raise InputError("SCENE", f"no such scene file: {display_name(str(p), 200)}")
+    data = read_capped(p, SCENE_MAX, "SCENE", "a scene file")
     try:
-        with open(p, "rb") as fh:
-            tree = tomllib.load(fh)
+        tree = tomllib.loads(data.decode())
     except ValueError as err:  # TOMLDecodeError, text that is not UTF-8, an integer past 4300 digits
         raise InputError("SCENE", f"{display_name(str(p), 200)} is not valid TOML: "
                                   f"{display_name(str(err), 200)}") from None

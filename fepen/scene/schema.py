@@ -334,6 +334,10 @@ SCHEMA: dict[str, Key] = {
     "mesh.rigid_panel": number(ABSENT, "m", 2.0e-4, 0.5,
                                doc="meridian panel of the rigid fidelity's load rings; absent: diameter / 6"),
     "mesh.nose_size": number(ABSENT, "m", 2.0e-4, 0.05, doc="element size at the nose tip; absent: mesh.size"),
+    "mesh.max_cells": number(1.0e6, "", 1.0e3, 1.0e9,
+                             doc="the most tetrahedra fepen meshes unless told more: a finer mesh.size is refused "
+                                 "before gmsh starts (about 2.2 kB per cell before the first step, 1e6 cells about "
+                                 "3.0 GB on one process); a mesh past the machine's memory is refused all the same"),
     "mesh.optimize": choice("netgen", "none", "gmsh", "netgen",
                             doc="tetrahedron optimiser; the stable step is set by the worst element"),
     # --- run control ---

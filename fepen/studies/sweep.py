@@ -49,6 +49,11 @@ from fepen.errors import InputError
 
 __all__ = ["Sweep", "read", "run", "table_rows", "resized", "DISTRIBUTIONS"]
 
+#: the most shots of one sweep: each shot's record is held in memory (about 5 kB), and every shot's scene is
+#: checked before the first runs; a larger study is several sweeps (another seed, or part of the grid each)
+MAX_SHOTS = 200_000
+#: the largest table of shots read (bytes)
+TABLE_MAX = 64 << 20
 #: distribution name: its parameters (mean absent: the base scene's value)
 DISTRIBUTIONS = {"normal": ("mean", "std"), "uniform": ("low", "high"),
                  "truncated-normal": ("mean", "std", "low", "high")}
@@ -229,13 +234,15 @@ def monte_carlo(distributions: dict, samples: int, seed: int, latin_hypercube: b
 def _read_table(path: Path) -> tuple[list, list]:
     """Keys and shots of a CSV table (header: scene keys; values in TOML syntax, bare words strings)."""
     try:
-        text = path.read_text()
-    except OSError as err:
-        raise InputError("table.file", f"cannot read {path}: {err.strerror}") from None
+        text = fscene.read_capped(path, TABLE_MAX, "table.file", "a table of shots").decode()
+    except UnicodeDecodeError:
+        raise InputError("table.file", f"{path} is not UTF-8 text") from None
     rows = list(csv.reader(io.StringIO(text)))
     rows = [r for r in rows if r and not r[0].lstrip().startswith("#")]
     if len(rows) < 2:
         raise InputError("table.file", f"{path} needs a header of scene keys and at least one row")
+    if len(rows) - 1 > MAX_SHOTS:
+        raise InputError("table.file", f"{path} holds {len(rows) - 1} shots; a sweep holds at most {MAX_SHOTS}")
     keys = [k.strip() for k in rows[0]]
     for k in keys:
         _check_key("table.file", k)
@@ -300,11 +307,12 @@ def read(path, sets=()) -> Sweep:
 def _load(path: Path) -> dict:
     import tomllib
 
+    if not path.is_file():
+        raise InputError("SWEEP", f"cannot read {fscene.display_name(str(path), 200)}: no such file")
+    data = fscene.read_capped(path, fscene.SCENE_MAX, "SWEEP", "a sweep file")
     try:
-        spec = tomllib.loads(path.read_text())
-    except OSError as err:
-        raise InputError("SWEEP", f"cannot read {path}: {err.strerror}") from None
-    except tomllib.TOMLDecodeError as err:
+        spec = tomllib.loads(data.decode())
+    except (tomllib.TOMLDecodeError, UnicodeDecodeError) as err:
         raise InputError("SWEEP", f"{path} is not valid TOML: {err}") from None
     return _sections(spec, str(path))
 
@@ -349,6 +357,11 @@ def _grid(grid) -> tuple[list, list]:
         _check_key("grid", k)
     values = {k: _grid_values(k, v) for k, v in values.items()}
     keys = list(values)
+    count = math.prod(len(v) for v in values.values())
+    if count > MAX_SHOTS:
+        sizes = " x ".join(f"{len(v)} ({k})" for k, v in values.items())
+        raise InputError("grid", f"{sizes} = {count} shots; a sweep holds at most {MAX_SHOTS}: split it into several "
+                                 "sweeps, or use [monte_carlo]")
     return keys, [dict(zip(keys, combo)) for combo in _product([values[k] for k in keys])]
 
 
@@ -358,8 +371,9 @@ def _monte_carlo(mc, resolved) -> tuple[list, list]:
         if k not in allowed:
             raise InputError(f"monte_carlo.{k}", f"not a key of [monte_carlo]; allowed: {', '.join(sorted(allowed))}")
     n = mc.get("samples")
-    if isinstance(n, bool) or not isinstance(n, int) or not 1 <= n <= 10_000_000:
-        raise InputError("monte_carlo.samples", f"an integer in [1, 10000000], got {n!r}")
+    if isinstance(n, bool) or not isinstance(n, int) or not 1 <= n <= MAX_SHOTS:
+        raise InputError("monte_carlo.samples", f"an integer in [1, {MAX_SHOTS}] (split a larger study into sweeps of "
+                                                f"other seeds), got {fscene.display_name(repr(n), 40)}")
     seed = mc.get("seed", 0)
     if isinstance(seed, bool) or not isinstance(seed, int) or seed < 0:
         raise InputError("monte_carlo.seed", f"a non-negative integer, got {seed!r}")

@@ -316,8 +316,8 @@ def plan(scene_path=None, scatter=None, sets=(), samples: int | None = None, see
     from fepen.studies import sweep, sweep_figures
 
     if samples is not None and (isinstance(samples, bool) or not isinstance(samples, int) or not 2 <= samples
-                                <= 10_000_000):
-        raise InputError("--samples", f"an integer in [2, 10000000], got {samples!r}")
+                                <= sweep.MAX_SHOTS):
+        raise InputError("--samples", f"an integer in [2, {sweep.MAX_SHOTS}], got {samples!r}")
     if seed is not None and (isinstance(seed, bool) or not isinstance(seed, int) or seed < 0):
         raise InputError("--seed", f"a non-negative integer, got {seed!r}")
     spec, path = {}, None

@@ -18,8 +18,8 @@ from mpi4py import MPI
 from fepen import scene as fscene
 from fepen.data import SHOTS
 from fepen.io import files
-from fepen.post import figures, paths
-from fepen.runs import run_scene, setup
+from fepen.post import paths
+from fepen.runs import run_in_directory, setup
 
 FIELDS = ["shot", "v0_m_s", "obliquity_deg", "attack_deg", "Hx_mm", "Hy_mm", "Tx_mm", "Ty_mm", "Hx_exp_mm",
           "Hy_exp_mm", "Tx_exp_mm", "Ty_exp_mm", "nose_error", "tail_error", "outcome", "wall_s"]
@@ -42,13 +42,12 @@ def validate(scene_path, sets, out, comm=MPI.COMM_WORLD) -> list[dict]:
         setup.check_supported(sc)
     out = files.prepare(out, comm)
     rows = []
-    summaries = _side_by_side(scenes, out) if _parallel(scenes, comm) else {}
+    summaries = _side_by_side(scene_path, base, scenes, out) if _parallel(scenes, comm) else {}
     for name, sc in scenes.items():
         if name in summaries:
             s = summaries[name]
-        else:
-            s = run_scene(sc, out / name, comm)
-            figures.history_figure(out / name, sc.get("impact.shot"), comm)
+        else:  # the study owns its shots' folders: each run replaces exactly what the one before wrote there
+            s = run_in_directory(sc, out / name, comm, "force")
         e = SHOTS[name]
         rows.append({"shot": name, "v0_m_s": e.v0, "obliquity_deg": e.obliquity_deg, "attack_deg": e.attack_deg,
                      "Hx_mm": s["Hx_mm"], "Hy_mm": s["Hy_mm"], "Tx_mm": s["Tx_mm"], "Ty_mm": s["Ty_mm"],
@@ -78,35 +77,38 @@ def _parallel(scenes, comm) -> bool:
     return comm.size == 1 and fid != "rigid" and (os.cpu_count() or 1) > 1
 
 
-def _side_by_side(scenes, out: Path) -> dict:
-    """Run each shot as its own ``fepen run`` process, as many at once as there are cores."""
+def _side_by_side(scene_path, base: list[str], scenes, out: Path) -> dict:
+    """Run each shot as its own ``fepen run`` process (the user's scene file and --set options, and the shot),
+    as many at once as there are cores; a failing shot's last line in the error."""
     import json
     import os
     import subprocess
     import sys
+    import tempfile
     import time
 
-    todo = list(scenes.items())
+    todo = list(scenes)
     running = []
     workers = min(os.cpu_count() or 1, len(todo))
     while todo or running:
         while todo and len(running) < workers:
-            name, sc = todo.pop(0)
-            d = files.prepare(out / name, MPI.COMM_SELF)
-            files.write_text(d / "scene.toml", fscene.to_toml(sc), MPI.COMM_SELF)
-            log = open(d / "run.log", "w")
-            proc = subprocess.Popen([sys.executable, "-m", "fepen", "run", str(d / "scene.toml"), "--out", str(d),
-                                     "--force"],
-                                    stdout=log, stderr=subprocess.STDOUT)
-            running.append((name, proc, log))
+            name = todo.pop(0)
+            argv = [sys.executable, "-m", "fepen", "run", *([str(scene_path)] if scene_path is not None else []),
+                    *(a for s in base for a in ("--set", s)), "--set", f'impact.shot="{name}"',
+                    "--out", str(out / name), "--force"]
+            log = tempfile.TemporaryFile("w+")  # the shot's console, read back only when it fails
+            running.append((name, subprocess.Popen(argv, stdout=log, stderr=subprocess.STDOUT), log))
         time.sleep(0.5)
         for item in list(running):
             name, proc, log = item
             if proc.poll() is not None:
-                log.close()
                 running.remove(item)
+                log.seek(0)
+                last = [ln for ln in log.read().splitlines() if ln.strip()][-1:]
+                log.close()
                 if proc.returncode != 0:
-                    raise RuntimeError(f"shot {name} failed (exit {proc.returncode}); see {out / name / 'run.log'}")
+                    raise RuntimeError(f"shot {name} failed (exit {proc.returncode}): {' '.join(last)}; see "
+                                       f"{out / name / 'fepen.log'}")
     return {name: json.loads((out / name / "summary.json").read_text()) for name in scenes}
 
 

@@ -4,7 +4,6 @@ run stops with exit 4 (or 2 for a checkpoint that cannot be trusted) and one lin
 summary.json that says why, and ``fepen run --resume`` then ends with the very results of an uninterrupted
 run, serially and on 2 ranks. The runs are whole processes."""
 
-import fnmatch
 import json
 import os
 import random
@@ -214,10 +213,11 @@ def test_damaged_or_foreign_checkpoint_is_refused(tmp_path):
     assert res.returncode == 2 and "--force" in lines[0] and "--resume" in lines[0]
 
 
-def test_force_clears_every_file_a_run_writes(whole):
-    """OUTPUT_NAMES covers everything a run with fields, gauges, profiles and pictures writes (so --force
-    leaves no file of the old run behind)."""
+def test_the_manifest_lists_every_file_a_run_writes(whole):
+    """run.json's manifest names every file a run with fields, gauges, profiles and pictures left in its
+    directory, and each is one of rundir.RUN_NAMES (checked before a run starts), so that --force removes exactly
+    the old run's files."""
     for out in whole.values():
-        names = [p.name for p in out.iterdir()]
-        stray = [n for n in names if not any(fnmatch.fnmatch(n, p) for p in rundir.OUTPUT_NAMES)]
-        assert not stray, stray
+        names = {p.name for p in out.iterdir()}
+        files = set(json.loads((out / "run.json").read_text())["files"])
+        assert names <= files <= rundir.RUN_NAMES, (names - files, files - rundir.RUN_NAMES)

@@ -111,9 +111,41 @@ def unreadable(msh, side):
     side.write_text(json.dumps({**meta, "sha256": hashlib.sha256(msh.read_bytes()).hexdigest()}))
 
 
+def _move_nodes(msh, side, move):
+    """Move the nodes of an ASCII MSH 4.1 file with ``move`` ((n, 3) -> (n, 3)) and recompute the sidecar's
+    checksum: a forged entry that passes every check of the file itself."""
+    lines = msh.read_text().splitlines()
+    i = lines.index("$Nodes") + 1
+    blocks = int(lines[i].split()[0])
+    i += 1
+    for _ in range(blocks):
+        parametric, count = int(lines[i].split()[2]), int(lines[i].split()[3])
+        first = i + 1 + count
+        for k in range(first, first + count):
+            xyz = np.array([float(v) for v in lines[k].split()[:3]])
+            rest = lines[k].split()[3:]
+            lines[k] = " ".join(repr(float(v)) for v in move(xyz[None, :])[0]) + (" " + " ".join(rest) if rest else "")
+        i = first + count
+        assert parametric in (0, 1)
+    msh.write_text("\n".join(lines) + "\n")
+    meta = json.loads(side.read_text())
+    side.write_text(json.dumps({**meta, "sha256": hashlib.sha256(msh.read_bytes()).hexdigest()}))
+
+
+def forged_shrunk(msh, side):
+    """Every node pulled 20 % toward the axis (a 0.235 kg body for a 0.367 kg scene, as found in issue 43)."""
+    _move_nodes(msh, side, lambda x: x * np.array([0.8, 1.0, 0.8]))
+
+
+def forged_longer(msh, side):
+    """The base pushed 0.5 mm back: mass and volume within their tolerances, the extent not."""
+    _move_nodes(msh, side, lambda x: np.where(x[:, 1:2] > 0.14, x + np.array([0.0, 0.0005, 0.0]), x))
+
+
 @pytest.mark.parametrize("damage, why", [
     (truncate, "SHA-256"), (flip_byte, "SHA-256"), (foreign_version, "fepen '0.0.0-foreign'"),
     (not_json, "not JSON"), (old_entry, "lacks sha256"), (unreadable, "cannot be read"),
+    (forged_shrunk, "mass"), (forged_longer, "nodes span"),
 ])
 def test_a_bad_entry_is_rebuilt_with_one_warning(cache, pristine, monkeypatch, warnings, damage, why):
     msh, side = entry(cache)
@@ -136,3 +168,20 @@ def test_a_bad_entry_is_rebuilt_with_one_warning(cache, pristine, monkeypatch, w
     again = build(cache, monkeypatch)
     assert again.cached and np.array_equal(again.mesh.geometry.x, pristine[1])
     assert len(warnings.records) == 1
+
+
+def test_a_cache_others_can_write_is_named_once_and_its_entries_still_checked(cache, pristine, monkeypatch, warnings):
+    """A cache directory writable by other users: one warning naming it, and a forged entry in it is still
+    rebuilt (issue 43: a writable FEPEN_MESH_CACHE once served a forged mesh silently)."""
+    import os
+
+    os.chmod(cache, 0o777)
+    mesh._warned_shared.clear()
+    msh, side = entry(cache)
+    forged_shrunk(msh, side)
+    pm = build(cache, monkeypatch)
+    assert not pm.cached and np.array_equal(pm.mesh.geometry.x, pristine[1])
+    lines = [r.getMessage() for r in warnings.records]
+    assert any("can be written by other users" in ln for ln in lines) and any("mass" in ln for ln in lines)
+    build(cache, monkeypatch)
+    assert sum("can be written by other users" in r.getMessage() for r in warnings.records) == 1

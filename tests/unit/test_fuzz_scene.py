@@ -402,7 +402,7 @@ def empty_dir(tmp_path, monkeypatch):
     def ran(*args, **kwargs):
         raise RuntimeError("the fuzz's argument list started a run")
 
-    for owner, name in [(api, "run"), (runs, "run_scene"), (validate, "run_scene"), (setup, "mesh"),
+    for owner, name in [(api, "run"), (runs, "run_scene"), (validate, "run_in_directory"), (setup, "mesh"),
                         (fmesh, "create"), (accuracy_cost, "study"), (depth, "predict_sets"), (subprocess, "Popen")]:
         monkeypatch.setattr(owner, name, ran)
     monkeypatch.chdir(tmp_path)

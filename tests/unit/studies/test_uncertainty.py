@@ -114,7 +114,7 @@ UNC = ["study", "uncertainty", "--out", "out", "--set", "effects.fidelity=rigid"
 
 
 @pytest.mark.parametrize("argv, text, key, words", [
-    (UNC + ["--samples", "1"], None, "--samples", r"an integer in \[2, 10000000\], got 1"),
+    (UNC + ["--samples", "1"], None, "--samples", r"an integer in \[2, 200000\], got 1"),
     (UNC + ["--seed", "-3"], None, "--seed", r"a non-negative integer, got -3"),
     (UNC + ["--samples", "many"], None, "command line", r"invalid int value: 'many'"),
     (UNC + ["--scatter", "nowhere.toml"], None, "--scatter", r"cannot read nowhere.toml"),
