@@ -8,6 +8,7 @@ from __future__ import annotations
 import ctypes
 import hashlib
 import os
+import stat
 import subprocess
 from pathlib import Path
 
@@ -39,14 +40,44 @@ def cache_dir() -> Path:
     return Path(base) / "fepen"
 
 
+def _private(path: Path) -> bool:
+    """Whether only this user (or root) can have written ``path``: owned by them, not a link, not writable by
+    the group or others. A library that others could have replaced is code others could run as this user."""
+    try:
+        st = os.lstat(path)
+    except OSError:
+        return False
+    return (not stat.S_ISLNK(st.st_mode) and st.st_uid in (os.getuid(), 0)
+            and not st.st_mode & (stat.S_IWGRP | stat.S_IWOTH))
+
+
+_own_dir: list[Path] = []
+
+
+def _folder() -> Path:
+    """cache_dir(), or, when others can write it, a private folder of this process's (one warning): a library
+    is never loaded from where another user could have put it."""
+    folder = cache_dir()
+    folder.mkdir(parents=True, exist_ok=True)
+    if _private(folder):
+        return folder
+    if not _own_dir:
+        import logging
+        import tempfile
+
+        _own_dir.append(Path(tempfile.mkdtemp(prefix="fepen-kernels-")))
+        logging.getLogger("fepen").warning(f"the kernel cache {folder} can be written by other users: fepen builds "
+                                           f"its C kernels in {_own_dir[0]} for this process instead")
+    return _own_dir[0]
+
+
 def _build(source: Path, cc: str, extra: tuple = ()) -> Path:
     flags = [*FLAGS, *extra]
     version = subprocess.run([cc, "--version"], capture_output=True, text=True, check=True).stdout
     key = hashlib.sha256(source.read_bytes() + " ".join(flags).encode() + version.encode() + _cpu_flags().encode())
-    out = cache_dir() / f"{source.stem}-{key.hexdigest()[:16]}.so"
-    if out.exists():
+    out = _folder() / f"{source.stem}-{key.hexdigest()[:16]}.so"
+    if out.exists() and _private(out):
         return out
-    out.parent.mkdir(parents=True, exist_ok=True)
     with replacing(out, ".so") as tmp:
         subprocess.run([cc, *flags, str(source), "-lm", "-o", str(tmp)], capture_output=True, text=True,
                        check=True)

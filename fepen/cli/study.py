@@ -93,6 +93,7 @@ def _ballistic_limit(args) -> int:
     """fepen study ballistic-limit, on the ranks it was started on."""
     from mpi4py import MPI
 
+    from fepen.io import rundir
     from fepen.studies import limits
 
     comm = MPI.COMM_WORLD
@@ -100,9 +101,10 @@ def _ballistic_limit(args) -> int:
     bracket = numbers("--speeds", args.speeds)
     if len(bracket) != 2:
         raise InputError("--speeds", f"two speeds LOW,HIGH (m/s), got {args.speeds!r}")
-    clear_rounds(args.out, args.fresh, comm)
     lo, hi = bracket
-    limits.ballistic_limit(args.scene, args.sets, args.out, comm, args.ranks_per_shot, lo, hi, args.tol, say=say)
+    limits.check_ballistic_limit(args.scene, args.sets, lo, hi, args.tol)  # bad input before anything is written
+    with rundir.study_directory(args.out, comm, args.fresh, "ballistic-limit", limits.BALLISTIC_NAMES):
+        limits.ballistic_limit(args.scene, args.sets, args.out, comm, args.ranks_per_shot, lo, hi, args.tol, say=say)
     say(f"written: {args.out}/ballistic_limit.json, ballistic_limit.png")
     return 0
 
@@ -111,6 +113,7 @@ def _ricochet(args) -> int:
     """fepen study ricochet, on the ranks it was started on."""
     from mpi4py import MPI
 
+    from fepen.io import rundir
     from fepen.studies import limits
 
     comm = MPI.COMM_WORLD
@@ -118,9 +121,10 @@ def _ricochet(args) -> int:
     if not (math.isfinite(args.obliquity_max) and 0.0 < args.obliquity_max < 90.0):
         raise InputError("--obliquity-max", f"in (0, 90) deg, got {args.obliquity_max!r}")
     speeds = numbers("--speeds", args.speeds)
-    clear_rounds(args.out, args.fresh, comm)
-    limits.ricochet(args.scene, args.sets, args.out, comm, args.ranks_per_shot, speeds, args.obliquity_max,
-                    args.tol, say=say)
+    limits.check_ricochet(args.scene, args.sets, speeds, args.obliquity_max, args.tol)  # before anything is written
+    with rundir.study_directory(args.out, comm, args.fresh, "ricochet", limits.RICOCHET_NAMES):
+        limits.ricochet(args.scene, args.sets, args.out, comm, args.ranks_per_shot, speeds, args.obliquity_max,
+                        args.tol, say=say)
     say(f"written: {args.out}/ricochet.json, ricochet.png")
     return 0
 
@@ -147,11 +151,3 @@ def _check_limit_options(args, comm) -> None:
         raise InputError("--tol", f"a positive number (m/s or deg), got {args.tol!r}")
 
 
-def clear_rounds(out: str, fresh: bool, comm) -> None:
-    """--fresh: remove OUT/rounds, the bisection rounds a limit study recorded (rank 0); every rank waits."""
-    import shutil
-    from pathlib import Path
-
-    if fresh and comm.rank == 0 and (Path(out) / "rounds").is_dir():
-        shutil.rmtree(Path(out) / "rounds")
-    comm.barrier()

@@ -85,6 +85,10 @@ def _import(path: str, scale: float) -> list:
     return vols
 
 
+#: the largest CAD file read (bytes)
+CAD_MAX = 512 << 20
+
+
 def probe(path: str, scale: float) -> tuple[float, float]:
     """The body's calibre (twice its largest distance from the y axis) and length along y (m).
 
@@ -95,6 +99,9 @@ def probe(path: str, scale: float) -> tuple[float, float]:
 
     if not Path(path).is_file():
         raise InputError("projectile.cad", f"no such file: {path}")
+    from fepen.atomic import input_file
+
+    input_file(path, "projectile.cad", CAD_MAX, "a STEP or BREP body")
     _import(path, scale)
     xmin, ymin, zmin, xmax, ymax, zmax = gmsh.model.getBoundingBox(-1, -1)
     gmsh.model.remove()

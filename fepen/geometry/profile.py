@@ -268,6 +268,10 @@ def min_radius(path: list[Segment], z0: float, z1: float) -> float:
 # ---------------------------------------------------------------------------------------------------------
 # drawn profiles: CSV of (z, r[, arc radius]) points
 # ---------------------------------------------------------------------------------------------------------
+#: the largest drawn profile read (bytes): a few thousand rows are a few hundred kB
+PROFILE_MAX = 16 << 20
+
+
 def read_points(path: str, key: str) -> list[tuple[float, float, float]]:
     """A drawn profile: rows ``z_m, r_m[, arc_radius_m]`` (a header line allowed, # comments). The segment
     into each point is straight, or a circle arc of that radius when arc_radius_m is not 0: positive bulging
@@ -279,12 +283,14 @@ def read_points(path: str, key: str) -> list[tuple[float, float, float]]:
     Returns:
         [(z, r, arc)] in file order. Raises InputError naming ``key`` when unreadable.
     """
+    from fepen.atomic import input_file
     from fepen.errors import InputError
 
+    input_file(path, key, PROFILE_MAX, "the profile")  # a regular file, not a device read forever
     try:
         text = open(path, encoding="utf-8").read()
-    except OSError as err:
-        raise InputError(key, f"cannot read the profile {path!r}: {err.strerror}") from None
+    except (OSError, UnicodeDecodeError) as err:
+        raise InputError(key, f"cannot read the profile {path!r}: {getattr(err, 'strerror', None) or err}") from None
     rows = []
     for n, line in enumerate(text.splitlines(), 1):
         line = line.split("#", 1)[0].strip()

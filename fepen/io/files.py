@@ -119,6 +119,12 @@ def _make_directory(out: Path) -> tuple[str, str] | None:
     """Create ``out``; None, or (kind "input" or "fault", the message)."""
     if out.exists() and not out.is_dir():
         return "input", f"{out} is a file, not a directory: name a directory (it is created if absent)"
+    from fepen.atomic import ForeignFile, guard
+
+    try:
+        guard(out)  # inside a claimed directory (a study's shot folder): fepen's or new, never a link
+    except ForeignFile as err:
+        return "input", err.message
     try:
         out.mkdir(parents=True, exist_ok=True)
     except OSError as err:

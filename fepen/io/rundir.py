@@ -22,7 +22,6 @@ import errno
 import json
 import logging
 import os
-import shutil
 import socket
 import stat
 import subprocess
@@ -216,6 +215,30 @@ def results_in(record: dict) -> list[str]:
     return sorted((manifest(record) or set()) - RECORD_NAMES - {"scene.toml"})
 
 
+def remove(path: Path) -> None:
+    """Remove what fepen wrote at ``path``: a file or a link (the link itself, never its target); a directory
+    that holds a fepen record, by its manifest (a user's file inside stays, and so does the directory then);
+    any other directory fepen made (checkpoint/, fields.d/, shots/, rounds/), with all it holds, each
+    directory inside by the same rule."""
+    try:
+        st = os.lstat(path)
+    except FileNotFoundError:
+        return
+    if not stat.S_ISDIR(st.st_mode):
+        path.unlink()
+        return
+    rec, _ = read_record(path)
+    files = manifest(rec) if rec is not None else None
+    for child in ([path / n for n in sorted(files)] if files is not None else sorted(path.iterdir())):
+        remove(child)
+    if files is not None:
+        (path / LOCK).unlink(missing_ok=True)  # the lock of a record that is gone (its run cannot be running)
+    try:
+        path.rmdir()
+    except OSError:  # a user's file inside a study's shot folder: the folder stays
+        pass
+
+
 def _names(names) -> str:
     names = sorted(names)
     return ", ".join(names[:4]) + (f" and {len(names) - 4} more" if len(names) > 4 else "")
@@ -228,28 +251,34 @@ class RunDirectory:
     Args:
         out: the results directory.
         comm: the run's communicator.
-        mode: "new" (refuse a directory holding results), "force" (remove the files its manifest lists first)
-            or "resume".
+        mode: "new" (refuse a directory holding results), "force" (remove the files its manifest lists first),
+            "resume", or "continue" (a study: keep what the same kind of study wrote there and go on; refuse
+            another kind's results).
         command: the command line to record (default: the one begin_command set, else this process's).
-        kind: what the command is ("run", "mesh"): a new "mesh" replaces an earlier mesh's files as a new run
-            never replaces a run's.
+        kind: what the command is ("run", "mesh", or a study's name): a new "mesh" replaces an earlier mesh's
+            files as a new run never replaces a run's.
         inputs: the digest of the run's inputs, recorded (a resume compares its own with it).
+        names: the top-level names the command may write, refused before it starts when a file fepen did not
+            write holds one (default: RUN_NAMES, or MESH_NAMES for a mesh).
     """
 
     def __init__(self, out, comm=MPI.COMM_WORLD, mode: str = "new", command: list[str] | None = None,
-                 kind: str = "run", inputs: dict | None = None):
+                 kind: str = "run", inputs: dict | None = None, names=None):
         self.out, self.comm, self.mode, self.kind = Path(out), comm, mode, kind
         if command is None:
             command = _command_line or [Path(sys.argv[0]).name, *sys.argv[1:]]
         self.command = list(command)
-        self.names = MESH_NAMES if kind == "mesh" else RUN_NAMES
+        default = MESH_NAMES if kind == "mesh" else RUN_NAMES
+        self.names = default if names is None else RECORD_NAMES | frozenset(names)
         self.inputs = inputs
         self.record: dict = {}
         self.claim: atomic.Claim | None = None
+        self._outer_log: Path | None = None
 
     # ------------------------------------------------------------------------------------------------
     def __enter__(self) -> RunDirectory:
         global _log_path
+        self._outer_log = _log_path  # a study's shot claims its own folder inside the study's: back to it at exit
         _log_path = None  # lines from here on belong to this run
         tee_logging(self.comm.rank)
         verdict = self._claim() if self.comm.rank == 0 else None
@@ -275,12 +304,15 @@ class RunDirectory:
         else:
             o = stop_outcome(err)
             outcome, code = o.name, o.exit_code
+        global _log_path
         try:
             if self.comm.rank == 0:
                 self._close(outcome, code,
                             None if err is None else str(err).splitlines()[0] if str(err) else kind.__name__)
         finally:
             atomic.release(self.claim)
+            if self._outer_log is not None:  # a shot's folder inside a study's: the study's log again (a run's own
+                _log_path = self._outer_log  # log keeps what the command says after it: its summary lines)
 
     @property
     def written(self) -> list[str]:
@@ -341,11 +373,14 @@ class RunDirectory:
                 return (f"{self.out} holds the results of an earlier fepen, which kept no manifest of its files: "
                         "fepen removes only what a manifest lists; remove them by hand, or name another --out")
             results = results_in(rec)
-            same_kind = rec.get("kind", "run") == self.kind == "mesh"
-            if self.mode == "new" and results and not same_kind:
+            same_kind = rec.get("kind", "run") == self.kind
+            if self.mode == "new" and results and not (same_kind and self.kind == "mesh"):
                 return (f"{self.out} holds another run's results ({_names(results)}): add --force to remove "
                         f"them first (exactly the files that run wrote), or continue that run with "
                         f"`fepen run --resume {self.out}`, or name another --out")
+            if self.mode == "continue" and results and not same_kind:
+                return (f"{self.out} holds the results of a {rec.get('kind', 'run')}, not of a {self.kind}: name "
+                        "another --out, or --fresh to remove them first (exactly the files it wrote)")
             owned = files
         elif self.mode == "resume":
             return f"{self.out} holds no fepen run to resume (no run.json)"
@@ -355,7 +390,7 @@ class RunDirectory:
             what = ", ".join(f"{n} (a link)" if os.path.islink(self.out / n) else n for n in blocking[:4])
             return (f"{self.out} holds {what}, which fepen did not write and this {self.kind} would replace: fepen "
                     "never overwrites a file it did not write; move it away or name another --out")
-        if rec is not None and self.mode != "resume":
+        if rec is not None and self.mode in ("new", "force"):
             if self.mode == "new":
                 logging.getLogger("fepen").info(f"{self.out}: the files of its last {rec.get('kind', 'run')} "
                                                 f"({rec.get('outcome')}) are replaced")
@@ -422,21 +457,14 @@ class RunDirectory:
     def _clear(self, names: set[str]) -> None:
         """Remove exactly ``names`` (the earlier command's manifest; links among them were refused before)."""
         for name in sorted(names):
-            path = self.out / name
-            try:
-                st = os.lstat(path)
-            except FileNotFoundError:
-                continue
-            if stat.S_ISDIR(st.st_mode):
-                shutil.rmtree(path)  # never follows a link inside
-            else:
-                path.unlink()
+            remove(self.out / name)
 
     def _write_record(self) -> None:
         path = self.out / "run.json"
         earlier = {}
-        if self.mode == "resume" and path.is_file():
+        if self.mode in ("resume", "continue") and path.is_file():
             earlier, _ = read_record(self.out)
+            earlier = earlier if earlier and earlier.get("kind", "run") == self.kind else {}
         this = {"command": self.command, "cwd": os.getcwd(), "ranks": self.comm.size, "fepen": __version__,
                 "revision": revision(), "host": socket.gethostname(), "pid": os.getpid(), "start": _now(),
                 "end": None, "outcome": "running", "exit_code": None}
@@ -469,3 +497,11 @@ class RunDirectory:
             pass
         _append(self.out / "fepen.log", [f"# {last['end']} {outcome} (exit {code})"])
         self._unlock()
+
+
+def study_directory(out, comm, fresh: bool, kind: str, names) -> RunDirectory:
+    """The claim of a study on its results directory (a RunDirectory of its ``kind``): ``fresh`` removes what
+    the study's manifest lists first ("force"), else the study goes on with what the same kind of study wrote
+    there ("continue"); ``names``, the top-level names it writes, are refused before it starts where a file
+    fepen did not write holds one. Each shot's own folder inside it is a run directory of its own."""
+    return RunDirectory(out, comm, "force" if fresh else "continue", kind=kind, names=names)

@@ -87,6 +87,20 @@ def study(out: str | Path = "results/study", ranks: int = 2, quick: bool = False
     out = Path(out)
     from mpi4py import MPI
 
+    from fepen.io import rundir
+
+    with rundir.study_directory(out, MPI.COMM_SELF, fresh, "accuracy-cost", STUDY_NAMES):
+        return _study(out, ranks, quick, fresh, shots, say)
+
+
+#: what the study writes into its folder (fepen.io.rundir.study_directory)
+STUDY_NAMES = ("runs", "study.csv", "study.md", "study.json", "pareto.png")
+
+
+def _study(out: Path, ranks: int, quick: bool, fresh: bool, shots, say) -> list[dict]:
+    """study's body, in its claimed folder."""
+    from mpi4py import MPI
+
     out = files.prepare(out, MPI.COMM_SELF)  # a file or a place that cannot be made: bad input, one line
     rows = []
     confs = configurations(quick)

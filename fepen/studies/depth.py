@@ -16,6 +16,7 @@ the paper's eight shots (docs/paper.md).
 from __future__ import annotations
 
 import csv
+import io
 import math
 from dataclasses import dataclass
 from importlib import resources
@@ -348,6 +349,10 @@ def figure(results: dict[str, list[dict]], path, method: str = "default") -> Non
     save_figure(fig, path, dpi=130)
 
 
+#: what fepen validate-depth writes into its folder
+DEPTH_NAMES = ("depth.csv", "depth.md", "depth.png")
+
+
 def validate_depth(paths=(), sets=(), out="results/validate-depth", workers: int = 1,
                    shipped: bool = True) -> list[dict]:
     """Run the data sets (gather_sets) by every method; write DIR/depth.csv (per shot), DIR/depth.md (the
@@ -361,22 +366,26 @@ def validate_depth(paths=(), sets=(), out="results/validate-depth", workers: int
 
     scene.load(None, ["effects.fidelity=rigid", *sets])  # bad --set: InputError before any run
     data = gather_sets(paths, shipped)
-    results = predict_sets(data, sets, workers)
     from mpi4py import MPI
 
-    from fepen.io import files
+    from fepen.atomic import replacing
+    from fepen.io import files, rundir
 
-    out = files.prepare(out, MPI.COMM_SELF)  # a file or a place that cannot be made: bad input, one line
-    fields = ["set", *Row.__dataclass_fields__, *METHODS]
-    with open(out / "depth.csv", "w", newline="") as f:
-        w = csv.DictWriter(f, fieldnames=fields)
+    with rundir.study_directory(out, MPI.COMM_SELF, False, "validate-depth", DEPTH_NAMES):
+        results = predict_sets(data, sets, workers)
+        out = Path(out)
+        fields = ["set", *Row.__dataclass_fields__, *METHODS]
+        buf = io.StringIO()
+        w = csv.DictWriter(buf, fieldnames=fields, lineterminator="\r\n")
         w.writeheader()
         for name, shots in results.items():
             for s in shots:
                 w.writerow({"set": name, **s})
-    table = summary_table(results, scene.load(None, ["effects.fidelity=rigid", *sets]).target.strength_model)
-    note = (f"Rigid fidelity, default scene but for each shot's projectile, target strength and density"
-            f"{' and ' + ', '.join(sets) if sets else ''}; errors P_pred/P_meas - 1.")
-    (out / "depth.md").write_text(markdown(table, note))
-    figure(results, out / "depth.png")
+        with replacing(out / "depth.csv") as tmp:
+            tmp.write_text(buf.getvalue(), newline="")
+        table = summary_table(results, scene.load(None, ["effects.fidelity=rigid", *sets]).target.strength_model)
+        note = (f"Rigid fidelity, default scene but for each shot's projectile, target strength and density"
+                f"{' and ' + ', '.join(sets) if sets else ''}; errors P_pred/P_meas - 1.")
+        files.write_text(out / "depth.md", markdown(table, note), MPI.COMM_SELF)
+        figure(results, out / "depth.png")
     return table

@@ -19,7 +19,6 @@ from __future__ import annotations
 import json
 import logging
 import os
-import shutil
 import sys
 import threading
 import time
@@ -56,20 +55,14 @@ def check_ranks_per_shot(ranks_per_shot: int, ranks: int) -> None:
 
 
 def check_directory(out: Path, digest: str, fresh: bool) -> tuple | None:
-    """On rank 0: None when OUT is new, holds this study (resumable) or is cleared by ``fresh``; else the
-    (key, message) of the InputError to raise on every rank."""
+    """On rank 0: None when OUT is new, holds this study (resumable) or ``fresh`` (its files removed by the
+    study's directory claim, by manifest); else the (key, message) of the InputError to raise on every rank."""
     out = Path(out)
     if out.exists() and not out.is_dir():
         return ("--out", f"{out} is a file, not a results directory")
-    meta = out / "sweep.json"
-    if fresh:
-        for name in (RECORDS, "sweep.json"):
-            if (out / name).exists():
-                (out / name).unlink()
-        if (out / "shots").is_dir():
-            shutil.rmtree(out / "shots")
+    if fresh:  # the study's directory claim (fepen.io.rundir.study_directory) removed its files by manifest
         return None
-    return other_study(out, meta, digest, "sweep")
+    return other_study(out, out / "sweep.json", digest, "sweep")
 
 
 def other_study(out: Path, meta: Path, digest: str, what: str) -> tuple | None:
@@ -108,8 +101,10 @@ class _Log:
     loses at most that much)."""
 
     def __init__(self, out: Path, records: dict, bar):
+        from fepen.atomic import open_append
+
         self.path, self.records, self.bar = Path(out) / RECORDS, records, bar
-        self.f = open(self.path, "a")
+        self.f = open_append(self.path)  # never through a link; fepen's or new in the study's folder
         self.synced = time.monotonic()
         if self.f.tell() > 0:  # a kill may have cut the last line: start on a new one
             with open(self.path, "rb") as g:

@@ -20,6 +20,7 @@ import numpy as np
 from mpi4py import MPI
 
 from fepen import scene as fscene
+from fepen.atomic import make_dir
 from fepen.errors import InputError
 from fepen.io import files
 from fepen.studies import engine
@@ -47,7 +48,7 @@ def _round(out: Path, r: int, scenes: list, comm, k: int) -> list[dict]:
     """Run a round of shots (resumable) and return their summaries (every rank), in order."""
     d = out / "rounds" / f"{r:03d}"
     if comm.rank == 0:
-        d.mkdir(parents=True, exist_ok=True)
+        make_dir(d)  # fepen's or new in the study's folder, never a link
     comm.barrier()
     rigid = all(sc.effects.fidelity == "rigid" for sc in scenes)
     records, _ = engine.execute(len(scenes), lambda i: scenes[i], d, comm, k,
@@ -59,6 +60,11 @@ def _round(out: Path, r: int, scenes: list, comm, k: int) -> list[dict]:
     return [rec["summary"] for rec in recs]
 
 
+#: what the limit studies write into their folders (fepen.io.rundir.study_directory)
+BALLISTIC_NAMES = ("rounds", "ballistic_limit.json", "ballistic_limit.png")
+RICOCHET_NAMES = ("rounds", "ricochet.json", "ricochet.png")
+
+
 def _base(scene_path, sets) -> dict:
     given = fscene.read_toml(scene_path) if scene_path else {}
     for item in sets:
@@ -66,6 +72,29 @@ def _base(scene_path, sets) -> dict:
         given[k] = v
     given.pop("impact.shot", None)
     return given
+
+
+def check_ballistic_limit(scene_path, sets, v_low: float, v_high: float, tol: float) -> tuple[dict, fscene.Scene]:
+    """The ballistic-limit study's inputs checked (InputError before anything is written): (base keys, scene)."""
+    base = _base(scene_path, sets)
+    probe = fscene.Scene(base)
+    if probe.get("target.thickness") is None and not probe.get("target.layers"):
+        raise InputError("target.thickness", "the ballistic limit needs a finite target: give target.thickness "
+                                             "or target.layers")
+    if not 0 < v_low < v_high <= 3000 or not tol > 0:
+        raise InputError("--speeds", f"need 0 < v_low < v_high <= 3000 m/s and tol > 0, got {v_low:g}, "
+                                     f"{v_high:g}, {tol:g}")
+    return base, probe
+
+
+def check_ricochet(scene_path, sets, speeds, obliquity_max: float, tol: float) -> tuple[dict, fscene.Scene, list]:
+    """The ricochet study's inputs checked (InputError before anything is written): (base keys, scene, speeds)."""
+    base = _base(scene_path, sets)
+    probe = fscene.Scene(base)
+    speeds = [float(v) for v in speeds]
+    if not speeds or not all(0 < v <= 3000 for v in speeds) or not 0 < obliquity_max < 90 or not tol > 0:
+        raise InputError("--speeds", "speeds in (0, 3000] m/s, obliquity_max in (0, 90) deg, tol > 0")
+    return base, probe, speeds
 
 
 def ballistic_limit(scene_path, sets, out, comm=None, ranks_per_shot: int = 1, v_low: float = 100.0,
@@ -84,14 +113,7 @@ def ballistic_limit(scene_path, sets, out, comm=None, ranks_per_shot: int = 1, v
         {"v_bl_m_s", "bracket_m_s", "tol_m_s", "check": {below, above}, "a", "p", "rms_m_s", "curve": [...]}.
     """
     comm = MPI.COMM_WORLD if comm is None else comm
-    base = _base(scene_path, sets)
-    probe = fscene.Scene(base)
-    if probe.get("target.thickness") is None and not probe.get("target.layers"):
-        raise InputError("target.thickness", "the ballistic limit needs a finite target: give target.thickness "
-                                             "or target.layers")
-    if not 0 < v_low < v_high <= 3000 or not tol > 0:
-        raise InputError("--speeds", f"need 0 < v_low < v_high <= 3000 m/s and tol > 0, got {v_low:g}, "
-                                     f"{v_high:g}, {tol:g}")
+    base, probe = check_ballistic_limit(scene_path, sets, v_low, v_high, tol)
     out = files.prepare(out, comm)
 
     def scene(v):
@@ -200,11 +222,7 @@ def ricochet(scene_path, sets, out, comm=None, ranks_per_shot: int = 1, speeds=(
         {"speeds_m_s", "critical_obliquity_deg", "brackets", "map": [{v, obliquity, outcome}], "tol_deg"}.
     """
     comm = MPI.COMM_WORLD if comm is None else comm
-    base = _base(scene_path, sets)
-    probe = fscene.Scene(base)
-    speeds = [float(v) for v in speeds]
-    if not speeds or not all(0 < v <= 3000 for v in speeds) or not 0 < obliquity_max < 90 or not tol > 0:
-        raise InputError("--speeds", "speeds in (0, 3000] m/s, obliquity_max in (0, 90) deg, tol > 0")
+    base, probe, speeds = check_ricochet(scene_path, sets, speeds, obliquity_max, tol)
     out = files.prepare(out, comm)
 
     def scene(v, ob):

@@ -547,7 +547,7 @@ def run(path, out, comm=None, ranks_per_shot: int = 1, sets=(), fresh: bool = Fa
 
     from mpi4py import MPI
 
-    from fepen.io import files
+    from fepen.io import rundir
     from fepen.studies import engine
 
     comm = MPI.COMM_WORLD if comm is None else comm
@@ -557,6 +557,24 @@ def run(path, out, comm=None, ranks_per_shot: int = 1, sets=(), fresh: bool = Fa
     err = comm.bcast(engine.check_directory(out, sweep.digest, fresh) if comm.rank == 0 else None, root=0)
     if err:
         raise InputError(*err)
+    with rundir.study_directory(out, comm, fresh, "sweep", SWEEP_NAMES):
+        return _run(sweep, path, out, comm, ranks_per_shot, say, progress, t0)
+
+
+#: what a sweep writes into its folder (fepen.io.rundir.study_directory)
+SWEEP_NAMES = ("sweep.json", "shots.jsonl", "shots", "sweep.csv", "costs.csv", "sweep.parquet", "sweep.md", "sweep.png",
+               "histograms.png")
+
+
+def _run(sweep: Sweep, path, out: Path, comm, ranks_per_shot: int, say, progress: bool, t0: float) -> dict:
+    """run's body, in the sweep's claimed folder."""
+    import time
+
+    from mpi4py import MPI
+
+    from fepen.io import files
+    from fepen.studies import engine
+
     out = files.prepare(out, comm)
     if comm.rank == 0:
         source = None if isinstance(path, dict) else str(Path(path).resolve())  # None: given as a dict

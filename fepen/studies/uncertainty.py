@@ -475,10 +475,9 @@ def study(p: Plan, out, comm=None, ranks_per_shot: int = 1, fresh: bool = False,
     """
     from mpi4py import MPI
 
-    from fepen.io import files
     from fepen.post import envelope
     from fepen.runs import setup
-    from fepen.studies import engine, sweep
+    from fepen.studies import engine
 
     comm = MPI.COMM_WORLD if comm is None else comm
     t0 = time.perf_counter()
@@ -500,6 +499,27 @@ def study(p: Plan, out, comm=None, ranks_per_shot: int = 1, fresh: bool = False,
     err = comm.bcast(err, root=0)
     if err:
         raise InputError(*err)
+    from fepen.io import rundir
+
+    with rundir.study_directory(out, comm, fresh, "uncertainty", UNCERTAINTY_NAMES):
+        return _study(p, sc, out, comm, ranks_per_shot, fresh, say, progress, t0, verdict,
+                      (m, why, response, draws, combined, inputs, digest))
+
+
+#: what the uncertainty study writes into its folder (fepen.io.rundir.study_directory)
+UNCERTAINTY_NAMES = ("uncertainty_input.json", "combined.csv", "model_draws.csv", "inputs.csv", "combined", "inputs",
+                     "uncertainty.json", "uncertainty.md", "uncertainty.png")
+
+
+def _study(p: Plan, sc, out: Path, comm, ranks_per_shot: int, fresh: bool, say, progress: bool, t0: float, verdict,
+           drawn: tuple) -> dict:
+    """study's body, in its claimed folder."""
+    from mpi4py import MPI
+
+    from fepen.io import files
+    from fepen.studies import sweep
+
+    m, why, response, draws, combined, inputs, digest = drawn
     out = files.prepare(out, comm)
     if comm.rank == 0:
         _write_tables(out, p, digest, combined, inputs, draws)

@@ -18,7 +18,7 @@ from mpi4py import MPI
 from fepen import scene as fscene
 from fepen.data import SHOTS
 from fepen.io import files
-from fepen.post import paths
+from fepen.post import figures, paths
 from fepen.runs import run_in_directory, setup
 
 FIELDS = ["shot", "v0_m_s", "obliquity_deg", "attack_deg", "Hx_mm", "Hy_mm", "Tx_mm", "Ty_mm", "Hx_exp_mm",
@@ -40,6 +40,18 @@ def validate(scene_path, sets, out, comm=MPI.COMM_WORLD) -> list[dict]:
     scenes = {name: fscene.load(scene_path, [*base, f'impact.shot="{name}"']) for name in SHOTS}
     for sc in scenes.values():
         setup.check_supported(sc)
+    from fepen.io import rundir
+
+    with rundir.study_directory(out, comm, False, "validate", VALIDATE_NAMES):
+        return _validate(scene_path, base, scenes, Path(out), comm)
+
+
+#: what fepen validate writes into its folder (fepen.io.rundir.study_directory): each shot's run folder too
+VALIDATE_NAMES = (*SHOTS, "validation.csv", "validation.md", "validation.png", "paths.png", "hazard_maps.png")
+
+
+def _validate(scene_path, base: list[str], scenes: dict, out: Path, comm) -> list[dict]:
+    """validate's body, in its claimed folder."""
     out = files.prepare(out, comm)
     rows = []
     summaries = _side_by_side(scene_path, base, scenes, out) if _parallel(scenes, comm) else {}
@@ -126,7 +138,7 @@ def hazard_figure(out: Path) -> None:
         a.set(xlabel="distance from the nose (mm)", ylabel="max surface PEEQ", title=f"hazard map by {what}")
         a.legend(fontsize=8)
     fig.tight_layout()
-    fig.savefig(Path(out) / "hazard_maps.png", dpi=110)
+    figures.save_figure(fig, Path(out) / "hazard_maps.png", dpi=110)
 
 
 def table(rows, sc) -> str:
@@ -180,4 +192,4 @@ def figure(rows, out: Path) -> None:
               aspect="equal")
     ax[2].legend(fontsize=7, ncol=2)
     fig.tight_layout()
-    fig.savefig(Path(out) / "validation.png", dpi=110)
+    figures.save_figure(fig, Path(out) / "validation.png", dpi=110)

@@ -267,6 +267,8 @@ def test_huge_values_files_and_sweeps_are_refused_in_a_short_line(tmp_path, caps
                   '"impact.velocity" = {distribution = "normal", std = 20.0}\n')
     code, _, err = fepen(capsys, "sweep", mc, "--out", tmp_path / "mc")
     assert code == 2 and "monte_carlo.samples" in err[0]
+    code, _, err = fepen(capsys, "run", *RIGID, "--set", 'projectile.profile="/dev/zero"', "--out", tmp_path / "z")
+    assert code == 2 and "not a regular file" in err[0]  # once read (and hashed) for ever
     assert time.perf_counter() - t0 < 20
 
 
@@ -308,3 +310,30 @@ def test_fepen_mesh_replaces_its_own_files_and_refuses_a_runs(tmp_path, capsys):
     assert code == 0, err
     assert not (run / "summary.json").exists() and (run / "mesh.json").exists()
     assert foreign_intact(run, ["photo.png"]) and foreign_intact(out, ["photo.png", "notes.json"])
+
+
+# ---------------------------------------------------------------------------------------------- studies
+def test_a_study_folder_is_owned_by_manifest_too(tmp_path, capsys):
+    """A sweep's folder keeps a manifest as a run's does: --fresh removes exactly what the sweep wrote (its
+    shots' folders by their own manifests, a user's file inside one of them kept), a foreign file under a name
+    the sweep writes is refused before any shot runs, and a run's folder is not taken for a sweep's."""
+    spec = tmp_path / "s.toml"
+    spec.write_text('[base]\n"effects.fidelity" = "rigid"\n[grid]\n"impact.velocity" = [500.0, 600.0]\n'
+                    "[output]\nkeep_results = true\n")
+    out = tmp_path / "sweep"
+    plant(out)
+    argv = ["sweep", spec, "--workers", "1", "--out", out]
+    assert fepen(capsys, *argv)[0] == 0
+    (out / "shots" / "00000" / "mine.txt").write_text("the user's")
+    assert "shots" in record(out)["files"] and (out / "shots" / "00001" / "summary.json").is_file()
+    code, _, err = fepen(capsys, *argv, "--fresh")
+    assert code == 0, err
+    assert foreign_intact(out) and (out / "shots" / "00000" / "mine.txt").read_text() == "the user's"
+    other = tmp_path / "other"
+    plant(other, ["sweep.csv"])
+    code, _, err = fepen(capsys, *argv[:-1], other)
+    assert code == 2 and "sweep.csv" in err[0] and not (other / "shots.jsonl").exists()
+    run = tmp_path / "run"
+    assert fepen(capsys, "run", *RIGID, "--out", run)[0] == 0
+    code, _, err = fepen(capsys, *argv[:-1], run)
+    assert code == 2 and "results of a run" in err[0]
