@@ -22,8 +22,8 @@ def run(args) -> int:
         say(tables())
         return 0
     from fepen import scene as fscene
-    from fepen.post import envelope, interval
     from fepen.runs import setup
+    from fepen.stats import envelope, interval
 
     sc = fscene.load(args.scene, args.sets)
     built = setup.check_supported(sc)
@@ -45,7 +45,7 @@ def tables() -> str:
     """The envelope of each law, the error models and the coverage tables (Markdown): what docs/uncertainty.md
     shows between its ``fepen envelope`` markers."""
     from fepen.data import prediction_errors
-    from fepen.post import envelope, interval
+    from fepen.stats import envelope, interval
 
     rows = prediction_errors.read()
     laws = [law for law in envelope.LAWS if envelope.ranges(law)]

@@ -301,7 +301,7 @@ class Run:
 def prediction(facts: dict, outcome: str, summary: dict) -> dict:
     """The summary's validated-envelope verdict and intervals (docs/uncertainty.md): "envelope",
     "depth_interval_mm", "lateral_interval_mm", "interval"."""
-    from fepen.post import envelope, interval
+    from fepen.stats import envelope, interval
 
     verdict = envelope.verdict(facts)
     out = {"envelope": {**verdict, "line": envelope.line(verdict)}}

@@ -406,15 +406,15 @@ def mesh_metrics(pm: fmesh.ProjectileMesh, scene) -> dict:
 
 
 def envelope_note(scene, built: Built | None = None) -> str:
-    """One line when the shot lies outside the validated envelope (fepen.post.envelope), else ""."""
-    from fepen.post import envelope
+    """One line when the shot lies outside the validated envelope (fepen.stats.envelope), else ""."""
+    from fepen.stats import envelope
 
     v = envelope.verdict(envelope_facts(scene, built))
     return "" if v["inside"] else envelope.line(v)
 
 
 def envelope_facts(scene, built: Built | None = None) -> dict:
-    """What the validated envelope looks at (fepen.post.envelope.verdict), from the scene and its built
+    """What the validated envelope looks at (fepen.stats.envelope.verdict), from the scene and its built
     projectile (the calibre and length of a drawn or CAD body)."""
     p, i, t = scene.projectile, scene.impact, scene.target
     D = built.shape.diameter if built is not None else p.diameter

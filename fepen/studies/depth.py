@@ -277,14 +277,14 @@ def summary_table(results: dict[str, list[dict]], law: str | None = "scaled-S") 
 
 def interval_coverage(name: str, shots: list[dict], law: str | None) -> dict:
     """How many of a set's measured depths lie in the 10-90 % interval of the default method's depth
-    (fepen.post.interval), the model fitted without the set when the shipped errors hold a set of that name.
+    (fepen.stats.interval), the model fitted without the set when the shipped errors hold a set of that name.
 
     Returns:
         {"interval inside": count, "interval shots": count} (shots the method could predict), or {} when the
         law has no error model.
     """
     from fepen.data import prediction_errors
-    from fepen.post import interval
+    from fepen.stats import interval
 
     if law is None:
         return {}

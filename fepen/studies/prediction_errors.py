@@ -7,7 +7,7 @@
 - **lateral**: the sideways travel Hx of Table 1's oblique shots (obliquity of LATERAL_MIN_OBLIQUITY_DEG and
   more), by the rigid fidelity and, from a ``fepen validate`` results directory, by the plastic one.
 
-Each row keeps the shot's features (what the validated envelope is made of, fepen.post.envelope), its role
+Each row keeps the shot's features (what the validated envelope is made of, fepen.stats.envelope), its role
 (whether the set informed the calibration, fepen.studies.calibration.CALIBRATION_SETS), the prediction and the
 measurement. The table is an output of fepen, not an input: ``tests/system/test_prediction_errors.py`` runs a
 subset again and checks it is what this version predicts.

@@ -61,7 +61,7 @@ def test_validate_depth_reports_the_interval_coverage_of_a_new_set(tmp_path):
     """A user's set (four shots of frew2006 under another name): `fepen validate-depth --data` counts its measured
     depths inside the 10-90 % interval of the model fitted on every shipped set (a shipped set's name would
     leave that set out of the fit)."""
-    from fepen.post import interval
+    from fepen.stats import interval
 
     src = depth.shipped_sets()["frew2006"]
     lines = src.read_text().splitlines()

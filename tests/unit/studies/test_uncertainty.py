@@ -1,15 +1,12 @@
-"""fepen.studies.uncertainty's pieces: the resistance response and its inverse, the Wilson interval against
-published values, the importance reweighting against a conditional probability known in closed form, the
-model's draws against the model's moments, and bad options answered in one line with exit 2 before any shot."""
+"""fepen.studies.uncertainty's pieces: the resistance response and its inverse, and bad options answered in one
+line with exit 2 before any shot (its statistics: tests/unit/stats/test_sampling.py)."""
 
 import math
 
 import numpy as np
 import pytest
-from scipy.special import ndtr
 
 from fepen import cli
-from fepen.post import interval
 from fepen.studies import uncertainty as unc
 
 DEMO = unc.Path(__file__).resolve().parents[3] / "demos" / "studies" / "c3_scatter.toml"
@@ -50,62 +47,6 @@ def test_inverse_is_clipped_to_the_keys_range():
     r = power_response(-0.8)
     assert r.inverse(1e-6) == pytest.approx(unc.LAMBDA_BOUNDS[1]) and r.inverse(1e6) == pytest.approx(
         unc.LAMBDA_BOUNDS[0])
-
-
-@pytest.mark.parametrize("x, n, low, high", [(81, 263, 0.2553, 0.3662), (15, 148, 0.0624, 0.1605),
-                                             (0, 20, 0.0, 0.1611), (1, 29, 0.0061, 0.1718)])
-def test_wilson_interval_matches_newcombe(x, n, low, high):
-    """Newcombe (1998), Statistics in Medicine 17:857, Table I, method 3 (Wilson's score interval)."""
-    lo, hi = unc.wilson(x, n)
-    assert lo == pytest.approx(low, abs=6e-5) and hi == pytest.approx(high, abs=6e-5)
-
-
-def test_wilson_interval_is_symmetric_and_shrinks_as_one_over_root_n():
-    lo, hi = unc.wilson(50, 100)
-    assert lo + hi == pytest.approx(1.0, abs=1e-12)
-    w1 = np.subtract(*unc.wilson(500, 1000)[::-1])
-    w2 = np.subtract(*unc.wilson(2000, 4000)[::-1])
-    assert w1 / w2 == pytest.approx(2.0, rel=0.01)
-
-
-def test_reweighting_recovers_a_known_conditional_probability():
-    """A slab perforated when eps + x > c (x: an independent input's effect): P(perforation | b) = 1 -
-    Phi((c - mu - b) / sqrt(sigma^2 + s_x^2)), recovered from one sample drawn over b."""
-    rng = np.random.default_rng(5)
-    n, mu, tau_p, sigma, s_x, c = 400_000, -0.07, 0.17, 0.125, 0.1, 0.05
-    b = tau_p * rng.standard_normal(n)
-    eps = mu + b + sigma * rng.standard_normal(n)
-    hit = (eps + s_x * rng.standard_normal(n) > c).astype(float)
-    for b_star in (-0.2, 0.0, 0.2):
-        p, ess = unc.conditional_probability(hit, eps, mu, tau_p, sigma, b_star)
-        exact = 1.0 - ndtr((c - mu - b_star) / math.hypot(sigma, s_x))
-        assert p == pytest.approx(exact, abs=0.01), (b_star, p, exact)
-        assert 0.1 * n < ess <= n
-    # no systematic spread: no reweighting
-    assert unc.conditional_probability(hit, eps, mu, 0.0, sigma, 0.3)[0] == pytest.approx(hit.mean())
-
-
-def test_model_draws_have_the_models_moments():
-    """eps = mu + b + e: its mean mu and its spread m.sd(V) in each speed regime; b and e independent."""
-    m = interval.model("depth", "scaled-S", "rigid")
-    speeds = np.r_[np.full(100_000, 600.0), np.full(100_000, 1200.0)]
-    d = unc.draw_model_errors(m, speeds, seed=3)
-    for sl, v in ((slice(0, 100_000), 600.0), (slice(100_000, None), 1200.0)):
-        eps = d["eps"][sl]
-        sd = m.sd(v)
-        assert eps.mean() == pytest.approx(m.mu, abs=4 * sd / math.sqrt(len(eps)))
-        assert eps.std() == pytest.approx(sd, rel=0.01)
-        assert np.allclose(d["sd"][sl], sd)
-    assert d["b"].std() == pytest.approx(m.tau * math.sqrt(1 + 1 / m.sets), rel=0.01)
-    assert abs(np.corrcoef(d["b"], d["e"])[0, 1]) < 0.01
-    again = unc.draw_model_errors(m, speeds[:10], seed=3)
-    assert np.array_equal(again["eps"], d["eps"][:10])  # seeded: the same draws
-    assert not np.array_equal(unc.draw_model_errors(m, speeds[:10], seed=4)["eps"], again["eps"])
-
-
-def test_depth_quantiles():
-    q = unc.depth_quantiles(np.r_[np.arange(1.0, 102.0), np.nan])
-    assert (q["P10_mm"], q["P50_mm"], q["P90_mm"], q["mean_mm"], q["shots"]) == (11.0, 51.0, 91.0, 51.0, 101)
 
 
 GRID = "[base]\neffects.fidelity = 'rigid'\n[grid]\n'impact.velocity' = [500.0]\n"

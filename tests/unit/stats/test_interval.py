@@ -1,4 +1,4 @@
-"""The prediction interval's statistics (fepen.post.interval): the random-effects fit recovers what it was given,
+"""The prediction interval's statistics (fepen.stats.interval): the random-effects fit recovers what it was given,
 its intervals cover what they claim on data drawn from the model, and on fepen's own errors on the public data
 the leave-one-set-out coverage lies in the band the issue asks (70-90 %)."""
 
@@ -8,7 +8,7 @@ import numpy as np
 import pytest
 
 from fepen.data import prediction_errors
-from fepen.post import interval as iv
+from fepen.stats import interval as iv
 
 
 def _synthetic(rng, sets=60, shots=8, mu=-0.05, tau=0.15, sigma_lo=0.1, sigma_hi=0.3, fast=0.25):

@@ -216,7 +216,7 @@ def predict(facts: dict, verdict: dict, outcome: str, depth_m: float, lateral_m:
     """The summary's intervals of one finished shot.
 
     Args:
-        facts: fepen.runs.setup.envelope_facts. verdict: fepen.post.envelope.verdict of them.
+        facts: fepen.runs.setup.envelope_facts. verdict: fepen.stats.envelope.verdict of them.
         outcome: the run's outcome. depth_m: the nose's greatest depth. lateral_m: the nose's final sideways
             travel Hx.
 

@@ -1,4 +1,4 @@
-"""The validated envelope (fepen.post.envelope, fepen.runs.setup.envelope_facts, fepen envelope): its ranges are
+"""The validated envelope (fepen.stats.envelope, fepen.runs.setup.envelope_facts, fepen envelope): its ranges are
 the public shots', a scene inside says so, a scene outside names each dimension and how far."""
 
 import subprocess
@@ -9,8 +9,8 @@ import pytest
 
 from fepen import scene
 from fepen.data import prediction_errors
-from fepen.post import envelope
 from fepen.runs import setup
+from fepen.stats import envelope
 
 ROOT = Path(__file__).resolve().parents[3]
 
