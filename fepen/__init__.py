@@ -5,8 +5,10 @@ resistance law applied node by node on the deformed projectile surface.
 
 The API (docs/api.md): ``fepen.Scene``, ``fepen.run(scene, out=None, comm=None) -> Result``,
 ``fepen.load(results_dir) -> Result``, ``fepen.resume(results_dir)``, ``fepen.mesh(scene, out) -> dict``,
-``fepen.sweep(spec, out=None) -> pandas.DataFrame``. The
-layers, bottom up: ``laws`` (plain arrays), ``geometry``, ``solver`` (dolfinx), ``io``, ``post``, ``runs``, ``studies``.
+``fepen.sweep(spec, out=None) -> pandas.DataFrame``, ``fepen.study(name, out=None, **options) -> dict``
+(every study the command line runs). The layers, bottom up: ``data``, ``stats`` and ``laws`` (plain arrays),
+``geometry``, ``solver`` (dolfinx, through ``dolfinx_api``), ``io``, ``post`` and ``scene``, ``runs``,
+``studies``, ``api``, ``cli``.
 """
 
 import os
@@ -15,8 +17,8 @@ from pathlib import Path
 
 from fepen.version import __version__
 
-__all__ = ["Scene", "Result", "run", "load", "resume", "mesh", "sweep", "InputError", "SimulationError", "MachineFault",
-           "Interrupted", "__version__"]
+__all__ = ["Scene", "Result", "run", "load", "resume", "mesh", "sweep", "study", "InputError", "SimulationError",
+           "MachineFault", "Interrupted", "__version__"]
 
 # numba highlights its error messages with colorama when colorama is installed (Debian's paraview brings
 # it): colorama then writes an ANSI reset to a terminal's stdout at exit, which under mpirun (whose ranks'
@@ -57,7 +59,7 @@ def __dir__() -> list[str]:
 
 def __getattr__(name):
     """The API, imported on first use: ``import fepen`` stays cheap (no dolfinx, no MPI)."""
-    if name in ("Scene", "Result", "run", "load", "resume", "mesh", "sweep"):
+    if name in ("Scene", "Result", "run", "load", "resume", "mesh", "sweep", "study"):
         from fepen import api
 
         return getattr(api, name)

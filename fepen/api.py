@@ -6,6 +6,8 @@
     again = fepen.load("results/C3-rigid")
     table = fepen.sweep({"base": {"effects.fidelity": "rigid"}, "grid": {"impact.velocity": [500.0, 700.0]}})
     info = fepen.mesh(scene, "results/C3-mesh")      # the mesh only, as ``fepen mesh``: info["cells"]
+    limit = fepen.study("ballistic-limit", sets=["effects.fidelity=rigid", "target.thickness=0.15"])
+    limit["v_bl_m_s"]                                # any study the command line runs, by its name
 
 Under ``mpirun -n N python script.py`` every rank calls ``fepen.run`` with the same arguments (or a
 communicator), as the command does.
@@ -23,7 +25,7 @@ import numpy as np
 from fepen.errors import InputError
 from fepen.scene import Scene
 
-__all__ = ["Scene", "Result", "run", "load", "resume", "mesh", "sweep"]
+__all__ = ["Scene", "Result", "run", "load", "resume", "mesh", "sweep", "study"]
 
 
 @dataclass
@@ -296,3 +298,38 @@ def _write_mesh(pm, out: Path, comm) -> None:
     if comm.rank == 0:  # one dataset per file, as every reader wants it
         mesh_index(out / "mesh.h5", out / "mesh.xdmf", out / "mesh_facets.xdmf")
     comm.barrier()
+
+
+def study(name: str, out=None, comm=None, ranks_per_shot: int = 1, fresh: bool = False, progress: bool = False,
+          say=None, **options) -> dict:
+    """Run a study by its name, as the command line does (``fepen study NAME``, ``fepen sweep``, ``fepen
+    validate``, ``fepen validate-depth``; the registry: fepen.studies.study.STUDIES), and return its result.
+
+    Args:
+        name: "ballistic-limit", "ricochet", "uncertainty", "accuracy-cost", "sweep", "validate",
+            "validate-depth", "calibration", "wear-calibration" or "prediction-errors".
+        out: its folder (None: a new temporary one). comm: the communicator (None: COMM_WORLD).
+        ranks_per_shot: ranks of each shot's group. fresh: remove what the study wrote in ``out`` first.
+        progress: the shots' bar on rank 0. say: prints its lines (None: silent).
+        options: the study's own (its plan's keywords), e.g. ``scene_path``, ``sets``, ``v_low``, ``v_high``,
+            ``tol`` for the ballistic limit; ``spec`` for a sweep.
+
+    Returns:
+        The study's result (the content of its NAME.json where it writes one), with "wall_s" and "ran".
+
+    Raises:
+        InputError: an unknown study or bad options, before anything is written.
+    """
+    from fepen.studies import study as fstudy
+
+    comm = _comm(comm)
+    from fepen.io import rundir
+
+    args = ", ".join([repr(name)] + [f"{k}={v!r}" for k, v in {"out": out, **options}.items()])
+    rundir.api_call([f"fepen.study({args})", f"# from {_caller()}"])
+    cls = fstudy.get(name)
+    st = cls()
+    plan = st.plan(**options)
+    if out is None:
+        out = comm.bcast(tempfile.mkdtemp(prefix=f"fepen-{name}-") if comm.rank == 0 else None, root=0)
+    return fstudy.run(st, plan, out, comm, ranks_per_shot, fresh, say or (lambda *lines: None), progress)

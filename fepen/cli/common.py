@@ -3,8 +3,6 @@ and ``validate``, and lists of numbers given as one option."""
 
 from __future__ import annotations
 
-from fepen.errors import InputError
-
 
 def say(*lines: str) -> None:
     """Print lines on rank 0 and keep them for fepen.log (fepen.io.rundir.log_line)."""
@@ -38,19 +36,20 @@ def scene_arguments(parser, out_default: str) -> None:
     set_argument(parser, "override a dotted scene key; VALUE in TOML syntax, bare words are strings")
 
 
+def workers_argument(parser, help: str) -> None:
+    """--workers W: a study started without mpirun runs under ``mpirun -n W`` (1: in this process)."""
+    parser.add_argument("--workers", type=int, default=None, metavar="W", help=help)
+
+
 def set_argument(parser, help: str) -> None:
-    """--set KEY=VALUE, repeatable, into ``args.sets``."""
-    parser.add_argument("--set", dest="sets", action="append", default=[], metavar="KEY=VALUE", help=help)
+    """--set KEY=VALUE, repeatable, into ``args.sets`` (fepen.studies.study.set_option)."""
+    from fepen.studies.study import set_option
+
+    set_option(parser, help)
 
 
 def numbers(option: str, text: str) -> list[float]:
-    """The positive finite numbers of a comma-separated option value; InputError naming ``option`` else."""
-    import math
+    """The positive finite numbers of a comma-separated option value (fepen.studies.study.numbers)."""
+    from fepen.studies.study import numbers as _numbers
 
-    try:
-        values = [float(x) for x in text.split(",")]
-    except ValueError:
-        values = []
-    if not values or not all(math.isfinite(v) and v > 0 for v in values):
-        raise InputError(option, f"comma-separated positive numbers, got {text!r}")
-    return values
+    return _numbers(option, text)

@@ -4,7 +4,7 @@ it runs itself again under ``mpirun -n W`` (fepen.studies.processes.relaunch_swe
 
 from __future__ import annotations
 
-from fepen.cli.common import say, set_argument
+from fepen.cli.common import say, set_argument, written_line
 from fepen.errors import InputError
 
 HELP = ("many shots of a base scene (grid, Monte Carlo or a table): sweep.csv, sweep.md, figures; resumable; MPI "
@@ -45,5 +45,5 @@ def run(args) -> int:
     res = sweep.run(args.sweep, args.out, world, args.ranks_per_shot, args.sets, args.fresh, say=say)
     say(f"shots: {res['shots']} ({res['ran']} run now, {res['skipped']} recorded before); "
         + ", ".join(f"{k} {v}" for k, v in sorted(res["statuses"].items())) + f"; wall {res['wall_s']:.1f} s",
-        f"written: {args.out}/sweep.csv, sweep.md, shots.jsonl, sweep.png")
+        written_line(args.out))
     return 0

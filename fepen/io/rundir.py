@@ -260,17 +260,19 @@ class RunDirectory:
         inputs: the digest of the run's inputs, recorded (a resume compares its own with it).
         names: the top-level names the command may write, refused before it starts when a file fepen did not
             write holds one (default: RUN_NAMES, or MESH_NAMES for a mesh).
+        digest: what a study's folder holds (fepen.studies.study): "continue" refuses a folder of the same kind
+            of study with another digest.
     """
 
     def __init__(self, out, comm=MPI.COMM_WORLD, mode: str = "new", command: list[str] | None = None,
-                 kind: str = "run", inputs: dict | None = None, names=None):
+                 kind: str = "run", inputs: dict | None = None, names=None, digest: str | None = None):
         self.out, self.comm, self.mode, self.kind = Path(out), comm, mode, kind
         if command is None:
             command = _command_line or [Path(sys.argv[0]).name, *sys.argv[1:]]
         self.command = list(command)
         default = MESH_NAMES if kind == "mesh" else RUN_NAMES
         self.names = default if names is None else RECORD_NAMES | frozenset(names)
-        self.inputs = inputs
+        self.inputs, self.digest = inputs, digest
         self.record: dict = {}
         self.claim: atomic.Claim | None = None
         self._outer_log: Path | None = None
@@ -381,6 +383,9 @@ class RunDirectory:
             if self.mode == "continue" and results and not same_kind:
                 return (f"{self.out} holds the results of a {rec.get('kind', 'run')}, not of a {self.kind}: name "
                         "another --out, or --fresh to remove them first (exactly the files it wrote)")
+            if self.mode == "continue" and same_kind and rec.get("digest") not in (None, self.digest):
+                return (f"{self.out} holds the results of another {self.kind}: give a new --out, or --fresh to "
+                        "replace them")
             owned = files
         elif self.mode == "resume":
             return f"{self.out} holds no fepen run to resume (no run.json)"
@@ -472,7 +477,8 @@ class RunDirectory:
             self.record = dict(earlier)
             self.record.setdefault("resumes", []).append(this)
         else:
-            self.record = {"kind": self.kind, **this, **({"inputs": self.inputs} if self.inputs else {})}
+            self.record = {"kind": self.kind, **this, **({"inputs": self.inputs} if self.inputs else {}),
+                           **({"digest": self.digest} if self.digest else {})}
         self._save()
 
     def _save(self) -> None:
@@ -499,9 +505,10 @@ class RunDirectory:
         self._unlock()
 
 
-def study_directory(out, comm, fresh: bool, kind: str, names) -> RunDirectory:
+def study_directory(out, comm, fresh: bool, kind: str, names, digest: str | None = None) -> RunDirectory:
     """The claim of a study on its results directory (a RunDirectory of its ``kind``): ``fresh`` removes what
     the study's manifest lists first ("force"), else the study goes on with what the same kind of study wrote
-    there ("continue"); ``names``, the top-level names it writes, are refused before it starts where a file
-    fepen did not write holds one. Each shot's own folder inside it is a run directory of its own."""
-    return RunDirectory(out, comm, "force" if fresh else "continue", kind=kind, names=names)
+    there ("continue"), unless its ``digest`` differs (another study of that kind: refused); ``names``, the
+    top-level names it writes, are refused before it starts where a file fepen did not write holds one. Each
+    shot's own folder inside it is a run directory of its own."""
+    return RunDirectory(out, comm, "force" if fresh else "continue", kind=kind, names=names, digest=digest)

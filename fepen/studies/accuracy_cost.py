@@ -1,5 +1,5 @@
 """``fepen study accuracy-cost``: what accuracy costs in time, over mesh and fidelity ladders of shots C3
-and C7, each run a whole ``fepen run`` process; restartable (docs/accuracy-cost.md).
+and C7, each run a whole ``fepen run`` process on the one executor; restartable (docs/accuracy-cost.md).
 """
 
 from __future__ import annotations
@@ -7,13 +7,14 @@ from __future__ import annotations
 import csv
 import io
 import json
+from dataclasses import dataclass
 from pathlib import Path
 
 import numpy as np
 
 from fepen import scene as fscene
 from fepen.io import files
-from fepen.studies import processes
+from fepen.studies.study import Round, Study, register
 
 SHOTS = ("C3", "C7")
 MESH_SIZES = (0.006, 0.004, 0.0025, 0.0016, 0.0012)
@@ -56,69 +57,91 @@ def configurations(quick: bool = False) -> list[dict]:
     return runs
 
 
-def _run(cmd_sets: list[str], out: Path, ranks: int, fresh: bool) -> dict:
-    """One ``fepen run`` process (reused when out already holds its result)."""
-    sc = fscene.load(None, cmd_sets)
-    want = sc.as_dict()
-    summary_path = out / "summary.json"
-    if not fresh and summary_path.exists():
-        old = json.loads(summary_path.read_text())
-        if old.get("scene") == want and old.get("ranks") == ranks and "process_s" in old:
-            return old
-    args = ["run", "--out", out, "--force"]
-    for s in cmd_sets:
-        args += ["--set", s]
-    code, process_s, message = processes.run_fepen_process(args, ranks)
-    if code != 0:
-        return {"failed": message, "process_s": process_s}
-    summary = json.loads(summary_path.read_text())
-    summary["process_s"] = process_s
-    summary_path.write_text(json.dumps(summary, indent=2) + "\n")
-    return summary
+@dataclass
+class CostPlan:
+    """The study's runs: (shot, configuration) pairs, their scenes, and the ranks."""
+
+    runs: list
+    scenes: list
+    ranks: int
+    quick: bool
 
 
-def study(out: str | Path = "results/study", ranks: int = 2, quick: bool = False, fresh: bool = False,
-          shots=SHOTS, say=print) -> list[dict]:
-    """Run the study (rank 0 of COMM_WORLD only: each run is its own MPI job) and write its outputs.
-
-    Returns:
-        One row per run and shot.
-    """
-    out = Path(out)
-    from mpi4py import MPI
-
-    from fepen.io import rundir
-
-    with rundir.study_directory(out, MPI.COMM_SELF, fresh, "accuracy-cost", STUDY_NAMES):
-        return _study(out, ranks, quick, fresh, shots, say)
+def _folder(run: tuple) -> str:
+    shot, c = run
+    return f"{shot}-{c['name'].replace(' ', '_').replace('+', 'with_')}"
 
 
-#: what the study writes into its folder (fepen.io.rundir.study_directory)
-STUDY_NAMES = ("runs", "study.csv", "study.md", "study.json", "pareto.png")
+@register
+class AccuracyCost(Study):
+    """``fepen study accuracy-cost``: each configuration of each shot a whole ``fepen run`` process (the wall
+    time a user waits), its folder OUT/runs/SHOT-NAME; the table, the exponents and speed-ups, the Pareto front."""
 
+    name = "accuracy-cost"
+    help = "what accuracy costs in time: study.csv, study.md, pareto.png"
+    names = ("runs", "shots.jsonl", "study.csv", "study.md", "study.json", "pareto.png")
+    out = "results/study"
 
-def _study(out: Path, ranks: int, quick: bool, fresh: bool, shots, say) -> list[dict]:
-    """study's body, in its claimed folder."""
-    from mpi4py import MPI
+    @classmethod
+    def add_arguments(cls, parser) -> None:
+        parser.add_argument("--ranks", type=int, default=2, help="MPI ranks of each run (default 2)")
+        parser.add_argument("--quick", action="store_true", help="a small subset on coarse meshes")
 
-    out = files.prepare(out, MPI.COMM_SELF)  # a file or a place that cannot be made: bad input, one line
-    rows = []
-    confs = configurations(quick)
-    if quick:
-        shots = shots[:1]
-    for shot in shots:
-        for c in confs:
-            sets = [f'impact.shot="{shot}"', "run.fields=false", *c["sets"]]
-            if quick:
-                sets.append("run.end_time=2e-4")
-            rk = c.get("ranks", ranks)
-            s = _run(sets, out / "runs" / f"{shot}-{c['name'].replace(' ', '_').replace('+', 'with_')}", rk,
-                     fresh)
-            row = {"shot": shot, "name": c["name"], "group": c["group"], "h_mm": c["h"] * 1e3, "ranks": rk}
-            if "failed" in s:
-                row["failed"] = s["failed"]
+    @classmethod
+    def options(cls, args) -> dict:
+        from mpi4py import MPI
+
+        from fepen.errors import InputError
+
+        if MPI.COMM_WORLD.size > 1:
+            raise InputError("fepen study", "run it without mpirun: it starts its own MPI jobs (--ranks)")
+        return {"ranks": args.ranks, "quick": args.quick}
+
+    def plan(self, ranks: int = 2, quick: bool = False, shots=SHOTS) -> CostPlan:
+        from fepen.errors import InputError
+
+        if ranks < 1:
+            raise InputError("--ranks", f"must be at least 1, got {ranks}")
+        runs = [(shot, c) for shot in (shots[:1] if quick else shots) for c in configurations(quick)]
+        scenes = [fscene.load(None, [f'impact.shot="{shot}"', "run.fields=false", *c["sets"],
+                                     *(["run.end_time=2e-4"] if quick else [])]) for shot, c in runs]
+        return CostPlan(runs, scenes, ranks, quick)
+
+    def digest(self, plan: CostPlan) -> str:
+        import hashlib
+
+        return hashlib.sha256(json.dumps([[s, c] for s, c in plan.runs] + [plan.ranks], sort_keys=True,
+                                         default=str).encode()).hexdigest()[:16]
+
+    def rounds(self, plan: CostPlan):
+        names = [_folder(r) for r in plan.runs]
+        ranks = [c.get("ranks", plan.ranks) for _, c in plan.runs]
+        if len(set(ranks)) == 1:
+            yield Round(plan.scenes, shot_folder=lambda out, i: out / "runs" / names[i], batch=False,
+                        label="runs", process=ranks[0])
+            return
+        for rk in sorted(set(ranks)):  # one round per rank count (the 1-rank run of the speed-up)
+            idx = [i for i, r in enumerate(ranks) if r == rk]
+            yield Round([plan.scenes[i] for i in idx], folder=f"ranks-{rk}",
+                        shot_folder=lambda out, j, idx=idx: out.parent / "runs" / names[idx[j]], batch=False,
+                        label=f"runs on {rk} rank{'s' if rk > 1 else ''}", process=rk)
+
+    def result(self, plan: CostPlan, records: list, info) -> dict:
+        ranks = [c.get("ranks", plan.ranks) for _, c in plan.runs]
+        order = sorted(set(ranks))
+        recs = {}
+        for rk, round_records in zip(order, records):
+            idx = [i for i, r in enumerate(ranks) if r == rk]
+            recs.update({idx[j]: rec for j, rec in round_records.items()})
+        rows = []
+        for i, (shot, c) in enumerate(plan.runs):
+            rec = recs[i]
+            row = {"shot": shot, "name": c["name"], "group": c["group"], "h_mm": c["h"] * 1e3, "ranks": ranks[i]}
+            s = rec.get("summary")
+            if rec["status"] != "ok" or s is None:
+                row["failed"] = rec.get("message") or rec["status"]
             else:
-                row.update({"process_s": s["process_s"], "wall_s": s["wall_s"],
+                row.update({"process_s": rec["wall_s"], "wall_s": s["wall_s"],
                             "loop_s": s.get("time_split_s", {}).get("time_loop", np.nan), "steps": s["steps"],
                             "dt_s": s["dt_s"], "peak_memory_mb": s.get("peak_memory_bytes", 0) / 2 ** 20,
                             "cells": s["cells"], "Hx_mm": s["Hx_mm"], "Hy_mm": s["Hy_mm"], "Tx_mm": s["Tx_mm"],
@@ -126,13 +149,30 @@ def _study(out: Path, ranks: int, quick: bool, fresh: bool, shots, say) -> list[
                             "outcome": s["outcome"], "nose_error": s["experiment"]["nose_error"],
                             "tail_error": s["experiment"]["tail_error"]})
             rows.append(row)
-            say(_line(row))
-    _against_finest(rows, quick)
-    exponents = cost_exponents(rows)
-    speedups = rank_speedups(rows)
-    _write(rows, exponents, speedups, out)
-    pareto(rows, out / "pareto.png")
-    return rows
+            info.say(_line(row))
+        _against_finest(rows, plan.quick)
+        return {"exponents": cost_exponents(rows), "speedups": rank_speedups(rows), "_rows": rows}
+
+    def write(self, plan: CostPlan, result: dict, out: Path, info) -> None:
+        from fepen.post import study_figures
+        from fepen.post.figures import new_figure, save_figure
+
+        _write(result["_rows"], result["exponents"], result["speedups"], out)
+        fig = new_figure((12, 5))
+        study_figures.pareto(fig, result["_rows"])
+        save_figure(fig, out / "pareto.png", dpi=120)
+
+
+def study(out: str | Path = "results/study", ranks: int = 2, quick: bool = False, fresh: bool = False,
+          shots=SHOTS, say=print) -> dict:
+    """Run the study (AccuracyCost; rank 0 of COMM_WORLD only: each run is its own MPI job) and write its
+    outputs. Returns its result: the exponents and the speed-ups."""
+    from mpi4py import MPI
+
+    from fepen.studies import study as fstudy
+
+    st = AccuracyCost()
+    return fstudy.run(st, st.plan(ranks, quick, shots), out, MPI.COMM_SELF, 1, fresh, say, progress=False)
 
 
 def _line(r: dict) -> str:
@@ -200,12 +240,14 @@ COLUMNS = ["shot", "group", "name", "h_mm", "ranks", "cells", "process_s", "wall
 
 
 def _write(rows, exponents, speedups, out: Path) -> None:
+    from mpi4py import MPI
+
     buf = io.StringIO()
     w = csv.DictWriter(buf, COLUMNS)
     w.writeheader()
     for r in rows:
         w.writerow({k: (f"{v:.6g}" if isinstance(v, float) else v) for k, v in r.items() if k in COLUMNS})
-    files.write_text(out / "study.csv", buf.getvalue())
+    files.write_text(out / "study.csv", buf.getvalue(), MPI.COMM_SELF)
     lines = ["| shot | run | h (mm) | ranks | cells | wall (s) | time loop (s) | steps | smallest step (ns) | "
              "peak memory (MiB) | Hy (mm) | nose error vs Table 1 | tail error vs Table 1 | "
              "H vs finest | max PEEQ | PEEQ vs finest |", "|" + "---|" * 16]
@@ -228,34 +270,5 @@ def _write(rows, exponents, speedups, out: Path) -> None:
     for shot, s in speedups.items():
         lines.append(f"- {shot}: 1 -> {s['ranks']} ranks at 2.5 mm: process {s['process']:.2f} x, time loop "
                      f"{s['loop']:.2f} x")
-    files.write_text(out / "study.md", "\n".join(lines) + "\n")
-    files.write_json(out / "study.json", {"exponents": exponents, "speedups": speedups})
-
-
-def pareto(rows, path: Path) -> None:
-    """Error against Table 1 (nose) and against the finest run, against wall time, log-log."""
-    from matplotlib.lines import Line2D
-
-    from fepen.post.figures import new_figure, save_figure
-
-    fig = new_figure((12, 5))
-    axes = fig.subplots(1, 2)
-    marks = {"mesh": "o", "fidelity": "s", "cheaper": "^", "costlier": "v", "ranks": "D"}
-    colours = {"C3": "tab:blue", "C7": "tab:red"}
-    for ax, key, label in ((axes[0], "nose_error", "nose error against Table 1's test"),
-                           (axes[1], "H_vs_finest", "nose position against the finest run")):
-        for r in rows:
-            if "failed" in r or not np.isfinite(r.get(key, np.nan)) or r.get(key, 0) <= 0:
-                continue
-            ax.loglog(r["process_s"], 100 * r[key], marks[r["group"]], color=colours.get(r["shot"], "k"),
-                      alpha=0.8)
-            ax.annotate(r["name"], (r["process_s"], 100 * r[key]), fontsize=6, alpha=0.7,
-                        xytext=(3, 2), textcoords="offset points")
-        ax.set(xlabel="wall time of the run (s)", ylabel=f"{label} (%)")
-        ax.grid(True, which="both", alpha=0.3)
-    handles = [Line2D([], [], marker=m, ls="", color="gray", label=f"varied: {g}") for g, m in marks.items()]
-    handles += [Line2D([], [], marker="o", ls="", color=c, label=f"shot {s}") for s, c in colours.items()]
-    axes[0].legend(handles=handles, fontsize=8)
-    fig.suptitle("fepen: accuracy against time (shots C3 and C7)")
-    fig.tight_layout()
-    save_figure(fig, path, dpi=120)
+    files.write_text(out / "study.md", "\n".join(lines) + "\n", MPI.COMM_SELF)
+    files.write_json(out / "study.json", {"exponents": exponents, "speedups": speedups}, MPI.COMM_SELF)

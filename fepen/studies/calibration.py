@@ -19,10 +19,10 @@ The procedure:
      STEP beyond it in that constant (within LIMITS) is run and fitted too (a pattern search);
   6. the node with the smallest fitted objective, with its a and D0, is the calibration.
 
-    .venv/bin/python -m fepen.studies.calibration [--data DIR] [--curves FILE] [--workers W] [--set K=V]
+    .venv/bin/fepen study calibration [--data DIR] [--out DIR] [--set K=V]     (mpirun -n N: on N ranks)
 
-Runs in about 10^4 rigid runs (docs/validation-depth.md gives the time); ``--curves`` keeps them in an .npz
-file so that the fit (seconds) can be repeated from them.
+Runs in about 10^4 rigid runs (docs/validation-depth.md gives the time), batched on the one executor; the runs'
+records stay in OUT/rounds, so that the fit (seconds) is repeated from them when the study runs again.
 """
 
 from __future__ import annotations
@@ -30,15 +30,18 @@ from __future__ import annotations
 import itertools
 import math
 import sys
+from dataclasses import dataclass
 from pathlib import Path
 
 import numpy as np
 
 from fepen.laws import target as tg
 from fepen.studies import depth
+from fepen.studies.study import Round, Study, register, set_option
 
-__all__ = ["CALIBRATION_SETS", "OPEN", "STEP", "LIMITS", "S_SPAN", "EXPONENT", "nodes", "curves", "predicted",
-           "group_errors", "objective", "fit", "calibrate", "search", "shipped_node", "main"]
+__all__ = ["CALIBRATION_SETS", "OPEN", "STEP", "LIMITS", "S_SPAN", "EXPONENT", "nodes", "jobs", "job_scene",
+           "table_of", "curves", "predicted", "group_errors", "objective", "fit", "calibrate", "shipped_node",
+           "Calibration", "main"]
 
 #: the calibration groups (file stems of fepen/data/depth; "table1" is the paper's Table 1, by its positions)
 #: and what each informs
@@ -85,18 +88,18 @@ def _scene_sets(name: str, row) -> list[str]:
     return depth.scene_sets(row)
 
 
-def _one(job) -> tuple:
-    """(Hx, Hy, Tx, Ty) (m) of one rigid run."""
-    from mpi4py import MPI
-
+def job_scene(job):
+    """The rigid scene of one run of step 2: (group, row, S, node, extra)."""
     from fepen import scene
-    from fepen.runs.rigid import RigidRun
 
     name, row, S, node, extra = job
-    sets = [*_scene_sets(name, row), scene.set_item("target.quasi_static_stress", S * _cylinder(row)),
-            *[scene.set_item(k, v) for k, v in node.items()], *extra]
-    s = RigidRun(scene.load(None, sets), None, MPI.COMM_SELF).run()
-    return tuple(s[k] / 1e3 for k in ("Hx_mm", "Hy_mm", "Tx_mm", "Ty_mm"))
+    return scene.load(None, [*_scene_sets(name, row), scene.set_item("target.quasi_static_stress", S * _cylinder(row)),
+                             *[scene.set_item(k, v) for k, v in node.items()], *extra])
+
+
+def _positions(summary: dict) -> tuple:
+    """(Hx, Hy, Tx, Ty) (m) of one rigid run's summary."""
+    return tuple(summary[k] / 1e3 for k in ("Hx_mm", "Hy_mm", "Tx_mm", "Ty_mm"))
 
 
 def _cylinder(row) -> float:
@@ -104,20 +107,16 @@ def _cylinder(row) -> float:
     return tg.cylinder_strength(row.fc, getattr(row, "strength_basis", "cylinder"))
 
 
-def curves(sets: dict, node_list: list[dict], workers: int = 1, extra=()) -> np.ndarray:
-    """The runs of step 2: an object array [node][group] of arrays (shots, len(S_SPAN), 4) of (Hx, Hy, Tx, Ty)
-    (m); run shot by shot (all nodes and S of one shot together, so that a worker builds each projectile
-    once)."""
-    jobs = [(name, row, Sr * _forrestal_S(_Row(row)), node, tuple(extra))
+def jobs(sets: dict, node_list: list[dict], extra=()) -> list[tuple]:
+    """The runs of step 2, shot by shot (all nodes and S of one shot together): (group, row, S, node, extra)."""
+    return [(name, row, Sr * _forrestal_S(_Row(row)), node, tuple(extra))
             for name, rows in sets.items() for row in rows for node in node_list for Sr in S_SPAN]
-    if workers > 1:
-        from concurrent.futures import ProcessPoolExecutor
 
-        with ProcessPoolExecutor(workers) as pool:
-            out = list(pool.map(_one, jobs, chunksize=len(S_SPAN) * max(1, len(node_list) // 2)))
-    else:
-        out = [_one(j) for j in jobs]
-    res = np.array(out).reshape(-1, len(node_list), len(S_SPAN), 4)
+
+def table_of(sets: dict, node_list: list[dict], positions: list) -> np.ndarray:
+    """The runs' (Hx, Hy, Tx, Ty) (in jobs()' order) as an object array [node][group] of arrays (shots,
+    len(S_SPAN), 4) (m)."""
+    res = np.array(positions).reshape(-1, len(node_list), len(S_SPAN), 4)
     table = np.empty((len(node_list), len(sets)), dtype=object)
     k = 0
     for j, rows in enumerate(sets.values()):
@@ -125,6 +124,15 @@ def curves(sets: dict, node_list: list[dict], workers: int = 1, extra=()) -> np.
             table[i, j] = res[k:k + len(rows), i]
         k += len(rows)
     return table
+
+
+def curves(sets: dict, node_list: list[dict], extra=(), comm=None) -> np.ndarray:
+    """The runs of step 2 here and now (fepen.studies.engine.summaries: batched on the one executor), as
+    table_of's array."""
+    from fepen.studies import engine
+
+    found = engine.summaries([job_scene(j) for j in jobs(sets, node_list, extra)], comm)
+    return table_of(sets, node_list, [_positions(s) for s in found])
 
 
 class _Row:
@@ -223,27 +231,6 @@ def _beyond(node: dict, seen: list[dict]) -> list[dict]:
     return out
 
 
-def search(sets: dict, node_list: list[dict], workers: int = 1, extra=(), done: dict | None = None):
-    """Steps 2–6 from the starting nodes: [(objective, node, a, D0)] best first, and the runs of every node
-    visited ({node key: [group tables]}; ``done`` holds runs already made, reused)."""
-    tables, fits = dict(done or {}), {}
-    todo = list(node_list)
-    while True:
-        missing = [n for n in todo if _key(n) not in tables]
-        if missing:
-            t = curves(sets, missing, workers, extra)
-            for i, n in enumerate(missing):
-                tables[_key(n)] = list(t[i])
-        for k in tables:
-            if k not in fits:
-                a, D0, obj = fit(sets, tables[k])
-                fits[k] = (obj, _node(k), a, D0)
-        ranked = sorted(fits.values(), key=lambda r: r[0])
-        todo = [n for n in _beyond(ranked[0][1], [r[1] for r in ranked]) if _key(n) not in tables]
-        if not todo:
-            return ranked, tables
-
-
 def shipped_node() -> dict:
     """The open constants as fepen ships them (the scene's defaults for the paper's concrete)."""
     from fepen import scene
@@ -263,43 +250,130 @@ def load_sets(folder=None) -> dict[str, list]:
             for name in CALIBRATION_SETS}
 
 
-def report(sets, tables: dict, ranked) -> None:
+def report_lines(sets, tables: dict, ranked) -> list[str]:
     """Every node's fit, then each group's errors at the chosen one."""
+    lines = []
     for obj, node, a, D0 in ranked:
-        print(f"objective {obj:.4f}  a {a:7.3f}  D0 {D0 * 1e3:9.2f} mm  " +
-              "  ".join(f"{k.split('.')[-1]} {v:g}" for k, v in node.items()))
+        lines.append(f"objective {obj:.4f}  a {a:7.3f}  D0 {D0 * 1e3:9.2f} mm  " +
+                     "  ".join(f"{k.split('.')[-1]} {v:g}" for k, v in node.items()))
     obj, node, a, D0 = ranked[0]
-    print(f"== chosen: {node}, coefficient {a:.4g}, exponent {EXPONENT}, size {D0:.4g} m (objective {obj:.4f})")
+    lines.append(f"== chosen: {node}, coefficient {a:.4g}, exponent {EXPONENT}, size {D0:.4g} m "
+                 f"(objective {obj:.4f})")
     for (name, rows), t in zip(sets.items(), tables[_key(node)]):
         e = group_errors(name, rows, predicted(rows, t, a, D0))
-        print(f"  {name:24s} n {len(rows):3d}  mean error {e.mean():.1%}  worst {e.max():.1%}")
+        lines.append(f"  {name:24s} n {len(rows):3d}  mean error {e.mean():.1%}  worst {e.max():.1%}")
+    return lines
+
+
+@dataclass
+class CalibrationPlan:
+    """The calibration groups, the starting nodes and the --set lines of every run."""
+
+    sets: dict
+    nodes: list
+    extra: tuple
+
+
+@register
+class Calibration(Study):
+    """The one calibration of the concrete law's open constants (module docstring): steps 2-6 as rounds of
+    rigid runs on the one executor (OUT/rounds/NNN, resumable), the fits between them."""
+
+    name = "calibration"
+    help = "the calibration of the concrete law's open constants on Table 1 and the depth sets (slow)"
+    names = ("rounds", "calibration.json", "calibration.md")
+    out = "results/calibration"
+
+    @classmethod
+    def add_arguments(cls, parser) -> None:
+        parser.add_argument("--data", default=None, help="folder of the depth sets (default: fepen/data/depth)")
+        set_option(parser, "a scene key in every run")
+
+    @classmethod
+    def options(cls, args) -> dict:
+        return {"data": args.data, "sets": args.sets}
+
+    def plan(self, data=None, sets=(), nodes_=None) -> CalibrationPlan:
+        from fepen import scene
+
+        scene.load(None, ["effects.fidelity=rigid", *sets])  # bad --set here
+        return CalibrationPlan(load_sets(data), list(nodes_ or nodes()), tuple(sets))
+
+    def digest(self, plan: CalibrationPlan) -> str:
+        import hashlib
+        import json
+
+        blob = json.dumps([{n: [r.__dict__ for r in rows] for n, rows in plan.sets.items()}, plan.nodes,
+                           plan.extra], sort_keys=True, default=str)
+        return hashlib.sha256(blob.encode()).hexdigest()[:16]
+
+    def rounds(self, plan: CalibrationPlan):
+        """Steps 2-6: the runs of the nodes not run yet, their fits, the nodes beyond the best (step 5)."""
+        tables, fits, todo, r = {}, {}, list(plan.nodes), 0
+        while True:
+            missing = [n for n in todo if _key(n) not in tables]
+            if missing:
+                js = jobs(plan.sets, missing, plan.extra)
+                recs = yield Round([job_scene(j) for j in js], folder=f"rounds/{r:03d}", label=f"round {r}",
+                                   then=True)
+                r += 1
+                t = table_of(plan.sets, missing, [_positions(_ok(recs[i])) for i in range(len(js))])
+                for i, n in enumerate(missing):
+                    tables[_key(n)] = list(t[i])
+            for k in tables:
+                if k not in fits:
+                    a, D0, obj = fit(plan.sets, tables[k])
+                    fits[k] = (obj, _node(k), a, D0)
+            ranked = sorted(fits.values(), key=lambda x: x[0])
+            todo = [n for n in _beyond(ranked[0][1], [x[1] for x in ranked]) if _key(n) not in tables]
+            if not todo:
+                self.ranked, self.tables = ranked, tables
+                return
+
+    def result(self, plan: CalibrationPlan, records: list, info) -> dict:
+        obj, node, a, D0 = self.ranked[0]
+        return {"chosen": {"node": node, "coefficient": a, "exponent": EXPONENT, "size_m": D0, "objective": obj},
+                "nodes": [{"node": n, "coefficient": aa, "size_m": dd, "objective": oo}
+                          for oo, n, aa, dd in self.ranked]}
+
+    def report(self, result: dict) -> str:
+        return "\n".join(["# The calibration of the concrete law", "", "```",
+                          *report_lines(self.plan_sets, self.tables, self.ranked), "```", ""])
+
+    def write(self, plan: CalibrationPlan, result: dict, out: Path, info) -> None:
+        self.plan_sets = plan.sets
+        super().write(plan, result, out, info)
+
+    def lines(self, result: dict) -> list[str]:
+        c = result["chosen"]
+        return [f"== chosen: {c['node']}, coefficient {c['coefficient']:.4g}, exponent {c['exponent']}, size "
+                f"{c['size_m']:.4g} m (objective {c['objective']:.4f})"]
+
+
+def _ok(record: dict) -> dict:
+    """A run's summary (a calibration run that did not finish stops the calibration)."""
+    if record["status"] != "ok":
+        from fepen.errors import SimulationError
+
+        raise SimulationError(f"a calibration run did not finish ({record['status']}: {record['message']})")
+    return record["summary"]
 
 
 def main(argv=None) -> int:
-    """``python -m fepen.studies.calibration [--data DIR] [--curves FILE] [--workers W] [--set KEY=VALUE]``."""
+    """``python -m fepen.studies.calibration [--data DIR] [--out DIR] [--set KEY=VALUE]``: the Calibration study
+    (``fepen study calibration`` runs the same)."""
     import argparse
+
+    from fepen.studies import study
 
     ap = argparse.ArgumentParser(prog="python -m fepen.studies.calibration")
     ap.add_argument("--data", default=None, help="folder of the depth sets (default: fepen/data/depth)")
-    ap.add_argument("--curves", default=None, help=".npz file of the runs: reused if it exists, and rewritten")
-    ap.add_argument("--workers", type=int, default=2)
+    ap.add_argument("--out", default=Calibration.out, help="results directory (its rounds are reused)")
     ap.add_argument("--set", dest="sets", action="append", default=[], metavar="KEY=VALUE")
     args = ap.parse_args(sys.argv[1:] if argv is None else argv)
-    sets = load_sets(args.data)
-    path = Path(args.curves) if args.curves else None
-    done = {}
-    if path is not None and path.exists():
-        z = np.load(path, allow_pickle=True)
-        done = {k: list(t) for k, t in zip(z["keys"], z["tables"])}
-    ranked, tables = search(sets, nodes(), args.workers, args.sets, done)
-    if path is not None:
-        keys = list(tables)
-        arr = np.empty((len(keys), len(sets)), dtype=object)
-        for i, k in enumerate(keys):
-            for j, t in enumerate(tables[k]):
-                arr[i, j] = t
-        np.savez(path, keys=np.array(keys), tables=arr)
-    report(sets, tables, ranked)
+    st = Calibration()
+    study.run(st, st.plan(args.data, args.sets), args.out, say=print)
+    print("\n".join(report_lines(st.plan_sets, st.tables, st.ranked)))
     return 0
 
 

@@ -26,10 +26,11 @@ import numpy as np
 
 from fepen.data import SHOTS
 from fepen.laws import target as tg
+from fepen.studies.study import Round, Study, register
 
 __all__ = ["Row", "read_set", "table1_set", "shipped_sets", "scene_sets", "rigid_depth", "closed_form_depth",
-           "errors", "predict_sets", "gather_sets", "summary_table", "interval_coverage", "markdown", "figure",
-           "validate_depth",
+           "errors", "shot_scenes", "predictions", "predict_sets", "gather_sets", "summary_table",
+           "interval_coverage", "markdown", "ValidateDepth", "validate_depth",
            "COLUMNS", "STRENGTH_BASES", "METHODS"]
 
 COLUMNS = ("shot", "d_mm", "m_kg", "crh", "L_mm", "v_ms", "fc_mpa", "rho_kgm3", "depth_m")
@@ -122,13 +123,13 @@ def rigid_depth(row: Row, sets=()) -> float:
     Args:
         row: the shot. sets: further --set lines (e.g. a strength model), after the shot's own.
     """
-    from mpi4py import MPI
-
     from fepen import scene
-    from fepen.runs.rigid import RigidRun
+    from fepen.studies import engine
 
-    sc = scene.load(None, [*scene_sets(row), *sets])
-    return RigidRun(sc, None, MPI.COMM_SELF, history=False).run()["Hy_mm"] / 1e3  # the final row alone
+    (s,) = engine.summaries([scene.load(None, [*scene_sets(row), *sets])])
+    if isinstance(s, Exception):
+        raise s
+    return s["Hy_mm"] / 1e3
 
 
 def closed_form_depth(row: Row, S: float | None = None, k: float = 2.0) -> float:
@@ -165,70 +166,51 @@ def errors(pred, meas) -> dict:
 METHODS = {"default": [], "forrestal-S": ["target.strength_model=forrestal-S"], "closed form": None}
 
 
-def predict_sets(sets: dict[str, list[Row]], extra=(), workers: int = 1) -> dict[str, list[dict]]:
-    """Every shot of every set by every METHODS entry.
+def shot_scenes(sets: dict[str, list[Row]], extra=()) -> tuple[list, list]:
+    """The rigid scenes of every shot by every rigid METHODS entry, and where each goes: ([Scene], [(set, row
+    index, method)]); a shot fepen cannot build (an impossible mass) is left out (its prediction NaN)."""
+    from fepen import scene
+    from fepen.errors import InputError
 
-    A shot's methods run together, in one process: its projectile is built once (fepen.runs.setup.projectile)
-    and its load points made once (fepen.runs.rigid.default_body). With workers > 1, a pool of processes that
-    import fepen and build the C kernels once each (_warm) takes the shots one at a time.
+    scenes, where = [], []
+    for name, rows in sets.items():
+        for i, row in enumerate(rows):
+            for method, lines in METHODS.items():
+                if lines is None:
+                    continue
+                try:
+                    scenes.append(scene.load(None, [*scene_sets(row), *lines, *extra]))
+                    where.append((name, i, method))
+                except InputError:
+                    pass
+    return scenes, where
 
-    Args:
-        sets: name -> rows. extra: --set lines added to every rigid run. workers: processes at once.
 
-    Returns:
-        name -> list of per-shot dicts (the row's fields, measured and predicted depths in m).
-    """
-    shots = [(name, i, row) for name, rows in sets.items() for i, row in enumerate(rows)]
-    jobs = [(row, tuple(extra)) for _, _, row in shots]
-    if workers > 1 and len(jobs) > 1:
-        from concurrent.futures import ProcessPoolExecutor
-
-        with ProcessPoolExecutor(min(workers, len(jobs)), initializer=_warm) as pool:
-            depths = list(pool.map(_predict_shot, jobs))
-    else:
-        depths = [_predict_shot(job) for job in jobs]
+def predictions(sets: dict[str, list[Row]], where: list, summaries) -> dict[str, list[dict]]:
+    """Every shot of every set by every METHODS entry: name -> list of per-shot dicts (the row's fields, the
+    measured and predicted depths in m), from the rigid shots' summaries (in the order of ``where``; an
+    InputError: NaN) and the closed form."""
     out: dict[str, list[dict]] = {name: [dict(row.__dict__) for row in rows] for name, rows in sets.items()}
-    for (name, i, _), d in zip(shots, depths):
-        out[name][i].update(d)
+    for name, rows in sets.items():
+        for i, row in enumerate(rows):
+            for method, lines in METHODS.items():
+                out[name][i][method] = closed_form_depth(row) if lines is None else math.nan
+    for (name, i, method), s in zip(where, summaries):
+        if isinstance(s, dict):
+            out[name][i][method] = s["Hy_mm"] / 1e3
+    for name in out:  # the methods in their order after the row's fields
+        out[name] = [{**{k: v for k, v in d.items() if k not in METHODS}, **{m: d[m] for m in METHODS}}
+                     for d in out[name]]
     return out
 
 
-def _warm() -> None:
-    """A worker's start: the imports and the C kernels of a rigid run, once."""
-    from mpi4py import MPI  # noqa: F401
+def predict_sets(sets: dict[str, list[Row]], extra=(), comm=None) -> dict[str, list[dict]]:
+    """Every shot of every set by every METHODS entry, here and now (fepen.studies.engine.summaries: the rigid
+    shots batched). Returns predictions()."""
+    from fepen.studies import engine
 
-    from fepen.laws import rigid_body
-    from fepen.runs import batch, rigid  # noqa: F401
-
-    rigid_body._kernel()
-    tg._point_kernel()
-    batch.kernel()
-
-
-def _predict_shot(job) -> dict[str, float]:
-    """One shot by every METHODS entry: method -> depth (m). The rigid methods run together (fepen.runs.batch:
-    one compiled call, the depths bitwise those of rigid_depth); a shot fepen cannot build is NaN."""
-    from fepen import scene
-    from fepen.errors import InputError
-    from fepen.runs import batch
-
-    row, extra = job
-    out = {method: closed_form_depth(row) for method, sets in METHODS.items() if sets is None}
-    scenes = {}
-    for method, sets in METHODS.items():
-        if sets is not None:
-            try:
-                scenes[method] = scene.load(None, [*scene_sets(row), *sets, *extra])
-            except InputError:  # a shot fepen cannot build (e.g. an impossible mass): left out of the errors
-                out[method] = math.nan
-    for method, s in zip(scenes, batch.summaries(list(scenes.values()), history=False)):  # the final row alone
-        if isinstance(s, InputError):
-            out[method] = math.nan
-        elif isinstance(s, Exception):
-            raise s
-        else:
-            out[method] = s["Hy_mm"] / 1e3
-    return {method: out[method] for method in METHODS}
+    scenes, where = shot_scenes(sets, extra)
+    return predictions(sets, where, engine.summaries(scenes, comm))
 
 
 def gather_sets(paths=(), shipped: bool = True) -> dict[str, list[Row]]:
@@ -317,63 +299,69 @@ def markdown(table: list[dict], header: str = "") -> str:
     return "\n".join(lines) + "\n"
 
 
-def figure(results: dict[str, list[dict]], path, method: str = "default") -> None:
-    """Predicted against measured depth, one marker per set, with the ±10 % and ±20 % bands (log scales, mm)."""
-    from fepen.post.figures import new_figure, save_figure
-
-    fig = new_figure((6.6, 6.4))
-    ax = fig.subplots()
-    hi = max(max(max(s["depth"], s[method]) for s in shots) for shots in results.values()) * 1.1e3
-    lo = min(min(min(s["depth"], s[method]) for s in shots) for shots in results.values()) / 1.1 * 1e3
-    line = np.geomspace(lo, hi, 50)
-    ax.plot(line, line, "k-", lw=1, label="predicted = measured")
-    for f, style in ((0.1, "--"), (0.2, ":")):
-        ax.plot(line, line * (1 + f), "k" + style, lw=0.8, label=f"±{f:.0%}")
-        ax.plot(line, line * (1 - f), "k" + style, lw=0.8)
-    markers = "osD^v<>pXh*P"
-    count = 0
-    for i, (name, shots) in enumerate(results.items()):
-        count += len(shots)
-        ax.plot([s["depth"] * 1e3 for s in shots], [s[method] * 1e3 for s in shots], markers[i % len(markers)],
-                ms=5, mfc="none", label=f"{name} ({len(shots)} tests)")
-    ax.set_xscale("log")
-    ax.set_yscale("log")
-    ax.set_xlim(lo, hi)
-    ax.set_ylim(lo, hi)
-    ax.set_xlabel("measured depth of penetration (mm)")
-    ax.set_ylabel(f"predicted depth (mm): rigid fidelity, {method} law")
-    ax.set_title(f"rigid fidelity against {count} measured depths ({len(results)} data sets)", fontsize=10)
-    ax.legend(fontsize=7, loc="upper left")
-    ax.grid(True, which="both", lw=0.3)
-    fig.tight_layout()
-    save_figure(fig, path, dpi=130)
-
-
 #: what fepen validate-depth writes into its folder
-DEPTH_NAMES = ("depth.csv", "depth.md", "depth.png")
+DEPTH_NAMES = ("shots.jsonl", "depth.csv", "depth.md", "depth.png")
 
 
-def validate_depth(paths=(), sets=(), out="results/validate-depth", workers: int = 1,
-                   shipped: bool = True) -> list[dict]:
-    """Run the data sets (gather_sets) by every method; write DIR/depth.csv (per shot), DIR/depth.md (the
-    table per set) and DIR/depth.png (predicted against measured); return the table.
+@dataclass
+class DepthPlan:
+    """The data sets, the --set lines and the law of the interval."""
 
-    Args:
-        paths: CSV files or folders of them. sets: --set lines for every rigid run (checked first).
-        out: results folder. workers: processes at once. shipped: include table1 and the shipped sets.
-    """
-    from fepen import scene
+    sets: dict
+    extra: tuple
+    law: str
 
-    scene.load(None, ["effects.fidelity=rigid", *sets])  # bad --set: InputError before any run
-    data = gather_sets(paths, shipped)
-    from mpi4py import MPI
 
-    from fepen.atomic import replacing
-    from fepen.io import files, rundir
+@register
+class ValidateDepth(Study):
+    """``fepen validate-depth``: every shot of the data sets by the rigid fidelity (both laws, batched on the
+    one executor) and the closed form; the errors per set and the interval's coverage."""
 
-    with rundir.study_directory(out, MPI.COMM_SELF, False, "validate-depth", DEPTH_NAMES):
-        results = predict_sets(data, sets, workers)
-        out = Path(out)
+    name = "validate-depth"
+    command = "validate-depth"
+    help = "depth data sets by the rigid fidelity and Forrestal's closed form: depth.csv, depth.md, depth.png"
+    names = DEPTH_NAMES
+    out = "results/validate-depth"
+
+    def plan(self, paths=(), sets=(), shipped: bool = True) -> DepthPlan:
+        from fepen import scene
+
+        law = scene.load(None, ["effects.fidelity=rigid", *sets]).target.strength_model  # bad --set here
+        return DepthPlan(gather_sets(paths, shipped), tuple(sets), law)
+
+    def digest(self, plan: DepthPlan) -> str:
+        import hashlib
+        import json
+
+        blob = json.dumps([{n: [r.__dict__ for r in rows] for n, rows in plan.sets.items()}, plan.extra],
+                          sort_keys=True)
+        return hashlib.sha256(blob.encode()).hexdigest()[:16]
+
+    def rounds(self, plan: DepthPlan):
+        self.scenes, self.where = shot_scenes(plan.sets, plan.extra)
+        yield Round(self.scenes, keep=lambda sc: False, label="shots")
+
+    def result(self, plan: DepthPlan, records: list, info) -> dict:
+        from fepen.errors import SimulationError
+
+        summaries = []
+        for i in range(len(self.scenes)):
+            r = records[0][i]
+            if r["status"] == "stopped":
+                raise SimulationError(r["message"])
+            summaries.append(r["summary"] if r["status"] == "ok" else None)
+        results = predictions(plan.sets, self.where, summaries)
+        return {"table": summary_table(results, plan.law), "_results": results}
+
+    def write(self, plan: DepthPlan, result: dict, out: Path, info) -> None:
+        from mpi4py import MPI
+
+        from fepen.atomic import replacing
+        from fepen.io import files
+        from fepen.post import study_figures
+        from fepen.post.figures import new_figure, save_figure
+
+        results = result["_results"]
         fields = ["set", *Row.__dataclass_fields__, *METHODS]
         buf = io.StringIO()
         w = csv.DictWriter(buf, fieldnames=fields, lineterminator="\r\n")
@@ -383,9 +371,18 @@ def validate_depth(paths=(), sets=(), out="results/validate-depth", workers: int
                 w.writerow({"set": name, **s})
         with replacing(out / "depth.csv") as tmp:
             tmp.write_text(buf.getvalue(), newline="")
-        table = summary_table(results, scene.load(None, ["effects.fidelity=rigid", *sets]).target.strength_model)
         note = (f"Rigid fidelity, default scene but for each shot's projectile, target strength and density"
-                f"{' and ' + ', '.join(sets) if sets else ''}; errors P_pred/P_meas - 1.")
-        files.write_text(out / "depth.md", markdown(table, note), MPI.COMM_SELF)
-        figure(results, out / "depth.png")
-    return table
+                f"{' and ' + ', '.join(plan.extra) if plan.extra else ''}; errors P_pred/P_meas - 1.")
+        files.write_text(out / "depth.md", markdown(result["table"], note), MPI.COMM_SELF)
+        fig = new_figure((6.6, 6.4))
+        study_figures.depth(fig, results)
+        save_figure(fig, out / "depth.png", dpi=130)
+
+
+def validate_depth(paths=(), sets=(), out="results/validate-depth", shipped: bool = True, comm=None) -> list[dict]:
+    """Run the data sets (gather_sets) by every method (ValidateDepth); write DIR/depth.csv (per shot),
+    DIR/depth.md (the table per set) and DIR/depth.png (predicted against measured); return the table."""
+    from fepen.studies import study
+
+    st = ValidateDepth()
+    return study.run(st, st.plan(paths, sets, shipped), out, comm, say=lambda *ls: None)["table"]

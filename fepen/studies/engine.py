@@ -22,13 +22,15 @@ import os
 import sys
 import threading
 import time
+from collections.abc import Callable
+from dataclasses import dataclass
 from pathlib import Path
 
 from mpi4py import MPI
 
 from fepen.errors import InputError, SimulationError
 
-__all__ = ["execute", "run_shot", "run_shots", "read_records", "check_directory", "other_study",
+__all__ = ["execute", "summaries", "run_shot", "run_shots", "process_shot", "How", "read_records",
            "check_ranks_per_shot", "RECORDS", "BATCH", "chunks"]
 
 RECORDS = "shots.jsonl"
@@ -54,31 +56,6 @@ def check_ranks_per_shot(ranks_per_shot: int, ranks: int) -> None:
         raise InputError("--ranks-per-shot", f"must divide the number of ranks ({ranks}), got {ranks_per_shot}")
 
 
-def check_directory(out: Path, digest: str, fresh: bool) -> tuple | None:
-    """On rank 0: None when OUT is new, holds this study (resumable) or ``fresh`` (its files removed by the
-    study's directory claim, by manifest); else the (key, message) of the InputError to raise on every rank."""
-    out = Path(out)
-    if out.exists() and not out.is_dir():
-        return ("--out", f"{out} is a file, not a results directory")
-    if fresh:  # the study's directory claim (fepen.io.rundir.study_directory) removed its files by manifest
-        return None
-    return other_study(out, out / "sweep.json", digest, "sweep")
-
-
-def other_study(out: Path, meta: Path, digest: str, what: str) -> tuple | None:
-    """The (key, message) of an InputError when ``meta`` (a study's record in OUT) holds another digest than
-    ``digest``, else None (no record, or the same study: resumable)."""
-    if meta.is_file():
-        try:
-            old = json.loads(meta.read_text()).get("digest")
-        except (OSError, ValueError):
-            old = None
-        if old != digest:
-            return ("--out", f"{out} holds the results of another {what}: give a new --out, or --fresh to "
-                             "replace them")
-    return None
-
-
 def read_records(out: Path) -> dict:
     """{shot: record} of OUT/shots.jsonl; a line cut short by a kill is ignored (its shot runs again)."""
     records = {}
@@ -100,12 +77,15 @@ class _Log:
     loses nothing it flushed) and synced to the disk at most every SYNC seconds (a machine that loses power
     loses at most that much)."""
 
-    def __init__(self, out: Path, records: dict, bar):
+    def __init__(self, out: Path | None, records: dict, bar):
         from fepen.atomic import open_append
 
-        self.path, self.records, self.bar = Path(out) / RECORDS, records, bar
-        self.f = open_append(self.path)  # never through a link; fepen's or new in the study's folder
+        self.records, self.bar, self.f = records, bar, None
         self.synced = time.monotonic()
+        if out is None:  # the records in memory alone (a study's quick calibration)
+            return
+        self.path = Path(out) / RECORDS
+        self.f = open_append(self.path)  # never through a link; fepen's or new in the study's folder
         if self.f.tell() > 0:  # a kill may have cut the last line: start on a new one
             with open(self.path, "rb") as g:
                 g.seek(-1, os.SEEK_END)
@@ -113,19 +93,21 @@ class _Log:
                     self.f.write("\n")
 
     def add(self, record: dict) -> None:
-        self.f.write(json.dumps(record, default=float) + "\n")
-        self.f.flush()
-        if time.monotonic() - self.synced > SYNC:
-            os.fsync(self.f.fileno())
-            self.synced = time.monotonic()
+        if self.f is not None:
+            self.f.write(json.dumps(record, default=float) + "\n")
+            self.f.flush()
+            if time.monotonic() - self.synced > SYNC:
+                os.fsync(self.f.fileno())
+                self.synced = time.monotonic()
         self.records[record["shot"]] = record
         if self.bar is not None:
             self.bar.update(1)
 
     def close(self):
-        self.f.flush()
-        os.fsync(self.f.fileno())
-        self.f.close()
+        if self.f is not None:
+            self.f.flush()
+            os.fsync(self.f.fileno())
+            self.f.close()
         if self.bar is not None:
             self.bar.close()
 
@@ -168,17 +150,40 @@ def _record(i: int, result, wall: float, comm) -> dict:
     return {"shot": i, "status": status, "message": message, "summary": summary, "wall_s": wall, "ranks": comm.size}
 
 
-def run_shots(indices, scene_of, out: Path, comm, keep) -> list[dict]:
+@dataclass(frozen=True)
+class How:
+    """How a round's shots run (execute's options, handed down to each group).
+
+    Attributes:
+        keep: Scene -> whether the shot keeps its results folder.
+        folder: (out, index) -> a kept shot's folder, or None (OUT/shots/NNNNN).
+        process: 0, or each shot is a whole ``fepen run`` process on this many ranks (its record's wall_s is the
+            process's: what a user waits), its folder always kept.
+    """
+
+    keep: Callable
+    folder: Callable | None = None
+    process: int = 0
+
+    def where(self, out: Path, i: int) -> Path:
+        return (self.folder or _shot_dir)(out, i)
+
+
+def run_shots(indices, scene_of, out: Path, comm, how: How) -> list[dict]:
     """The records of shots ``indices`` on comm, in order: the rigid shots that keep no results directory in
-    one batch (fepen.runs.batch: each its share of the batch's wall time), the others by run_shot.
+    one batch (fepen.runs.batch: each its share of the batch's wall time), the others by run_shot, or each a
+    whole process (How.process).
 
     Args:
         indices: shot indices. scene_of: index -> resolved Scene. out: the study's directory. comm: the group's
-            communicator. keep: Scene -> whether the shot writes its results directory.
+            communicator. how: How.
     """
     from fepen.runs import batch
 
     scenes = [(i, scene_of(i)) for i in indices]
+    if how.process:
+        return [process_shot(i, sc, how.where(out, i), how.process) for i, sc in scenes]
+    keep = how.keep
     together = [(i, sc) for i, sc in scenes if not keep(sc) and sc.effects.fidelity == "rigid"]
     records = {}
     if together:
@@ -189,7 +194,7 @@ def run_shots(indices, scene_of, out: Path, comm, keep) -> list[dict]:
             records[i] = _record(i, result, wall, comm)
     for i, sc in scenes:
         if i not in records:
-            records[i] = run_shot(i, sc, _shot_dir(out, i) if keep(sc) else None, comm)
+            records[i] = run_shot(i, sc, how.where(out, i) if keep(sc) else None, comm)
     return [records[i] for i in indices]
 
 
@@ -214,17 +219,42 @@ def bar_disabled(progress: bool = True) -> bool | None:
     return False if env == "1" else None
 
 
+def process_shot(i: int, scene, out: Path, ranks: int) -> dict:
+    """Shot i as a whole ``fepen run`` process on ``ranks`` ranks into ``out`` (its scene handed over as a
+    TOML file of its own, outside the folder); its record, with the process's wall time as wall_s."""
+    import tempfile
+
+    from fepen import scene as fscene
+    from fepen.studies import processes
+
+    with tempfile.TemporaryDirectory(prefix="fepen-shot-") as tmp:
+        path = Path(tmp) / "scene.toml"
+        path.write_text(fscene.to_toml(scene))
+        code, wall, message = processes.run_fepen_process(["run", path, "--out", out, "--force"], ranks)
+    summary = None
+    if code == 0:
+        summary = json.loads((Path(out) / "summary.json").read_text())
+        summary = {k: v for k, v in summary.items() if k not in ("scene", "versions")}
+    status = "ok" if code == 0 else "bad-input" if code == 2 else "stopped" if code == 3 else "failed"
+    return {"shot": i, "status": status, "message": "" if code == 0 else message, "summary": summary,
+            "wall_s": wall, "ranks": ranks}
+
+
 def execute(n: int, scene_of, out, comm=None, ranks_per_shot: int = 1, keep=None, say=None,
-            desc: str = "shots", batch: int = 1, progress: bool = True) -> tuple[dict, int]:
+            desc: str = "shots", batch: int = 1, progress: bool = True, folder=None,
+            process: int = 0) -> tuple[dict, int]:
     """Run the shots 0 … n−1 not yet recorded in OUT/shots.jsonl.
 
     Args:
-        n: number of shots. scene_of: shot index -> resolved Scene. out: the results directory (exists).
+        n: number of shots. scene_of: shot index -> resolved Scene. out: the results directory (exists), or None
+            (the records in memory only: no shot keeps a folder).
         comm: the communicator (None: COMM_WORLD). ranks_per_shot: ranks per group; divides comm.size.
         keep: Scene -> whether the shot writes its results directory OUT/shots/NNNNN (None: never for rigid
             shots). say: prints a line (rank 0). desc: the progress bar's label.
         batch: the most rigid shots of one batch. progress: the bar of shots done over the total on rank 0's
             stderr (bar_disabled: on a terminal, or FEPEN_PROGRESS=1).
+        folder: (out, index) -> the folder of a shot that keeps its results (None: OUT/shots/NNNNN).
+        process: 0, or each shot a whole ``fepen run`` process on this many ranks (How).
 
     Returns:
         ({shot: record} of every finished shot on rank 0, {} elsewhere; the number of shots run now).
@@ -232,9 +262,9 @@ def execute(n: int, scene_of, out, comm=None, ranks_per_shot: int = 1, keep=None
     comm = MPI.COMM_WORLD if comm is None else comm
     k = ranks_per_shot
     check_ranks_per_shot(k, comm.size)
-    keep = keep or (lambda sc: sc.effects.fidelity != "rigid")
-    out = Path(out)
-    records = read_records(out) if comm.rank == 0 else {}
+    how = How(keep or (lambda sc: sc.effects.fidelity != "rigid"), folder, process)
+    out = Path(out) if out is not None else None  # None: the records in memory, none kept
+    records = read_records(out) if comm.rank == 0 and out is not None else {}
     pending = comm.bcast([i for i in range(n) if i not in records] if comm.rank == 0 else None, root=0)
     groups = comm.size // k
     if comm.rank == 0 and say is not None:
@@ -256,15 +286,15 @@ def execute(n: int, scene_of, out, comm=None, ranks_per_shot: int = 1, keep=None
         runs = chunks(pending, batch, groups)
         if comm.size == 1:
             for run in runs:
-                for r in run_shots(run, scene_of, out, comm, keep):
+                for r in run_shots(run, scene_of, out, comm, how):
                     log.add(r)
         elif MPI.Query_thread() < MPI.THREAD_MULTIPLE:  # no dispatcher thread: a fixed round robin
             if comm.rank == 0 and say is not None:
                 say(f"{desc}: this MPI has no MPI_THREAD_MULTIPLE: shots go round robin, not by a queue")
-            _round_robin(runs, scene_of, out, comm, k, keep, log)
+            _round_robin(runs, scene_of, out, comm, k, how, log)
         else:
             sys.setswitchinterval(1e-3)  # rank 0's dispatcher answers within a millisecond or so
-            _parallel(runs, scene_of, out, comm, k, keep, log)
+            _parallel(runs, scene_of, out, comm, k, how, log)
     finally:
         quiet.setLevel(level)
         sys.setswitchinterval(interval)
@@ -277,7 +307,7 @@ def _shot_dir(out: Path, i: int) -> Path:
     return out / "shots" / f"{i:05d}"
 
 
-def _parallel(runs, scene_of, out, comm, k, keep, log) -> None:
+def _parallel(runs, scene_of, out, comm, k, how, log) -> None:
     group = comm.Split(comm.rank // k, comm.rank)
     queue = comm.Dup()
     groups = comm.size // k
@@ -295,7 +325,7 @@ def _parallel(runs, scene_of, out, comm, k, keep, log) -> None:
             run = group.bcast(run, root=0)
             if not run:
                 break
-            rs = run_shots(run, scene_of, out, group, keep)
+            rs = run_shots(run, scene_of, out, group, how)
             records = rs if group.rank == 0 else None
     finally:
         if dispatcher is not None:
@@ -304,11 +334,11 @@ def _parallel(runs, scene_of, out, comm, k, keep, log) -> None:
         queue.Free()
 
 
-def _round_robin(runs, scene_of, out, comm, k, keep, log) -> None:
+def _round_robin(runs, scene_of, out, comm, k, how, log) -> None:
     group = comm.Split(comm.rank // k, comm.rank)
     mine = []
     for run in runs[comm.rank // k:: comm.size // k]:
-        rs = run_shots(run, scene_of, out, group, keep)
+        rs = run_shots(run, scene_of, out, group, how)
         if comm.rank == 0:
             for r in rs:
                 log.add(r)
@@ -339,3 +369,25 @@ def _dispatch(queue, runs: list, groups: int, log) -> None:
         else:
             queue.send([], dest=src, tag=_REPLY)
             stopped += 1
+
+
+def summaries(scenes, comm=None) -> list:
+    """The summaries of shots that keep no folder, run here and now (the executor in memory: no records file;
+    rigid shots batched, fepen.runs.batch), in order: a summary dict, or the InputError of a shot fepen cannot
+    build. A shot the simulation could not finish raises its SimulationError.
+
+    Args:
+        scenes: resolved Scenes. comm: the communicator (None: COMM_SELF); every rank gets the summaries.
+    """
+    comm = MPI.COMM_SELF if comm is None else comm
+    records, _ = execute(len(scenes), lambda i: scenes[i], None, comm, keep=lambda sc: False, batch=BATCH,
+                         progress=False)
+    records = comm.bcast(records if comm.rank == 0 else None, root=0) if comm.size > 1 else records
+    out = []
+    for i in range(len(scenes)):
+        r = records[i]
+        if r["status"] == "stopped":
+            raise SimulationError(r["message"])
+        out.append(r["summary"] if r["status"] == "ok" else InputError(*r["message"].split(": ", 1))
+                   if ": " in r["message"] else InputError("", r["message"]))
+    return out

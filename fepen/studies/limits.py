@@ -1,6 +1,6 @@
-"""``fepen study ballistic-limit`` and ``fepen study ricochet`` (docs/studies.md): outcome boundaries found
-by bisection, each round of shots run on fepen.studies.engine (so on any number of ranks, and resumable: a
-round's records are kept in OUT/rounds/NNN, and the bisection replays them).
+"""``fepen study ballistic-limit`` and ``fepen study ricochet`` (docs/studies.md): outcome boundaries found by
+bisection, each a Study (fepen.studies.study) whose rounds of shots run on the one executor (so on any number of
+ranks, and resumable: a round's records are kept in OUT/rounds/NNN, and the bisection replays them).
 
 Ballistic limit: the striking speed v_bl below which the projectile does not perforate the slab (or layered
 target), bracketed by [v_lo, v_hi] and bisected until v_hi − v_lo ≤ tol; v_bl is the bracket's middle. Above
@@ -14,18 +14,16 @@ obliquity × speed grid.
 
 from __future__ import annotations
 
-from pathlib import Path
+from dataclasses import dataclass
 
 import numpy as np
-from mpi4py import MPI
 
 from fepen import scene as fscene
-from fepen.atomic import make_dir
 from fepen.errors import InputError
-from fepen.io import files
-from fepen.studies import engine
+from fepen.studies.study import Round, Study, numbers, register, set_option
 
-__all__ = ["ballistic_limit", "ricochet", "recht_ipson", "fit_recht_ipson"]
+__all__ = ["BallisticLimit", "Ricochet", "ballistic_limit", "ricochet", "recht_ipson", "fit_recht_ipson",
+           "check_ballistic_limit", "check_ricochet", "scene_line"]
 
 
 def recht_ipson(v, v_bl: float, a: float, p: float):
@@ -42,27 +40,6 @@ def fit_recht_ipson(v, vr, v_bl: float) -> tuple[float, float, float]:
     (a, p), _ = curve_fit(lambda x, a, p: recht_ipson(x, v_bl, a, p), v, vr, p0=(1.0, 2.0),
                           bounds=([0.1, 1.0], [1.5, 10.0]))
     return float(a), float(p), float(np.sqrt(np.mean((recht_ipson(v, v_bl, a, p) - vr) ** 2)))
-
-
-def _round(out: Path, r: int, scenes: list, comm, k: int) -> list[dict]:
-    """Run a round of shots (resumable) and return their summaries (every rank), in order."""
-    d = out / "rounds" / f"{r:03d}"
-    if comm.rank == 0:
-        make_dir(d)  # fepen's or new in the study's folder, never a link
-    comm.barrier()
-    rigid = all(sc.effects.fidelity == "rigid" for sc in scenes)
-    records, _ = engine.execute(len(scenes), lambda i: scenes[i], d, comm, k,
-                                batch=engine.BATCH if rigid else 1)  # rigid shots in batches
-    recs = comm.bcast([records[i] for i in range(len(scenes))] if comm.rank == 0 else None, root=0)
-    for rec in recs:
-        if rec["status"] != "ok":
-            raise InputError("study", f"a shot of round {r} did not finish ({rec['status']}: {rec['message']})")
-    return [rec["summary"] for rec in recs]
-
-
-#: what the limit studies write into their folders (fepen.io.rundir.study_directory)
-BALLISTIC_NAMES = ("rounds", "ballistic_limit.json", "ballistic_limit.png")
-RICOCHET_NAMES = ("rounds", "ricochet.json", "ricochet.png")
 
 
 def _base(scene_path, sets) -> dict:
@@ -97,73 +74,7 @@ def check_ricochet(scene_path, sets, speeds, obliquity_max: float, tol: float) -
     return base, probe, speeds
 
 
-def ballistic_limit(scene_path, sets, out, comm=None, ranks_per_shot: int = 1, v_low: float = 100.0,
-                    v_high: float = 1500.0, tol: float = 2.0, curve: int = 8, say=print) -> dict:
-    """The ballistic limit of the scene's target by bisection on perforation, the check one tolerance either
-    side, and the Recht–Ipson fit of the residual speeds above it.
-
-    Args:
-        scene_path, sets: the base scene (a finite target.thickness or target.layers) and --set overrides.
-        out: results directory. comm: communicator. ranks_per_shot: ranks per shot.
-        v_low, v_high: the initial bracket (m/s): v_low must not perforate, v_high must.
-        tol: the bracket's final width (m/s). curve: shots of the residual-speed curve.
-        say: prints a line (rank 0).
-
-    Returns:
-        {"v_bl_m_s", "bracket_m_s", "tol_m_s", "check": {below, above}, "a", "p", "rms_m_s", "curve": [...]}.
-    """
-    comm = MPI.COMM_WORLD if comm is None else comm
-    base, probe = check_ballistic_limit(scene_path, sets, v_low, v_high, tol)
-    out = files.prepare(out, comm)
-
-    def scene(v):
-        return fscene.Scene({**base, "impact.velocity": float(v)})
-
-    def perforates(s):
-        return s["outcome"] == "perforated"
-
-    lo, hi = float(v_low), float(v_high)
-    r = 0
-    ends = _round(out, r, [scene(lo), scene(hi)], comm, ranks_per_shot)
-    if perforates(ends[0]) or not perforates(ends[1]):
-        raise InputError("--speeds", f"{lo:g} m/s must not perforate and {hi:g} m/s must "
-                                     f"({ends[0]['outcome']}, {ends[1]['outcome']})")
-    steps = [(lo, ends[0]["outcome"], ends[0]["residual_speed_m_s"]),
-             (hi, ends[1]["outcome"], ends[1]["residual_speed_m_s"])]
-    while hi - lo > tol:
-        r += 1
-        mid = 0.5 * (lo + hi)
-        s = _round(out, r, [scene(mid)], comm, ranks_per_shot)[0]
-        steps.append((mid, s["outcome"], s["residual_speed_m_s"]))
-        if perforates(s):
-            hi = mid
-        else:
-            lo = mid
-    v_bl = 0.5 * (lo + hi)
-    speeds = [v_bl * (1.0 + 0.04 * (j + 1)) for j in range(curve)] if curve else []
-    r += 1
-    shots = _round(out, r, [scene(v_bl - tol), scene(v_bl + tol), *map(scene, speeds)], comm, ranks_per_shot)
-    check = {"below": {"v_m_s": v_bl - tol, "outcome": shots[0]["outcome"]},
-             "above": {"v_m_s": v_bl + tol, "outcome": shots[1]["outcome"],
-                       "residual_speed_m_s": shots[1]["residual_speed_m_s"]}}
-    pts = [(v, s["residual_speed_m_s"]) for v, s in zip(speeds, shots[2:]) if perforates(s)]
-    result = {"v_bl_m_s": v_bl, "bracket_m_s": [lo, hi], "tol_m_s": tol, "check": check,
-              "bisection": [{"v_m_s": v, "outcome": o, "residual_speed_m_s": vr} for v, o, vr in steps],
-              "curve": [{"v_m_s": v, "residual_speed_m_s": vr} for v, vr in pts]}
-    if len(pts) >= 3:
-        a, p, rms = fit_recht_ipson([v for v, _ in pts], [vr for _, vr in pts], v_bl)
-        result.update(a=a, p=p, rms_m_s=rms)
-    if comm.rank == 0:
-        files.write_json(out / "ballistic_limit.json", result, MPI.COMM_SELF)
-        _limit_figure(result, out / "ballistic_limit.png", probe)
-        say(f"ballistic limit {v_bl:.1f} m/s (bracket {lo:.2f}-{hi:.2f}, tol {tol:g}); "
-            f"{v_bl - tol:.1f} m/s: {check['below']['outcome']}, {v_bl + tol:.1f} m/s: {check['above']['outcome']}"
-            + (f"; Recht-Ipson a = {result['a']:.3f}, p = {result['p']:.2f}, rms {result['rms_m_s']:.1f} m/s"
-               if "a" in result else ""))
-    return result
-
-
-def _scene_line(sc) -> str:
+def scene_line(sc) -> str:
     """What a study's figure says of its base scene: fidelity, projectile mass and calibre, the target."""
     layers = sc.get("target.layers")
     if layers:
@@ -180,106 +91,248 @@ def _scene_line(sc) -> str:
             f"{sc.get('projectile.diameter') * 1e3:g} mm projectile; {target}")
 
 
-def _limit_figure(res: dict, path: Path, sc=None) -> None:
-    """ballistic_limit.png: residual against striking speed, the shots that did not perforate on the axis,
-    the Recht–Ipson fit and the limit (dotted). sc: the base Scene (for the title), or None."""
-    from fepen.post.figures import new_figure, save_figure
+def _summaries(r: int, records: dict, n: int) -> list[dict]:
+    """The summaries of a round's n shots, in order (InputError when one did not finish)."""
+    recs = [records[i] for i in range(n)]
+    for rec in recs:
+        if rec["status"] != "ok":
+            raise InputError("study", f"a shot of round {r} did not finish ({rec['status']}: {rec['message']})")
+    return [rec["summary"] for rec in recs]
 
-    fig = new_figure((6.4, 4.6))
-    ax = fig.subplots()
-    pts = res["curve"] + [{"v_m_s": b["v_m_s"], "residual_speed_m_s": b["residual_speed_m_s"]}
-                          for b in res["bisection"] if b["outcome"] == "perforated"]
-    v = np.array([p["v_m_s"] for p in pts])
-    vr = np.array([p["residual_speed_m_s"] for p in pts])
-    ax.plot(v, vr, "o", label="fepen shots (perforated)")
-    stuck = [b["v_m_s"] for b in res["bisection"] if b["outcome"] != "perforated"]
-    ax.plot(stuck, np.zeros(len(stuck)), "x", color="tab:red", label="fepen shots (not perforated)")
-    if "a" in res:
-        x = np.linspace(res["v_bl_m_s"], max(v.max(), res["v_bl_m_s"] * 1.4), 200)
-        ax.plot(x, recht_ipson(x, res["v_bl_m_s"], res["a"], res["p"]), "-", color="k",
-                label=f"Recht–Ipson fit: a = {res['a']:.3f}, p = {res['p']:.2f}")
-    ax.axvline(res["v_bl_m_s"], ls=":", color="k", label=f"ballistic limit {res['v_bl_m_s']:.1f} m/s")
-    ax.set_xlabel("striking speed (m/s)")
-    ax.set_ylabel("residual speed (m/s)")
-    title = f"ballistic limit {res['v_bl_m_s']:.1f} m/s (± {res['tol_m_s'] / 2:g} m/s)"
-    ax.set_title(title + (f"\n{_scene_line(sc)}" if sc is not None else ""), fontsize=9)
-    ax.grid(alpha=0.3)
-    ax.legend(fontsize=8)
-    fig.tight_layout()
-    save_figure(fig, path, dpi=120)
+
+def _round(r: int, scenes: list) -> Round:
+    """A bisection round: its records in rounds/NNN, every rank told its outcomes, rigid shots in batches."""
+    return Round(scenes, folder=f"rounds/{r:03d}", label="", then=True,
+                 batch=all(sc.effects.fidelity == "rigid" for sc in scenes))
+
+
+@dataclass
+class LimitPlan:
+    """A limit study's checked inputs."""
+
+    base: dict
+    probe: fscene.Scene
+    speeds: list
+    tol: float
+    extra: float = 0.0  #: the ricochet's obliquity_max; the ballistic limit's shots of the curve
+    curve: int = 8
+
+
+class _Limit(Study):
+    """What the two limit studies share: the base scene and --set, the rounds' shots, the figure's title."""
+
+    names = ("rounds",)
+
+    @classmethod
+    def add_arguments(cls, parser) -> None:
+        parser.add_argument("scene", nargs="?", help="the base scene (absent: the default)")
+        set_option(parser, "override a key of the base scene")
+
+    def figure_size(self, result: dict) -> tuple[float, float]:
+        return (6.4, 4.6)
+
+    def scene(self, plan: LimitPlan, **keys) -> fscene.Scene:
+        return fscene.Scene({**plan.base, **{k: float(v) for k, v in keys.items()}})
+
+    def write(self, plan: LimitPlan, result: dict, out, info) -> None:
+        from mpi4py import MPI
+
+        from fepen.io import files
+        from fepen.post.figures import new_figure, save_figure
+
+        files.write_json(out / f"{self.json_name}.json", result, MPI.COMM_SELF)
+        fig = new_figure(self.figure_size(result))
+        self.draw(fig, result, plan)
+        save_figure(fig, out / f"{self.json_name}.png", dpi=120)
+
+
+@register
+class BallisticLimit(_Limit):
+    """``fepen study ballistic-limit``: bisection on perforation, the check one tolerance either side, the
+    Recht–Ipson fit of the residual speeds above the limit."""
+
+    name = "ballistic-limit"
+    help = "the speed below which the target is not perforated, by bisection: ballistic_limit.json, .png"
+    names = ("rounds", "ballistic_limit.json", "ballistic_limit.png")
+    out = "results/ballistic-limit"
+
+    @classmethod
+    def add_arguments(cls, parser) -> None:
+        super().add_arguments(parser)
+        parser.add_argument("--speeds", default="100,1500", help="the bracket 'LOW,HIGH' (default 100,1500 m/s)")
+        parser.add_argument("--tol", type=float, default=2.0, help="the bisection's final width in m/s (default 2)")
+
+    @classmethod
+    def options(cls, args) -> dict:
+        bracket = numbers("--speeds", args.speeds)
+        if len(bracket) != 2:
+            raise InputError("--speeds", f"two speeds LOW,HIGH (m/s), got {args.speeds!r}")
+        return {"scene_path": args.scene, "sets": args.sets, "v_low": bracket[0], "v_high": bracket[1],
+                "tol": args.tol}
+
+    def plan(self, scene_path=None, sets=(), v_low: float = 100.0, v_high: float = 1500.0, tol: float = 2.0,
+             curve: int = 8) -> LimitPlan:
+        base, probe = check_ballistic_limit(scene_path, sets, v_low, v_high, tol)
+        return LimitPlan(base, probe, [float(v_low), float(v_high)], tol, curve=curve)
+
+    def rounds(self, plan: LimitPlan):
+        lo, hi = plan.speeds
+        tol = plan.tol
+        self.bisection, r = [], 0
+        ends = _summaries(r, (yield _round(r, [self.scene(plan, **{"impact.velocity": v}) for v in (lo, hi)])), 2)
+        if _perforates(ends[0]) or not _perforates(ends[1]):
+            raise InputError("--speeds", f"{lo:g} m/s must not perforate and {hi:g} m/s must "
+                                         f"({ends[0]['outcome']}, {ends[1]['outcome']})")
+        self.bisection = [(lo, ends[0]["outcome"], ends[0]["residual_speed_m_s"]),
+                          (hi, ends[1]["outcome"], ends[1]["residual_speed_m_s"])]
+        while hi - lo > tol:
+            r += 1
+            mid = 0.5 * (lo + hi)
+            s = _summaries(r, (yield _round(r, [self.scene(plan, **{"impact.velocity": mid})])), 1)[0]
+            self.bisection.append((mid, s["outcome"], s["residual_speed_m_s"]))
+            lo, hi = (lo, mid) if _perforates(s) else (mid, hi)
+        self.bracket = (lo, hi)
+        v_bl = 0.5 * (lo + hi)
+        self.speeds = [v_bl * (1.0 + 0.04 * (j + 1)) for j in range(plan.curve)] if plan.curve else []
+        vs = [v_bl - tol, v_bl + tol, *self.speeds]
+        self.last = _summaries(r + 1, (yield _round(r + 1, [self.scene(plan, **{"impact.velocity": v})
+                                                            for v in vs])), len(vs))
+
+    def result(self, plan: LimitPlan, records: list[dict], info) -> dict:
+        lo, hi = self.bracket
+        v_bl, tol, shots = 0.5 * (lo + hi), plan.tol, self.last
+        check = {"below": {"v_m_s": v_bl - tol, "outcome": shots[0]["outcome"]},
+                 "above": {"v_m_s": v_bl + tol, "outcome": shots[1]["outcome"],
+                           "residual_speed_m_s": shots[1]["residual_speed_m_s"]}}
+        pts = [(v, s["residual_speed_m_s"]) for v, s in zip(self.speeds, shots[2:]) if _perforates(s)]
+        result = {"v_bl_m_s": v_bl, "bracket_m_s": [lo, hi], "tol_m_s": tol, "check": check,
+                  "bisection": [{"v_m_s": v, "outcome": o, "residual_speed_m_s": vr} for v, o, vr in self.bisection],
+                  "curve": [{"v_m_s": v, "residual_speed_m_s": vr} for v, vr in pts]}
+        if len(pts) >= 3:
+            a, p, rms = fit_recht_ipson([v for v, _ in pts], [vr for _, vr in pts], v_bl)
+            result.update(a=a, p=p, rms_m_s=rms)
+        return result
+
+    def draw(self, fig, res: dict, plan: LimitPlan) -> None:
+        from fepen.post import study_figures
+
+        fit = None
+        if "a" in res:
+            v = [p["v_m_s"] for p in res["curve"]] + [b["v_m_s"] for b in res["bisection"]
+                                                       if b["outcome"] == "perforated"]
+            x = np.linspace(res["v_bl_m_s"], max(max(v), res["v_bl_m_s"] * 1.4), 200)
+            fit = (x, recht_ipson(x, res["v_bl_m_s"], res["a"], res["p"]))
+        study_figures.limit(fig, res, scene_line(plan.probe), fit)
+
+    def lines(self, res: dict) -> list[str]:
+        v_bl, tol, check = res["v_bl_m_s"], res["tol_m_s"], res["check"]
+        lo, hi = res["bracket_m_s"]
+        return [f"ballistic limit {v_bl:.1f} m/s (bracket {lo:.2f}-{hi:.2f}, tol {tol:g}); "
+                f"{v_bl - tol:.1f} m/s: {check['below']['outcome']}, {v_bl + tol:.1f} m/s: {check['above']['outcome']}"
+                + (f"; Recht-Ipson a = {res['a']:.3f}, p = {res['p']:.2f}, rms {res['rms_m_s']:.1f} m/s"
+                   if "a" in res else "")]
+
+
+@register
+class Ricochet(_Limit):
+    """``fepen study ricochet``: the outcome map over obliquity and speed, and at each speed the critical
+    obliquity by bisection (every speed's in the same rounds)."""
+
+    name = "ricochet"
+    help = "the outcome map over obliquity and speed, the critical obliquity at each speed: ricochet.json, .png"
+    names = ("rounds", "ricochet.json", "ricochet.png")
+    out = "results/ricochet"
+
+    def figure_size(self, result: dict) -> tuple[float, float]:
+        return (6.4, 4.8)
+
+    @classmethod
+    def add_arguments(cls, parser) -> None:
+        super().add_arguments(parser)
+        parser.add_argument("--speeds", default="300,400,500,600,700,800,900", help="the speeds (default "
+                                                                                    "300,400,...,900 m/s)")
+        parser.add_argument("--tol", type=float, default=0.5, help="the bisection's final width in deg (default 0.5)")
+        parser.add_argument("--obliquity-max", type=float, default=85.0, help="top of the bracket (deg)")
+
+    @classmethod
+    def options(cls, args) -> dict:
+        import math
+
+        if not (math.isfinite(args.obliquity_max) and 0.0 < args.obliquity_max < 90.0):
+            raise InputError("--obliquity-max", f"in (0, 90) deg, got {args.obliquity_max!r}")
+        return {"scene_path": args.scene, "sets": args.sets, "speeds": numbers("--speeds", args.speeds),
+                "obliquity_max": args.obliquity_max, "tol": args.tol}
+
+    def plan(self, scene_path=None, sets=(), speeds=(300, 400, 500, 600, 700, 800, 900), obliquity_max: float = 85.0,
+             tol: float = 0.5, map_step: float = 10.0) -> LimitPlan:
+        base, probe, speeds = check_ricochet(scene_path, sets, speeds, obliquity_max, tol)
+        return LimitPlan(base, probe, speeds, tol, extra=obliquity_max, curve=map_step)
+
+    def rounds(self, plan: LimitPlan):
+        speeds, tol, top, step = plan.speeds, plan.tol, plan.extra, plan.curve
+        grid = [float(x) for x in np.arange(0.0, top + 1e-9, step)]
+        if grid[-1] < top:
+            grid.append(top)
+        pairs = [(v, ob) for v in speeds for ob in grid]
+        shots = _summaries(0, (yield _round(0, [self._at(plan, v, ob) for v, ob in pairs])), len(pairs))
+        self.cells = [{"v_m_s": v, "obliquity_deg": ob, "outcome": s["outcome"]} for (v, ob), s in zip(pairs, shots)]
+        self.brackets = []
+        for v in speeds:  # the bracket: the last grid obliquity that does not ricochet, the next that does
+            row = [c for c in self.cells if c["v_m_s"] == v]
+            rico = [c["obliquity_deg"] for c in row if c["outcome"] == "ricochet"]
+            if not rico:
+                raise InputError("--obliquity-max", f"no ricochet at {v:g} m/s up to {top:g} deg")
+            hi = min(rico)
+            lower = [c["obliquity_deg"] for c in row if c["obliquity_deg"] < hi]
+            self.brackets.append([max(lower) if lower else 0.0, hi])
+        r = 0
+        while any(hi - lo > tol for lo, hi in self.brackets):
+            r += 1
+            open_ = [j for j, (lo, hi) in enumerate(self.brackets) if hi - lo > tol]
+            mids = [0.5 * sum(self.brackets[j]) for j in open_]
+            res = _summaries(r, (yield _round(r, [self._at(plan, speeds[j], m) for j, m in zip(open_, mids)])),
+                             len(open_))
+            for j, m, s in zip(open_, mids, res):
+                self.cells.append({"v_m_s": speeds[j], "obliquity_deg": m, "outcome": s["outcome"]})
+                self.brackets[j][1 if s["outcome"] == "ricochet" else 0] = m
+
+    def _at(self, plan: LimitPlan, v: float, ob: float) -> fscene.Scene:
+        return fscene.Scene({**plan.base, "impact.velocity": v, "impact.obliquity_deg": float(ob)})
+
+    def result(self, plan: LimitPlan, records: list[dict], info) -> dict:
+        critical = [0.5 * (lo + hi) for lo, hi in self.brackets]
+        return {"speeds_m_s": plan.speeds, "critical_obliquity_deg": critical, "brackets": self.brackets,
+                "tol_deg": plan.tol, "map": self.cells}
+
+    def draw(self, fig, res: dict, plan: LimitPlan) -> None:
+        from fepen.post import study_figures
+
+        study_figures.ricochet(fig, res, scene_line(plan.probe))
+
+    def lines(self, res: dict) -> list[str]:
+        return ["critical obliquity: " + ", ".join(f"{v:g} m/s {c:.1f} deg" for v, c in
+                                                   zip(res["speeds_m_s"], res["critical_obliquity_deg"]))]
+
+
+def _perforates(s: dict) -> bool:
+    return s["outcome"] == "perforated"
+
+
+def ballistic_limit(scene_path, sets, out, comm=None, ranks_per_shot: int = 1, v_low: float = 100.0,
+                    v_high: float = 1500.0, tol: float = 2.0, curve: int = 8, say=print, fresh: bool = False) -> dict:
+    """The ballistic limit study (BallisticLimit) run into OUT; its result (every rank)."""
+    from fepen.studies import study
+
+    st = BallisticLimit()
+    return study.run(st, st.plan(scene_path, sets, v_low, v_high, tol, curve), out, comm, ranks_per_shot, fresh, say)
 
 
 def ricochet(scene_path, sets, out, comm=None, ranks_per_shot: int = 1, speeds=(300, 400, 500, 600, 700, 800, 900),
-             obliquity_max: float = 85.0, tol: float = 0.5, map_step: float = 10.0, say=print) -> dict:
-    """The ricochet boundary (critical obliquity) at each speed by bisection, and the outcome map.
+             obliquity_max: float = 85.0, tol: float = 0.5, map_step: float = 10.0, say=print,
+             fresh: bool = False) -> dict:
+    """The ricochet study (Ricochet) run into OUT; its result (every rank)."""
+    from fepen.studies import study
 
-    Args:
-        scene_path, sets: the base scene and --set overrides (its obliquity is what varies).
-        speeds: striking speeds (m/s). obliquity_max: the bracket's top (deg): must ricochet.
-        tol: the bisection's final width (deg). map_step: the outcome map's obliquity step (deg).
-
-    Returns:
-        {"speeds_m_s", "critical_obliquity_deg", "brackets", "map": [{v, obliquity, outcome}], "tol_deg"}.
-    """
-    comm = MPI.COMM_WORLD if comm is None else comm
-    base, probe, speeds = check_ricochet(scene_path, sets, speeds, obliquity_max, tol)
-    out = files.prepare(out, comm)
-
-    def scene(v, ob):
-        return fscene.Scene({**base, "impact.velocity": v, "impact.obliquity_deg": float(ob)})
-
-    grid = [float(x) for x in np.arange(0.0, obliquity_max + 1e-9, map_step)]
-    if grid[-1] < obliquity_max:
-        grid.append(obliquity_max)
-    pairs = [(v, ob) for v in speeds for ob in grid]
-    r = 0
-    shots = _round(out, r, [scene(v, ob) for v, ob in pairs], comm, ranks_per_shot)
-    cells = [{"v_m_s": v, "obliquity_deg": ob, "outcome": s["outcome"]} for (v, ob), s in zip(pairs, shots)]
-    brackets = []
-    for v in speeds:  # the bracket: the last grid obliquity that does not ricochet, the next that does
-        row = [c for c in cells if c["v_m_s"] == v]
-        rico = [c["obliquity_deg"] for c in row if c["outcome"] == "ricochet"]
-        if not rico:
-            raise InputError("--obliquity-max", f"no ricochet at {v:g} m/s up to {obliquity_max:g} deg")
-        hi = min(rico)
-        lower = [c["obliquity_deg"] for c in row if c["obliquity_deg"] < hi]
-        brackets.append([max(lower) if lower else 0.0, hi])
-    while any(hi - lo > tol for lo, hi in brackets):
-        r += 1
-        open_ = [j for j, (lo, hi) in enumerate(brackets) if hi - lo > tol]
-        mids = [0.5 * sum(brackets[j]) for j in open_]
-        res = _round(out, r, [scene(speeds[j], m) for j, m in zip(open_, mids)], comm, ranks_per_shot)
-        for j, m, s in zip(open_, mids, res):
-            cells.append({"v_m_s": speeds[j], "obliquity_deg": m, "outcome": s["outcome"]})
-            brackets[j][1 if s["outcome"] == "ricochet" else 0] = m
-    critical = [0.5 * (lo + hi) for lo, hi in brackets]
-    result = {"speeds_m_s": speeds, "critical_obliquity_deg": critical, "brackets": brackets, "tol_deg": tol,
-              "map": cells}
-    if comm.rank == 0:
-        files.write_json(out / "ricochet.json", result, MPI.COMM_SELF)
-        _ricochet_figure(result, out / "ricochet.png", probe)
-        say("critical obliquity: " + ", ".join(f"{v:g} m/s {c:.1f} deg" for v, c in zip(speeds, critical)))
-    return result
-
-
-def _ricochet_figure(res: dict, path: Path, sc=None) -> None:
-    """ricochet.png: the outcome of every shot over striking speed and obliquity, and the bisected ricochet
-    boundary. sc: the base Scene (for the title), or None."""
-    from fepen.post.figures import new_figure, save_figure
-    from fepen.studies.sweep_figures import OUTCOME_COLOURS
-
-    fig = new_figure((6.4, 4.8))
-    ax = fig.subplots()
-    for name in sorted({c["outcome"] for c in res["map"]}):
-        c = [m for m in res["map"] if m["outcome"] == name]
-        ax.plot([m["v_m_s"] for m in c], [m["obliquity_deg"] for m in c], "s", ms=5,
-                color=OUTCOME_COLOURS.get(name, "k"), label=f"fepen shots: {name}", alpha=0.8)
-    ax.plot(res["speeds_m_s"], res["critical_obliquity_deg"], "-k", lw=1.5,
-            label=f"ricochet boundary (± {res['tol_deg'] / 2:g}°)")
-    ax.set_xlabel("striking speed (m/s)")
-    ax.set_ylabel("obliquity from the face normal (°)")
-    ax.set_title("critical obliquity of ricochet" + (f"\n{_scene_line(sc)}" if sc is not None else ""), fontsize=9)
-    ax.grid(alpha=0.3)
-    ax.legend(fontsize=8)
-    fig.tight_layout()
-    save_figure(fig, path, dpi=120)
+    st = Ricochet()
+    return study.run(st, st.plan(scene_path, sets, speeds, obliquity_max, tol, map_step), out, comm, ranks_per_shot,
+                     fresh, say)

@@ -12,7 +12,8 @@ Each row keeps the shot's features (what the validated envelope is made of, fepe
 measurement. The table is an output of fepen, not an input: ``tests/system/test_prediction_errors.py`` runs a
 subset again and checks it is what this version predicts.
 
-    .venv/bin/python -m fepen.studies.prediction_errors [--plastic DIR] [--workers W] [--out FILE]
+    .venv/bin/python -m fepen.studies.prediction_errors [--plastic DIR] [--out FILE]
+    .venv/bin/fepen study prediction-errors [--plastic DIR] [--table FILE] [--out DIR]
 
 ``--plastic DIR``: the directory of ``fepen validate --set run.fields=false --out DIR`` (the plastic fidelity
 at the default mesh); without it the plastic rows of the existing table are kept.
@@ -24,15 +25,17 @@ import csv
 import io
 import math
 import sys
+from dataclasses import dataclass
 from pathlib import Path
 
 from fepen.data.prediction_errors import COLUMNS, read
 from fepen.data.prediction_errors import path as shipped_path
 from fepen.laws import target as tg
 from fepen.studies import depth
+from fepen.studies.study import Round, Study, register
 
-__all__ = ["LAWS", "LATERAL_MIN_OBLIQUITY_DEG", "depth_rows", "lateral_rows",
-           "plastic_lateral_rows", "write", "main"]
+__all__ = ["LAWS", "LATERAL_MIN_OBLIQUITY_DEG", "depth_rows", "lateral_scenes", "lateral_rows",
+           "plastic_lateral_rows", "write", "PredictionErrors", "main"]
 
 #: the concrete strength laws with prediction errors: target.strength_model -> fepen.studies.depth.METHODS name
 LAWS = {"scaled-S": "default", "forrestal-S": "forrestal-S"}
@@ -53,11 +56,12 @@ def _features(row: depth.Row) -> dict:
             "obliquity_deg": row.obliquity_deg, "attack_deg": row.attack_deg}
 
 
-def depth_rows(sets: dict | None = None, workers: int = 1) -> list[dict]:
+def depth_rows(sets: dict | None = None, results: dict | None = None) -> list[dict]:
     """The depth rows: every shot of ``sets`` (name -> fepen.studies.depth rows; None: table1 and the shipped
-    sets) by every law of LAWS (the rigid fidelity; a shot fepen cannot build is left out)."""
+    sets) by every law of LAWS (the rigid fidelity; a shot fepen cannot build is left out), from ``results``
+    (fepen.studies.depth.predictions; None: run here and now)."""
     sets = depth.gather_sets() if sets is None else sets
-    results = depth.predict_sets(sets, (), workers)
+    results = depth.predict_sets(sets) if results is None else results
     out = []
     for name, shots in results.items():
         for row, s in zip(sets[name], shots):
@@ -79,20 +83,24 @@ def _table1_row(shot) -> depth.Row:
     return next(r for r in depth.table1_set() if r.name == shot.name)
 
 
-def lateral_rows() -> list[dict]:
-    """Table 1's oblique shots' sideways travel Hx by the rigid fidelity at the defaults (``impact.shot``)."""
-    from mpi4py import MPI
-
+def lateral_scenes() -> list:
+    """Table 1's oblique shots by the rigid fidelity at the defaults (``impact.shot``)."""
     from fepen import scene
-    from fepen.runs.rigid import RigidRun
 
+    return [scene.load(None, ["effects.fidelity=rigid", f"impact.shot={s.name}"]) for s in _lateral_shots()]
+
+
+def lateral_rows(summaries: list | None = None) -> list[dict]:
+    """Table 1's oblique shots' sideways travel Hx by the rigid fidelity at the defaults, from their summaries
+    (lateral_scenes' order; None: run here and now)."""
+    from fepen.studies import engine
+
+    summaries = engine.summaries(lateral_scenes()) if summaries is None else summaries
     out = []
-    for s in _lateral_shots():
-        sc = scene.load(None, ["effects.fidelity=rigid", f"impact.shot={s.name}"])
-        hx = RigidRun(sc, None, MPI.COMM_SELF, history=False).run()["Hx_mm"] / 1e3
+    for s, summary in zip(_lateral_shots(), summaries):
         out.append({"set": "table1", "shot": s.name, "role": _role("table1"), "law": "scaled-S",
                     "fidelity": "rigid", "quantity": "lateral", **_features(_table1_row(s)),
-                    "predicted_m": hx, "measured_m": s.Hx_mm / 1e3})
+                    "predicted_m": summary["Hx_mm"] / 1e3, "measured_m": s.Hx_mm / 1e3})
     return out
 
 
@@ -118,31 +126,94 @@ def write(rows: list[dict], path, header: str) -> None:
     w.writerow(COLUMNS)
     for r in rows:
         w.writerow([repr(r[c]) if isinstance(r[c], float) else r[c] for c in COLUMNS])
-    Path(path).write_text(buf.getvalue())
+    from fepen.atomic import replacing
+
+    with replacing(path) as tmp:
+        tmp.write_text(buf.getvalue())
+
+
+@dataclass
+class ErrorsPlan:
+    """The sets, the plastic rows' validation folder (or None: the table's own plastic rows), the table."""
+
+    sets: dict
+    plastic: str | None
+    table: str | None
+
+
+@register
+class PredictionErrors(Study):
+    """fepen/data/prediction_errors.csv: fepen's predictions of the shipped public shots (one round of rigid
+    shots on the one executor), the plastic rows from a validation, written with their provenance."""
+
+    name = "prediction-errors"
+    help = "fepen's errors on the shipped public data: prediction_errors.csv (fepen/data's table, docs/uncertainty.md)"
+    names = ("shots.jsonl", "prediction_errors.csv")
+    out = "results/prediction-errors"
+
+    @classmethod
+    def add_arguments(cls, parser) -> None:
+        parser.add_argument("--plastic", metavar="DIR", help="a `fepen validate --set run.fields=false` folder")
+        parser.add_argument("--table", metavar="FILE", help="write the table here too (fepen/data's: --table "
+                                                            "fepen/data/prediction_errors.csv)")
+
+    @classmethod
+    def options(cls, args) -> dict:
+        return {"plastic": args.plastic, "table": args.table}
+
+    def plan(self, plastic=None, table=None) -> ErrorsPlan:
+        return ErrorsPlan(depth.gather_sets(), plastic, table)
+
+    def rounds(self, plan: ErrorsPlan):
+        self.scenes, self.where = depth.shot_scenes(plan.sets)
+        lateral = lateral_scenes()
+        yield Round([*self.scenes, *lateral], keep=lambda sc: False, label="shots")
+
+    def result(self, plan: ErrorsPlan, records: list, info) -> dict:
+        from fepen.studies.calibration import _ok
+        from fepen.version import __version__
+
+        recs = records[0]
+        n = len(self.scenes)
+        summaries = [recs[i]["summary"] if recs[i]["status"] == "ok" else None for i in range(n)]
+        rows = depth_rows(plan.sets, depth.predictions(plan.sets, self.where, summaries))
+        rows += lateral_rows([_ok(recs[n + j]) for j in range(len(_lateral_shots()))])
+        if plan.plastic:
+            rows += plastic_lateral_rows(plan.plastic)
+            plastic = (f"the plastic rows from {Path(plan.plastic).name}/validation.csv (fepen validate, "
+                       "run.fields=false)")
+        else:
+            rows += [r for r in read() if r["fidelity"] == "plastic"]
+            plastic = "the plastic rows kept from the shipped table"
+        header = (f"fepen {__version__}: fepen study prediction-errors; {plastic}.\n"
+                  "Predictions of fepen's defaults on the shipped public data (docs/uncertainty.md); lengths in m.")
+        return {"rows": len(rows), "_rows": rows, "_header": header}
+
+    def write(self, plan: ErrorsPlan, result: dict, out: Path, info) -> None:
+        write(result["_rows"], out / "prediction_errors.csv", result["_header"])
+        if plan.table:
+            write(result["_rows"], plan.table, result["_header"])
+
+    def lines(self, result: dict) -> list[str]:
+        return [f"{result['rows']} rows"]
 
 
 def main(argv=None) -> int:
+    """``python -m fepen.studies.prediction_errors [--plastic DIR] [--out FILE]``: the PredictionErrors study,
+    its table written to FILE (default: the shipped one)."""
     import argparse
+    import tempfile
 
-    from fepen.version import __version__
+    from fepen.studies import study
 
     p = argparse.ArgumentParser(prog="python -m fepen.studies.prediction_errors", description=__doc__.split("\n\n")[0])
     p.add_argument("--plastic", metavar="DIR", help="a `fepen validate --set run.fields=false` results directory")
-    p.add_argument("--workers", type=int, default=2)
     p.add_argument("--out", default=str(shipped_path()))
     args = p.parse_args(argv)
-    rows = depth_rows(workers=args.workers) + lateral_rows()
-    if args.plastic:
-        rows += plastic_lateral_rows(args.plastic)
-        plastic = f"the plastic rows from {Path(args.plastic).name}/validation.csv (fepen validate, run.fields=false)"
-    else:
-        old = [r for r in read(args.out) if r["fidelity"] == "plastic"] if Path(args.out).is_file() else []
-        rows += old
-        plastic = "the plastic rows kept from the previous table"
-    header = (f"fepen {__version__}: python -m fepen.studies.prediction_errors; {plastic}.\n"
-              "Predictions of fepen's defaults on the shipped public data (docs/uncertainty.md); lengths in m.")
-    write(rows, args.out, header)
-    print(f"written: {args.out} ({len(rows)} rows)")
+    st = PredictionErrors()
+    with tempfile.TemporaryDirectory(prefix="fepen-errors-") as tmp:
+        res = study.run(st, st.plan(args.plastic, args.out), tmp, say=lambda *ls: None)
+    print(f"written: {args.out} ({res['rows']} rows)")
     return 0
 
 

@@ -88,10 +88,17 @@ def run_fepen_process(args: list[str], ranks: int = 1) -> tuple[int, float, str]
     return r.returncode, wall, (lines[-1] if lines else r.stderr.strip()[-400:])
 
 
+def relaunch(argv: list, workers: int) -> int:
+    """A study command started without mpirun on a machine that has it (``fepen sweep``, ``fepen validate``,
+    ``fepen validate-depth``): the same command again as ``mpirun -n WORKERS python -m fepen ARGV --workers 1``,
+    whose ranks share the shots (the caller checked its input first, and sets FEPEN_PROGRESS for the bar).
+    Returns that process's exit code."""
+    return subprocess.run(command([*map(str, argv), "--workers", "1"], workers), env=mpi_env()).returncode
+
+
 def relaunch_sweep(sweep_file, out, ranks_per_shot: int, workers: int, sets=(), fresh: bool = False) -> int:
-    """``fepen sweep`` started without mpirun on a machine that has it: the same sweep again as ``mpirun -n
-    WORKERS python -m fepen sweep ... --workers 1``, whose ranks share the shots in groups of
-    ``ranks_per_shot`` (the caller checked its input first). Returns that process's exit code."""
-    argv = ["sweep", sweep_file, "--out", out, "--ranks-per-shot", str(ranks_per_shot), "--workers", "1",
+    """``fepen sweep`` started without mpirun on a machine that has it: ``relaunch`` of the same sweep, whose ranks
+    share the shots in groups of ``ranks_per_shot``. Returns that process's exit code."""
+    argv = ["sweep", sweep_file, "--out", out, "--ranks-per-shot", str(ranks_per_shot),
             *(["--fresh"] if fresh else []), *[f"--set={s}" for s in sets]]
-    return subprocess.run(command(argv, workers), env=mpi_env()).returncode
+    return relaunch(argv, workers)

@@ -1,430 +1,34 @@
-"""``fepen sweep SWEEP.toml``: many shots of one base scene with some keys varied (docs/studies.md).
-
-A sweep file names a base scene and the keys to vary, in one of three ways:
-
-    scene = "../scenes/default.toml"      # the base scene (absent: the default scene), relative to this file
-    [base]                                # scene keys over it, written as in a scene file
-    effects.fidelity = "rigid"
-
-    [grid]                                # every combination (the first key varies slowest)
-    "impact.velocity" = [500.0, 600.0, 700.0]
-    "impact.obliquity_deg" = { start = 0.0, stop = 30.0, num = 4 }
-
-    [monte_carlo]                         # or: a seeded sample
-    samples = 2000
-    seed = 1
-    latin_hypercube = false
-    [monte_carlo.vary]                    # mean absent: the base scene's value
-    "impact.velocity" = { distribution = "normal", std = 20.0 }
-    "impact.obliquity_deg" = { distribution = "truncated-normal", std = 1.0, low = 0.0 }
-    "target.compressive_strength" = { distribution = "normal", std_percent = 10.0 }
-
-    [table]                               # or: one shot per row of a CSV whose header names scene keys
-    file = "shots.csv"
-
-    [output]
-    keep_results = false                  # each shot's results directory (deformable shots: always)
-    digits = 6                            # significant digits of the numbers in sweep.csv
+"""``fepen sweep SWEEP.toml``: many shots of one base scene with some keys varied (docs/studies.md), read from a
+sweep spec (fepen.studies.spec: a base scene and [grid], [monte_carlo] or [table]).
 
 Writes to OUT: sweep.json (the sweep as run), shots.jsonl (one record per finished shot, appended as each
 ends: what makes a killed sweep resumable), sweep.csv (one row per shot: the varied keys and every summary
 figure; sweep.parquet too when pyarrow is installed), costs.csv (wall time and ranks per shot), sweep.md and
-figures. The shots run on fepen.studies.engine (MPI groups taking shots from a shared queue).
+figures (fepen.post.study_figures). A Study (fepen.studies.study) of one round, on the one executor.
 """
 
 from __future__ import annotations
 
 import csv
-import hashlib
 import io
-import json
-import math
-from dataclasses import dataclass, field
+from dataclasses import dataclass
 from pathlib import Path
 
 import numpy as np
 
-from fepen import scene as fscene
 from fepen.errors import InputError
+from fepen.studies.spec import DISTRIBUTIONS, IMPACT, MAX_SHOTS, monte_carlo, read, resized
+from fepen.studies.spec import Spec as Sweep
+from fepen.studies.study import Round, Study, register
 
-__all__ = ["Sweep", "read", "run", "table_rows", "resized", "DISTRIBUTIONS"]
+__all__ = ["Sweep", "SweepStudy", "SweepPlan", "read", "run", "table_rows", "write_table", "resized",
+           "DISTRIBUTIONS", "MAX_SHOTS", "IMPACT", "monte_carlo", "measured_shot"]
 
-#: the most shots of one sweep: each shot's record is held in memory (about 5 kB), and every shot's scene is
-#: checked before the first runs; a larger study is several sweeps (another seed, or part of the grid each)
-MAX_SHOTS = 200_000
-#: the largest table of shots read (bytes)
-TABLE_MAX = 64 << 20
-#: distribution name: its parameters (mean absent: the base scene's value)
-DISTRIBUTIONS = {"normal": ("mean", "std"), "uniform": ("low", "high"),
-                 "truncated-normal": ("mean", "std", "low", "high")}
 #: summary entries that describe the machine or the run's cost, not the shot (costs.csv holds some)
 MACHINE = ("wall_s", "time_split_s", "peak_memory_bytes", "ranks", "scene", "versions")
-IMPACT = ("impact.velocity", "impact.obliquity_deg", "impact.attack_deg")
-
-
-@dataclass
-class Sweep:
-    """A sweep as read from its file.
-
-    Attributes:
-        kind: "grid", "monte-carlo" or "table".
-        base: the base scene's given keys (flat, dotted).
-        keys: the varied scene keys, in the file's order.
-        shots: one {key: value} per shot, in shot order.
-        keep_results: keep every shot's results directory.
-        digits: significant digits of sweep.csv's numbers.
-        spec: the sweep file's content (for sweep.json and the digest).
-    """
-
-    kind: str
-    base: dict
-    keys: list
-    shots: list
-    keep_results: bool = False
-    digits: int = 6
-    spec: dict = field(default_factory=dict)
-
-    @property
-    def digest(self) -> str:
-        """A digest of the base and the shots: a results directory of another sweep is not resumed."""
-        text = json.dumps([self.base, self.shots, self.keep_results], sort_keys=True, default=str)
-        return hashlib.sha256(text.encode()).hexdigest()[:16]
-
-    def scene(self, i: int) -> fscene.Scene:
-        """The resolved scene of shot i (InputError naming the shot and the key)."""
-        try:
-            return fscene.Scene({**self.base, **self.shots[i]})
-        except InputError as err:
-            raise InputError(f"shot {i}: {err.key}", err.message) from None
-
-
-def resized(path, samples: int, seed: int | None = None) -> str:
-    """The text of a Monte Carlo sweep file with another sample size (and seed), its base scene made absolute:
-    for tests and benchmarks of a shipped sweep file."""
-    import re
-
-    path = Path(path).resolve()
-    text = path.read_text()
-    text = re.sub(r"(?m)^scene = \"(.*)\"", lambda m: f'scene = "{(path.parent / m.group(1)).resolve()}"', text)
-    text = re.sub(r"(?m)^samples = \d+", f"samples = {samples}", text)
-    if seed is not None:
-        text = re.sub(r"(?m)^seed = \d+", f"seed = {seed}", text)
-    return text
-
-
-def _flat_leaves(tree: dict, is_leaf, prefix: str = "") -> dict:
-    """{dotted key: leaf} of a TOML table whose keys may be quoted ("impact.velocity") or nested."""
-    out = {}
-    for k, v in tree.items():
-        name = f"{prefix}{k}"
-        if isinstance(v, dict) and not is_leaf(v):
-            out.update(_flat_leaves(v, is_leaf, name + "."))
-        else:
-            out[name] = v
-    return out
-
-
-def _check_key(section: str, name: str) -> None:
-    if name not in fscene.SCHEMA:
-        err = fscene.unknown_key(name)
-        raise InputError(f"{section}.{name}", f"not a scene key ({err.message})")
-
-
-def _number(where: str, value, positive: bool = False) -> float:
-    if isinstance(value, bool) or not isinstance(value, (int, float)) or not math.isfinite(value):
-        raise InputError(where, f"must be a finite number, got {value!r}")
-    if positive and value <= 0:
-        raise InputError(where, f"must be > 0, got {value!r}")
-    return float(value)
-
-
-def _grid_values(name: str, spec) -> list:
-    where = f"grid.{name}"
-    if isinstance(spec, list):
-        if not spec:
-            raise InputError(where, "an empty list: give at least one value")
-        return list(spec)
-    if isinstance(spec, dict):
-        unknown = set(spec) - {"start", "stop", "num", "step"}
-        if unknown or "start" not in spec or "stop" not in spec or ("num" in spec) == ("step" in spec):
-            raise InputError(where, "a range is {start, stop, num} or {start, stop, step} (stop included)")
-        a, b = _number(f"{where}.start", spec["start"]), _number(f"{where}.stop", spec["stop"])
-        if "num" in spec:
-            num = spec["num"]
-            if isinstance(num, bool) or not isinstance(num, int) or not 1 <= num <= 100000:
-                raise InputError(f"{where}.num", f"must be an integer in [1, 100000], got {num!r}")
-            return [float(x) for x in np.linspace(a, b, num)]
-        step = _number(f"{where}.step", spec["step"], positive=True)
-        num = int(math.floor(abs(b - a) / step + 1e-9)) + 1
-        if num > 100000:
-            raise InputError(f"{where}.step", f"gives {num} values; at most 100000")
-        return [float(a + math.copysign(step, b - a) * i) for i in range(num)]
-    raise InputError(where, f"a list of values or a range table {{start, stop, num}}, got {spec!r}")
-
-
-def _distribution(name: str, spec, base_value) -> tuple:
-    """(kind, parameters) of one Monte Carlo key, checked."""
-    where = f"monte_carlo.vary.{name}"
-    if not isinstance(spec, dict) or spec.get("distribution") not in DISTRIBUTIONS:
-        raise InputError(f"{where}.distribution", f"one of {', '.join(map(repr, DISTRIBUTIONS))}")
-    kind = spec["distribution"]
-    allowed = {"distribution", *DISTRIBUTIONS[kind], *(("std_percent",) if "std" in DISTRIBUTIONS[kind] else ())}
-    unknown = sorted(set(spec) - allowed)
-    if unknown:
-        raise InputError(f"{where}.{unknown[0]}", f"not a parameter of {kind!r}; allowed: {', '.join(sorted(allowed))}")
-    p = {}
-    if kind == "uniform":
-        for k in ("low", "high"):
-            if k not in spec:
-                raise InputError(f"{where}.{k}", "required by 'uniform'")
-            p[k] = _number(f"{where}.{k}", spec[k])
-        if not p["low"] < p["high"]:
-            raise InputError(f"{where}.high", f"must be above low = {p['low']:g}")
-        return kind, p
-    mean = spec.get("mean", base_value)
-    if mean is None:
-        raise InputError(f"{where}.mean", "required: the base scene gives this key no value")
-    p["mean"] = _number(f"{where}.mean", mean)
-    if ("std" in spec) == ("std_percent" in spec):
-        raise InputError(f"{where}.std", "give one of std (in the key's unit) and std_percent (of the mean)")
-    p["std"] = (_number(f"{where}.std", spec["std"], positive=True) if "std" in spec
-                else abs(p["mean"]) * _number(f"{where}.std_percent", spec["std_percent"], positive=True) / 100)
-    if kind == "truncated-normal":
-        p["low"] = _number(f"{where}.low", spec.get("low", -math.inf)) if "low" in spec else -math.inf
-        p["high"] = _number(f"{where}.high", spec["high"]) if "high" in spec else math.inf
-        if not p["low"] < p["high"]:
-            raise InputError(f"{where}.high", f"must be above low = {p['low']:g}")
-    return kind, p
-
-
-def _quantile(kind: str, p: dict, u: np.ndarray) -> np.ndarray:
-    """The distribution's values at probabilities u (inverse CDF: the same u gives the same value)."""
-    from scipy.special import ndtr, ndtri
-
-    if kind == "uniform":
-        return p["low"] + (p["high"] - p["low"]) * u
-    if kind == "normal":
-        return p["mean"] + p["std"] * ndtri(u)
-    a, b = ndtr((p["low"] - p["mean"]) / p["std"]), ndtr((p["high"] - p["mean"]) / p["std"])
-    return p["mean"] + p["std"] * ndtri(a + u * (b - a))
-
-
-def monte_carlo(distributions: dict, samples: int, seed: int, latin_hypercube: bool) -> list[dict]:
-    """The sample: one {key: value} per shot, from numpy's default_rng(seed), keys in the given order.
-
-    Args:
-        distributions: {key: (kind, parameters)} (_distribution).
-        samples: number of shots. seed: the generator's seed.
-        latin_hypercube: stratify each key's probabilities into `samples` equal bins, in a random order.
-
-    Returns:
-        The shots' values.
-    """
-    rng = np.random.default_rng(seed)
-    keys = list(distributions)
-    if latin_hypercube:
-        u = np.stack([(rng.permutation(samples) + rng.random(samples)) / samples for _ in keys], axis=1)
-    else:
-        u = rng.random((samples, len(keys)))
-    u = np.clip(u, 1e-12, 1.0 - 1e-12)
-    cols = [_quantile(*distributions[k], u[:, j]) for j, k in enumerate(keys)]
-    return [{k: float(cols[j][i]) for j, k in enumerate(keys)} for i in range(samples)]
-
-
-def _read_table(path: Path) -> tuple[list, list]:
-    """Keys and shots of a CSV table (header: scene keys; values in TOML syntax, bare words strings)."""
-    try:
-        text = fscene.read_capped(path, TABLE_MAX, "table.file", "a table of shots").decode()
-    except UnicodeDecodeError:
-        raise InputError("table.file", f"{path} is not UTF-8 text") from None
-    rows = list(csv.reader(io.StringIO(text)))
-    rows = [r for r in rows if r and not r[0].lstrip().startswith("#")]
-    if len(rows) < 2:
-        raise InputError("table.file", f"{path} needs a header of scene keys and at least one row")
-    if len(rows) - 1 > MAX_SHOTS:
-        raise InputError("table.file", f"{path} holds {len(rows) - 1} shots; a sweep holds at most {MAX_SHOTS}")
-    keys = [k.strip() for k in rows[0]]
-    for k in keys:
-        _check_key("table.file", k)
-    shots = []
-    for n, r in enumerate(rows[1:], start=2):
-        if len(r) != len(keys):
-            raise InputError("table.file", f"{path} line {n}: {len(r)} values for {len(keys)} keys")
-        shots.append({k: fscene.parse_set(f"{k}={v.strip()}")[1] for k, v in zip(keys, r)})
-    return keys, shots
-
-
-def read(path, sets=()) -> Sweep:
-    """Read and check a sweep file; every shot's scene is resolved, so bad input stops here.
-
-    Args:
-        path: the SWEEP.toml, or its content as a dict (``{"base": {...}, "grid": {"impact.velocity": [...]}}``;
-            a relative ``scene`` or table ``file`` is then taken from the working directory).
-        sets: --set KEY=VALUE overrides of the base scene.
-
-    Returns:
-        The Sweep.
-
-    Raises:
-        InputError: naming the sweep key (or the shot and the scene key) and what is allowed.
-    """
-    if isinstance(path, dict):
-        spec, path = _sections(dict(path), "the sweep"), Path.cwd() / "sweep.toml"
-    else:
-        path = Path(path)
-        spec = _load(path)
-    kinds = [k for k in ("grid", "monte_carlo", "table") if k in spec]
-    if len(kinds) != 1:
-        raise InputError("SWEEP", "give exactly one of [grid], [monte_carlo] and [table]")
-    base = _base_keys(path, spec, sets)
-    resolved = fscene.Scene(base)  # the base alone must be a valid scene
-    kind = kinds[0]
-    if kind == "grid":
-        keys, shots = _grid(spec["grid"])
-    elif kind == "monte_carlo":
-        keys, shots = _monte_carlo(spec["monte_carlo"], resolved)
-    else:
-        tab = spec["table"]
-        if not isinstance(tab, dict) or not isinstance(tab.get("file"), str):
-            raise InputError("table.file", "the CSV file of shots (a string)")
-        keys, shots = _read_table((path.parent / tab["file"]).resolve())
-    if ("target.compressive_strength" in keys and "target.strength_basis" not in base
-            and "target.strength_basis" not in keys and resolved.get("target.layers") is None):
-        # a varied strength is on the base scene's basis (the default concrete's 40 MPa is a cube strength);
-        # given alone, each shot's value would be read as a cylinder strength (theory.md §8.1)
-        base["target.strength_basis"] = resolved.get("target.strength_basis")
-    if any(k in IMPACT for k in keys) and "impact.shot" in base:
-        # the shot's three impact values become plain keys, so that the varied ones may replace them
-        del base["impact.shot"]
-        for k in IMPACT:
-            base.setdefault(k, resolved.get(k))
-    keep, digits = _output(spec.get("output", {}))
-    sweep = Sweep(kind.replace("_", "-"), base, keys, shots, keep, digits, spec)
-    _check_shots(sweep)
-    return sweep
-
-
-def _load(path: Path) -> dict:
-    import tomllib
-
-    if not path.is_file():
-        raise InputError("SWEEP", f"cannot read {fscene.display_name(str(path), 200)}: no such file")
-    data = fscene.read_capped(path, fscene.SCENE_MAX, "SWEEP", "a sweep file")
-    try:
-        spec = tomllib.loads(data.decode())
-    except (tomllib.TOMLDecodeError, UnicodeDecodeError) as err:
-        raise InputError("SWEEP", f"{path} is not valid TOML: {err}") from None
-    return _sections(spec, str(path))
-
-
-def _sections(spec: dict, where: str) -> dict:
-    """The sweep's sections, checked by name (InputError naming an unknown one)."""
-    known = {"scene", "base", "grid", "monte_carlo", "table", "output"}
-    for k in spec:
-        if k not in known:
-            raise InputError(k, f"not a sweep section of {where}; allowed: {', '.join(sorted(known))}")
-    return spec
-
-
-def _base_keys(path: Path, spec: dict, sets) -> dict:
-    """The base scene's given keys: the scene file, then [base], then --set."""
-    base = {}
-    if "scene" in spec:
-        if not isinstance(spec["scene"], str):
-            raise InputError("scene", "the base scene's file name (a string)")
-        scene_path = (path.parent / spec["scene"]).resolve()
-        if not scene_path.is_file():
-            raise InputError("scene", f"no such file: {scene_path}")
-        base.update(fscene.read_toml(scene_path))
-    if "base" in spec:
-        if not isinstance(spec["base"], dict):
-            raise InputError("base", "a table of scene keys")
-        base.update(fscene.flatten(spec["base"]))
-    for item in sets:
-        k, v = fscene.parse_set(item)
-        base[k] = v
-    for k in base:
-        if k not in fscene.SCHEMA:
-            raise fscene.unknown_key(k)
-    return base
-
-
-def _grid(grid) -> tuple[list, list]:
-    if not isinstance(grid, dict) or not grid:
-        raise InputError("grid", "a table of scene keys, each with a list or a range")
-    values = _flat_leaves(grid, lambda d: "start" in d)
-    for k in values:
-        _check_key("grid", k)
-    values = {k: _grid_values(k, v) for k, v in values.items()}
-    keys = list(values)
-    count = math.prod(len(v) for v in values.values())
-    if count > MAX_SHOTS:
-        sizes = " x ".join(f"{len(v)} ({k})" for k, v in values.items())
-        raise InputError("grid", f"{sizes} = {count} shots; a sweep holds at most {MAX_SHOTS}: split it into several "
-                                 "sweeps, or use [monte_carlo]")
-    return keys, [dict(zip(keys, combo)) for combo in _product([values[k] for k in keys])]
-
-
-def _monte_carlo(mc, resolved) -> tuple[list, list]:
-    allowed = {"samples", "seed", "latin_hypercube", "vary"}
-    for k in mc:
-        if k not in allowed:
-            raise InputError(f"monte_carlo.{k}", f"not a key of [monte_carlo]; allowed: {', '.join(sorted(allowed))}")
-    n = mc.get("samples")
-    if isinstance(n, bool) or not isinstance(n, int) or not 1 <= n <= MAX_SHOTS:
-        raise InputError("monte_carlo.samples", f"an integer in [1, {MAX_SHOTS}] (split a larger study into sweeps of "
-                                                f"other seeds), got {fscene.display_name(repr(n), 40)}")
-    seed = mc.get("seed", 0)
-    if isinstance(seed, bool) or not isinstance(seed, int) or seed < 0:
-        raise InputError("monte_carlo.seed", f"a non-negative integer, got {seed!r}")
-    lhs = mc.get("latin_hypercube", False)
-    if not isinstance(lhs, bool):
-        raise InputError("monte_carlo.latin_hypercube", f"true or false, got {lhs!r}")
-    vary = mc.get("vary")
-    if not isinstance(vary, dict) or not vary:
-        raise InputError("monte_carlo.vary", "a table of scene keys, each with its distribution")
-    specs = _flat_leaves(vary, lambda d: "distribution" in d)
-    for k in specs:
-        _check_key("monte_carlo.vary", k)
-    dists = {k: _distribution(k, v, resolved.get(k)) for k, v in specs.items()}
-    return list(dists), monte_carlo(dists, n, seed, lhs)
-
-
-def _output(output) -> tuple[bool, int]:
-    if not isinstance(output, dict) or set(output) - {"keep_results", "digits"}:
-        raise InputError("output", "a table of keep_results (true or false) and digits (3 to 17)")
-    keep = output.get("keep_results", False)
-    if not isinstance(keep, bool):
-        raise InputError("output.keep_results", f"true or false, got {keep!r}")
-    digits = output.get("digits", 6)
-    if isinstance(digits, bool) or not isinstance(digits, int) or not 3 <= digits <= 17:
-        raise InputError("output.digits", f"an integer in [3, 17], got {digits!r}")
-    return keep, digits
-
-
-def _product(lists):
-    if not lists:
-        yield ()
-        return
-    for v in lists[0]:
-        for rest in _product(lists[1:]):
-            yield (v, *rest)
-
-
-def _check_shots(sweep: Sweep) -> None:
-    """Resolve every shot's scene and build each distinct projectile once: bad input before any shot runs."""
-    from fepen.runs import setup
-
-    seen = set()
-    for i in range(len(sweep.shots)):
-        sc = sweep.scene(i)
-        try:
-            key = setup.body_key(sc)
-            if key not in seen or (sc.effects.fidelity == "rigid" and sc.target.kind != "concrete"):
-                seen.add(key)
-                setup.check_supported(sc)  # builds the projectile: once per distinct one
-        except InputError as err:
-            raise InputError(f"shot {i}: {err.key}", err.message) from None
+#: what a sweep writes into its folder (fepen.io.rundir.study_directory)
+SWEEP_NAMES = ("sweep.json", "shots.jsonl", "shots", "sweep.csv", "costs.csv", "sweep.parquet", "sweep.md", "sweep.png",
+               "histograms.png")
 
 
 # -------------------------------------------------------------------------------------------------- table
@@ -527,77 +131,222 @@ def parquet_unavailable() -> str | None:
     return None
 
 
-# -------------------------------------------------------------------------------------------------- run
+# -------------------------------------------------------------------------------------------------- the study
+@dataclass
+class SweepPlan:
+    """A sweep as planned: its spec and where it came from (None: given as a dict)."""
+
+    spec: Sweep
+    source: str | None
+
+
+class _Scenes:
+    """The shots' scenes, resolved when the executor asks for one."""
+
+    def __init__(self, spec: Sweep):
+        self.spec = spec
+
+    def __len__(self) -> int:
+        return len(self.spec.shots)
+
+    def __getitem__(self, i: int):
+        return self.spec.scene(i)
+
+
+@register
+class SweepStudy(Study):
+    """``fepen sweep``: the spec's shots in one round; the table, its figures and its report."""
+
+    name = "sweep"
+    command = "sweep"
+    help = "many shots of a base scene (grid, Monte Carlo or a table): sweep.csv, sweep.md, figures"
+    names = SWEEP_NAMES
+    out = "results/sweep"
+
+    def plan(self, spec=None, sets=()) -> SweepPlan:
+        """spec: a SWEEP.toml or its content as a dict; sets: --set overrides of the base scene."""
+        if spec is None:
+            raise InputError("SWEEP", "name the sweep file (docs/studies.md)")
+        source = None if isinstance(spec, dict) else str(Path(spec).resolve())
+        return SweepPlan(read(spec, sets), source)
+
+    def digest(self, plan: SweepPlan) -> str:
+        return plan.spec.digest
+
+    def prepare(self, plan: SweepPlan, out: Path, comm) -> None:
+        from mpi4py import MPI
+
+        from fepen.io import files
+
+        sw = plan.spec
+        if comm.rank == 0:
+            files.write_json(out / "sweep.json", {"file": plan.source, "digest": sw.digest, "kind": sw.kind,
+                                                  "keys": sw.keys, "shots": len(sw.shots), "base": sw.base,
+                                                  "spec": sw.spec}, MPI.COMM_SELF)
+
+    def rounds(self, plan: SweepPlan):
+        sw = plan.spec
+        keep = sw.keep_results
+        rigid = sw.base.get("effects.fidelity") == "rigid" and "effects.fidelity" not in sw.keys and not keep
+        yield Round(_Scenes(sw), keep=lambda sc: keep or sc.effects.fidelity != "rigid", batch=rigid)
+
+    def result(self, plan: SweepPlan, records: list[dict], info) -> dict:
+        recs = records[0]
+        statuses: dict = {}
+        for r in recs.values():
+            statuses[r["status"]] = statuses.get(r["status"], 0) + 1
+        cols, rows = table_rows(plan.spec, recs)
+        return {"shots": len(plan.spec.shots), "statuses": statuses, "_records": recs, "_cols": cols, "_rows": rows}
+
+    def write(self, plan: SweepPlan, result: dict, out: Path, info) -> None:
+        from mpi4py import MPI
+
+        from fepen.io import files
+
+        sw = plan.spec
+        write_table(sw, result["_records"], out, info.say)
+        draw(sw, result["_cols"], result["_rows"], out)
+        files.write_text(out / "sweep.md", report(sw, result["_rows"], info.wall_s, info.ran, info.ranks,
+                                                  info.ranks_per_shot), MPI.COMM_SELF)
+
+    def lines(self, result: dict) -> list[str]:
+        return []
+
+
 def run(path, out, comm=None, ranks_per_shot: int = 1, sets=(), fresh: bool = False, say=print,
         progress: bool = True) -> dict:
-    """Read the sweep, run its missing shots on fepen.studies.engine, write the table, summary and figures.
+    """Read the sweep, run its missing shots, write the table, summary and figures (fepen.studies.study.run of
+    SweepStudy).
 
     Args:
         path: the SWEEP.toml, or its content as a dict (read). out: the results directory.
         comm: the communicator (None: COMM_WORLD).
         ranks_per_shot: ranks of each shot's group. sets: --set overrides of the base scene.
-        fresh: run every shot again (the records in OUT are discarded).
+        fresh: run every shot again (what the sweep wrote in OUT is removed first, by its manifest).
         say: prints one line (rank 0).
         progress: the bar of shots done over the total (rank 0, stderr; fepen.studies.engine.bar_disabled).
 
     Returns:
         {"shots", "ran", "skipped", "wall_s", "statuses"} (every rank).
     """
-    import time
+    from fepen.studies import study
 
-    from mpi4py import MPI
-
-    from fepen.io import rundir
-    from fepen.studies import engine
-
-    comm = MPI.COMM_WORLD if comm is None else comm
-    t0 = time.perf_counter()
-    sweep = read(path, sets)
-    out = Path(out)
-    err = comm.bcast(engine.check_directory(out, sweep.digest, fresh) if comm.rank == 0 else None, root=0)
-    if err:
-        raise InputError(*err)
-    with rundir.study_directory(out, comm, fresh, "sweep", SWEEP_NAMES):
-        return _run(sweep, path, out, comm, ranks_per_shot, say, progress, t0)
+    st = SweepStudy()
+    res = study.run(st, st.plan(path, sets), out, comm, ranks_per_shot, fresh, say, progress)
+    return {"shots": res["shots"], "ran": res["ran"], "skipped": res["shots"] - res["ran"], "wall_s": res["wall_s"],
+            "statuses": res["statuses"]}
 
 
-#: what a sweep writes into its folder (fepen.io.rundir.study_directory)
-SWEEP_NAMES = ("sweep.json", "shots.jsonl", "shots", "sweep.csv", "costs.csv", "sweep.parquet", "sweep.md", "sweep.png",
-               "histograms.png")
+# -------------------------------------------------------------------------------------------------- pictures
+def measured_shot(sweep):
+    """The Table 1 shot the sweep's base scene is (its striking speed, obliquity and attack angle those of a
+    shot, and neither the projectile nor the target changed), or None: the sweep then varies keys around a
+    measured test, whose values the figures mark."""
+    from fepen import scene as fscene
+    from fepen.data import SHOTS
+
+    if any(k.startswith(("projectile.", "target.")) for k in sweep.base) or "impact.shot" in sweep.keys:
+        return None
+    try:
+        sc = fscene.Scene(sweep.base)
+    except Exception:  # noqa: BLE001 - a figure's mark, never an error
+        return None
+    if sc.get("impact.shot"):
+        return SHOTS.get(sc.get("impact.shot"))
+    v, ob, at = (sc.get(k) for k in ("impact.velocity", "impact.obliquity_deg", "impact.attack_deg"))
+    for shot in SHOTS.values():
+        if (shot.v0, shot.obliquity_deg, shot.attack_deg) == (v, ob, at):
+            return shot
+    return None
 
 
-def _run(sweep: Sweep, path, out: Path, comm, ranks_per_shot: int, say, progress: bool, t0: float) -> dict:
-    """run's body, in the sweep's claimed folder."""
-    import time
+def key_axis(key: str) -> tuple[str, float]:
+    """(axis label with its unit, factor from the scene's SI value) of a varied scene key, e.g.
+    ("target.compressive_strength (MPa)", 1e-6)."""
+    from fepen.post.study_figures import SHOWN_UNITS
+    from fepen.scene import SCHEMA
 
-    from mpi4py import MPI
+    unit = SCHEMA[key].unit if key in SCHEMA else ""
+    shown, factor = SHOWN_UNITS.get(unit, (unit, 1.0))
+    return (f"{key} ({shown})" if shown else f"{key} (−)"), factor
 
-    from fepen.io import files
-    from fepen.studies import engine
 
-    out = files.prepare(out, comm)
-    if comm.rank == 0:
-        source = None if isinstance(path, dict) else str(Path(path).resolve())  # None: given as a dict
-        files.write_json(out / "sweep.json", {"file": source, "digest": sweep.digest,
-                                              "kind": sweep.kind, "keys": sweep.keys, "shots": len(sweep.shots),
-                                              "base": sweep.base, "spec": sweep.spec}, MPI.COMM_SELF)
-    keep = sweep.keep_results
-    rigid = sweep.base.get("effects.fidelity") == "rigid" and "effects.fidelity" not in sweep.keys and not keep
-    records, ran = engine.execute(len(sweep.shots), sweep.scene, out, comm, ranks_per_shot,
-                                  keep=lambda sc: keep or sc.effects.fidelity != "rigid", say=say,
-                                  batch=engine.BATCH if rigid else 1,  # rigid shots in batches
-                                  progress=progress)
-    wall = time.perf_counter() - t0
-    statuses = {}
-    if comm.rank == 0:
-        for r in records.values():
-            statuses[r["status"]] = statuses.get(r["status"], 0) + 1
-        cols, rows = write_table(sweep, records, out, say)
-        from fepen.studies import sweep_figures
+def _test_x(sweep, shot, key):
+    """The test shot's value of a varied key (SI): its own impact values, else the base scene's."""
+    from fepen import scene as fscene
 
-        sweep_figures.write(sweep, cols, rows, out)
-        files.write_text(out / "sweep.md", sweep_figures.report(sweep, rows, wall, ran, comm.size,
-                                                                ranks_per_shot), MPI.COMM_SELF)
-    statuses = comm.bcast(statuses, root=0)
-    return {"shots": len(sweep.shots), "ran": ran, "skipped": len(sweep.shots) - ran, "wall_s": wall,
-            "statuses": statuses}
+    own = {"impact.velocity": shot.v0, "impact.obliquity_deg": shot.obliquity_deg,
+           "impact.attack_deg": shot.attack_deg}
+    if key in own:
+        return own[key]
+    value = fscene.Scene(sweep.base).get(key)
+    return value if isinstance(value, (int, float)) and not isinstance(value, bool) else None
+
+
+def _title(sweep, rows) -> str:
+    fid = {r.get("fidelity") for r in rows} - {None, ""}
+    if not fid:
+        from fepen import scene as fscene
+
+        try:
+            fid = {fscene.Scene(sweep.base).get("effects.fidelity")}
+        except Exception:  # noqa: BLE001
+            fid = set()
+    return f"{sweep.kind} sweep, {len(rows)} shots" + (f", {', '.join(sorted(fid))} fidelity" if fid else "")
+
+
+def draw(sweep, cols, rows, out: Path) -> list[Path]:
+    """sweep.png and, for a Monte Carlo sample, histograms.png (fepen.post.study_figures), with what only the
+    scene knows handed over: each varied key's axis label, unit factor and test value, the measured shot, the
+    title. Returns the files written."""
+    from fepen.post import study_figures as sf
+    from fepen.post.figures import new_figure, save_figure
+
+    shot = measured_shot(sweep)
+    axes = [(k, *key_axis(k), _test_x(sweep, shot, k) if shot is not None else None) for k in sweep.keys]
+    title = _title(sweep, rows)
+    written = []
+    size = sf.sweep_size(axes, rows)
+    if size is not None:
+        fig = new_figure(size)
+        sf.sweep_figure(fig, axes, rows, shot, title)
+        written.append(save_figure(fig, out / "sweep.png"))
+    if sweep.kind == "monte-carlo":
+        names = sf.histogram_names(cols, rows)
+        if names:
+            fig = new_figure((4.4 * len(names), 3.8))
+            sf.histograms(fig, names, rows, shot, title)
+            written.append(save_figure(fig, out / "histograms.png"))
+    return written
+
+
+def report(sweep, rows, wall_s: float, ran: int, ranks: int, ranks_per_shot: int) -> str:
+    """sweep.md: what ran, the outcomes, quantiles of the main figures."""
+    from fepen.post.study_figures import column, quantiles, summarised
+
+    statuses, outcomes = {}, {}
+    for r in rows:
+        statuses[r["status"]] = statuses.get(r["status"], 0) + 1
+        if r["status"] == "ok":
+            outcomes[r.get("outcome")] = outcomes.get(r.get("outcome"), 0) + 1
+    lines = [f"# Sweep ({sweep.kind}, {len(sweep.shots)} shots)", "",
+             f"Varied: {', '.join(f'`{k}`' for k in sweep.keys)}. Ran {ran} shots now "
+             f"({len(sweep.shots) - ran} recorded before) on {ranks} rank(s), {ranks_per_shot} per shot, in "
+             f"{wall_s:.1f} s.", "",
+             "Status: " + ", ".join(f"{k} {v}" for k, v in sorted(statuses.items())) + ". Outcomes: "
+             + ", ".join(f"{k} {v}" for k, v in sorted(outcomes.items(), key=lambda kv: str(kv[0]))) + ".", ""]
+    cols = list(rows[0]) if rows else []
+    names = [*[k for k in sweep.keys if np.isfinite(column(rows, k)).all()], *summarised(cols, rows)]
+    if names:
+        lines += ["| figure | count | mean | std | min | P5 | P50 | P95 | max |",
+                  "|---|---|---|---|---|---|---|---|---|"]
+        for name in names:
+            q = quantiles(column(rows, name))
+            if q["count"]:
+                label = f"`{name}`" + (" (perforated)" if name == "residual_speed_m_s" else "")
+                lines.append(f"| {label} | {q['count']} | " + " | ".join(
+                    f"{q[p]:.5g}" for p in ("mean", "std", "min", "P5", "P50", "P95", "max")) + " |")
+    lines += ["", "Files: sweep.csv (one row per shot), costs.csv (wall time per shot), shots.jsonl (the records, "
+              "full precision), sweep.json, sweep.png" + (", histograms.png" if sweep.kind == "monte-carlo" else "")
+              + ".", ""]
+    return "\n".join(lines)

@@ -16,19 +16,21 @@ statements are all the calibration data there is; one of them is used, the other
 The trend with speed, the losses of the other shots, every shortening and the plastic fidelity's numbers
 are predictions (docs/wear.md shows them against the paper's statements).
 
-    .venv/bin/python -m fepen.studies.wear_calibration [--workers W]
+    .venv/bin/fepen study wear-calibration [--out DIR]       (mpirun -n N: on N ranks)
 """
 
 from __future__ import annotations
 
 import sys
+from dataclasses import dataclass
 
 import numpy as np
 
 from fepen.laws import target as tg
 from fepen.studies import calibration, depth
+from fepen.studies.study import Round, Study, register
 
-__all__ = ["TARGET_MASS_LOSS", "wear_sets", "table1_losses", "efficiency", "refit", "calibrate", "main"]
+__all__ = ["TARGET_MASS_LOSS", "wear_sets", "table1_scenes", "table1_losses", "WearCalibration", "main"]
 
 #: the paper's largest mass loss of its recovered projectiles (its Fig. 13: "below 4.5 %", at the fastest)
 TARGET_MASS_LOSS = 0.045
@@ -41,83 +43,115 @@ def wear_sets(eta: float) -> tuple[str, ...]:
     return ("effects.wear=true", set_item("projectile.wear.efficiency", eta))
 
 
-def _one(job) -> dict:
-    from mpi4py import MPI
-
+def _scene(name: str, sigma: float, extra):
     from fepen import scene
-    from fepen.runs.rigid import RigidRun
 
-    name, sigma, extra = job
-    sets = ["effects.fidelity=rigid", scene.set_item("impact.shot", name),
-            scene.set_item("target.quasi_static_stress", sigma), *extra]
-    return RigidRun(scene.load(None, sets), None, MPI.COMM_SELF).run()
+    return scene.load(None, ["effects.fidelity=rigid", scene.set_item("impact.shot", name),
+                             scene.set_item("target.quasi_static_stress", sigma), *extra])
 
 
-def table1_losses(eta: float, a: float, D0: float, workers: int = 1) -> list[dict]:
-    """Table 1's shots with the rigid fidelity, wear on at η and the scaled-S law at (a, D0): each shot's
-    summary (mass_loss_percent, length_change_mm, Hx_mm, ...)."""
-    rows = depth.table1_set()
-    jobs = [(r.name, calibration.strength_S(r, a, D0) * calibration._cylinder(r), wear_sets(eta)) for r in rows]
-    if workers > 1:
-        from concurrent.futures import ProcessPoolExecutor
-
-        with ProcessPoolExecutor(workers) as pool:
-            return list(pool.map(_one, jobs))
-    return [_one(j) for j in jobs]
+def table1_scenes(eta: float, a: float, D0: float) -> list:
+    """Table 1's shots with the rigid fidelity, wear on at η and the scaled-S law at (a, D0)."""
+    return [_scene(r.name, calibration.strength_S(r, a, D0) * calibration._cylinder(r), wear_sets(eta))
+            for r in depth.table1_set()]
 
 
-def efficiency(a: float, D0: float, start: float, workers: int = 1, log=print) -> float:
-    """Step 1: η such that the largest Table 1 mass loss is TARGET_MASS_LOSS (a secant iteration)."""
-    eta, prev = start, None
-    for _ in range(12):
-        loss = max(s["mass_loss_percent"] for s in table1_losses(eta, a, D0, workers)) / 100.0
-        log(f"  eta {eta:.5f}: largest mass loss {loss:.3%}")
-        if abs(loss / TARGET_MASS_LOSS - 1.0) < 1e-3:
-            return eta
-        if prev is None or prev[1] == loss:
-            new = eta * TARGET_MASS_LOSS / loss
-        else:
-            new = eta + (TARGET_MASS_LOSS - loss) * (eta - prev[0]) / (loss - prev[1])
-        prev, eta = (eta, loss), float(np.clip(new, 1e-4, 1.0))
-    return eta
+def table1_losses(eta: float, a: float, D0: float, comm=None) -> list[dict]:
+    """Each of table1_scenes' summaries (mass_loss_percent, length_change_mm, Hx_mm, ...), here and now
+    (fepen.studies.engine.summaries)."""
+    from fepen.studies import engine
+
+    return engine.summaries(table1_scenes(eta, a, D0), comm)
 
 
-def refit(eta: float, workers: int = 1) -> tuple[float, float, float]:
-    """Step 2: (a, D0, objective) of fepen.studies.calibration's fit at the shipped node, wear on at η."""
-    sets = calibration.load_sets()
-    table = calibration.curves(sets, [calibration.shipped_node()], workers, wear_sets(eta))
-    return calibration.fit(sets, list(table[0]))
+def _summaries(recs: dict, n: int) -> list[dict]:
+    from fepen.studies.calibration import _ok
+
+    return [_ok(recs[i]) for i in range(n)]
 
 
-def calibrate(workers: int = 1, log=print) -> tuple[float, float, float]:
-    """Steps 1-3 from fepen's wear-off constants: (η, a, D0) (shipped as projectile.wear.efficiency's default
-    and fepen.laws.target.SCALED_S_WEAR)."""
-    a, D0 = tg.SCALED_S_COEFFICIENT, tg.SCALED_S_SIZE
-    eta = 0.25
-    for it in range(6):
-        log(f"iteration {it + 1}: a {a:.4g}, D0 {D0 * 1e3:.4g} mm")
-        new = efficiency(a, D0, eta, workers, log)
-        a, D0, obj = refit(new, workers)
-        log(f"  eta {new:.5f} -> refit: a {a:.4g}, D0 {D0 * 1e3:.4g} mm, objective {obj:.4f}")
-        done = abs(new / eta - 1.0) < 0.01 and it > 0
-        eta = new
-        if done:
-            break
-    return eta, a, D0
+@dataclass
+class WearPlan:
+    """Where the procedure starts: fepen's wear-off constants and η."""
+
+    a: float
+    D0: float
+    eta: float
+
+
+@register
+class WearCalibration(Study):
+    """The one calibration of the wear law (module docstring), its rounds of rigid runs on the one executor
+    (OUT/rounds/NNN, resumable): the secant steps in η, the refits of (a, D0), and Table 1 at the result."""
+
+    name = "wear-calibration"
+    help = "the calibration of the wear law's melt efficiency on the paper's recovered projectiles (slow)"
+    names = ("rounds", "wear_calibration.json", "wear_calibration.md")
+    out = "results/wear-calibration"
+
+    def plan(self) -> WearPlan:
+        return WearPlan(tg.SCALED_S_COEFFICIENT, tg.SCALED_S_SIZE, 0.25)
+
+    def rounds(self, plan: WearPlan):
+        a, D0, eta, r = plan.a, plan.D0, plan.eta, 0
+        sets = calibration.load_sets()
+        self.log = []
+        for it in range(6):
+            self.log.append(f"iteration {it + 1}: a {a:.4g}, D0 {D0 * 1e3:.4g} mm")
+            e, prev = eta, None
+            for _ in range(12):  # step 1: a secant iteration in eta
+                scenes = table1_scenes(e, a, D0)
+                recs = yield Round(scenes, folder=f"rounds/{r:03d}", label="", then=True)
+                r += 1
+                loss = max(s["mass_loss_percent"] for s in _summaries(recs, len(scenes))) / 100.0
+                self.log.append(f"  eta {e:.5f}: largest mass loss {loss:.3%}")
+                if abs(loss / TARGET_MASS_LOSS - 1.0) < 1e-3:
+                    break
+                new = e * TARGET_MASS_LOSS / loss if prev is None or prev[1] == loss else (
+                    e + (TARGET_MASS_LOSS - loss) * (e - prev[0]) / (loss - prev[1]))
+                prev, e = (e, loss), float(np.clip(new, 1e-4, 1.0))
+            js = calibration.jobs(sets, [calibration.shipped_node()], wear_sets(e))  # step 2: the refit
+            recs = yield Round([calibration.job_scene(j) for j in js], folder=f"rounds/{r:03d}", label="", then=True)
+            r += 1
+            table = calibration.table_of(sets, [calibration.shipped_node()],
+                                         [calibration._positions(s) for s in _summaries(recs, len(js))])
+            a, D0, obj = calibration.fit(sets, list(table[0]))
+            self.log.append(f"  eta {e:.5f} -> refit: a {a:.4g}, D0 {D0 * 1e3:.4g} mm, objective {obj:.4f}")
+            done = abs(e / eta - 1.0) < 0.01 and it > 0
+            eta = e
+            if done:
+                break
+        scenes = table1_scenes(eta, a, D0)
+        self.final = (eta, a, D0, _summaries((yield Round(scenes, folder=f"rounds/{r:03d}", label="", then=True)),
+                                             len(scenes)))
+
+    def result(self, plan: WearPlan, records: list, info) -> dict:
+        eta, a, D0, shots = self.final
+        return {"efficiency": eta, "coefficient": a, "size_m": D0,
+                "shots": [{"shot": s["experiment"]["shot"], "mass_loss_percent": s["mass_loss_percent"],
+                           "length_change_mm": s["length_change_mm"]} for s in shots]}
+
+    def report(self, result: dict) -> str:
+        return "\n".join(["# The calibration of the wear law", "", "```", *self.log, *self.lines(result), "```", ""])
+
+    def lines(self, result: dict) -> list[str]:
+        return [f"== chosen: efficiency {result['efficiency']:.4g}, coefficient {result['coefficient']:.4g}, size "
+                f"{result['size_m']:.4g} m"] + [f"  {s['shot']:3s} mass loss {s['mass_loss_percent']:5.2f} %  length "
+                                               f"change {s['length_change_mm']:6.2f} mm" for s in result["shots"]]
 
 
 def main(argv=None) -> int:
-    """``python -m fepen.studies.wear_calibration [--workers W]``: the procedure, then Table 1 at its result."""
+    """``python -m fepen.studies.wear_calibration [--out DIR]``: the WearCalibration study (``fepen study
+    wear-calibration`` runs the same)."""
     import argparse
 
+    from fepen.studies import study
+
     ap = argparse.ArgumentParser(prog="python -m fepen.studies.wear_calibration")
-    ap.add_argument("--workers", type=int, default=2)
+    ap.add_argument("--out", default=WearCalibration.out, help="results directory (its rounds are reused)")
     args = ap.parse_args(sys.argv[1:] if argv is None else argv)
-    eta, a, D0 = calibrate(args.workers)
-    print(f"== chosen: efficiency {eta:.4g}, coefficient {a:.4g}, size {D0:.4g} m")
-    for s in table1_losses(eta, a, D0, args.workers):
-        print(f"  {s['experiment']['shot']:3s} mass loss {s['mass_loss_percent']:5.2f} %  length change "
-              f"{s['length_change_mm']:6.2f} mm")
+    st = WearCalibration()
+    study.run(st, st.plan(), args.out, say=print)
     return 0
 
 

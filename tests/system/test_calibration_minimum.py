@@ -11,7 +11,7 @@ from fepen.studies import calibration as cal
 def test_refit_at_the_shipped_constants_gives_them_back():
     node = cal.shipped_node()
     sets = cal.load_sets()
-    table = cal.curves(sets, [node], workers=2)
+    table = cal.curves(sets, [node])
     a, D0, obj = cal.fit(sets, list(table[0]))
     a0, b0, D00 = tg.S_MODELS["scaled-S"]
     assert b0 == cal.EXPONENT

@@ -217,13 +217,13 @@ def nothing_runs(tmp_path, monkeypatch):
 
     from fepen import runs
     from fepen.geometry import mesh as fmesh
-    from fepen.studies import accuracy_cost, depth, validate
+    from fepen.studies import engine, study
 
     def ran(*args, **kwargs):
         raise RuntimeError("the bad input got as far as running or meshing")
 
-    for owner, name in [(runs, "run_scene"), (validate, "run_in_directory"), (setup, "mesh"), (fmesh, "create"),
-                        (accuracy_cost, "study"), (depth, "predict_sets"), (subprocess, "Popen")]:
+    for owner, name in [(runs, "run_scene"), (study, "run"), (engine, "execute"), (setup, "mesh"), (fmesh, "create"),
+                        (subprocess, "Popen")]:
         monkeypatch.setattr(owner, name, ran)
     monkeypatch.chdir(tmp_path)
     return tmp_path

@@ -397,13 +397,13 @@ def empty_dir(tmp_path, monkeypatch):
 
     from fepen import api, runs
     from fepen.geometry import mesh as fmesh
-    from fepen.studies import accuracy_cost, depth, validate
+    from fepen.studies import engine, study
 
     def ran(*args, **kwargs):
         raise RuntimeError("the fuzz's argument list started a run")
 
-    for owner, name in [(api, "run"), (runs, "run_scene"), (validate, "run_in_directory"), (setup, "mesh"),
-                        (fmesh, "create"), (accuracy_cost, "study"), (depth, "predict_sets"), (subprocess, "Popen")]:
+    for owner, name in [(api, "run"), (runs, "run_scene"), (study, "run"), (engine, "execute"), (setup, "mesh"),
+                        (fmesh, "create"), (subprocess, "Popen")]:
         monkeypatch.setattr(owner, name, ran)
     monkeypatch.chdir(tmp_path)
     return tmp_path

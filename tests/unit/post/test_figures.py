@@ -128,7 +128,7 @@ def draw_all(base: Path) -> list[Path]:
 
     from fepen.data import shot
     from fepen.post import analyses, figures, paths, slices
-    from fepen.studies import accuracy_cost, depth, limits, sweep, sweep_figures
+    from fepen.studies import limits, sweep
 
     dirs = make_runs(base)
     written = []
@@ -152,7 +152,15 @@ def draw_all(base: Path) -> list[Path]:
         written += [d / "stress_maps_peak.png", d / "trajectory.png"]
     slices.charge_report(c, {"front": 0.045, "mid": 0.08}, 6e-4)
     written += [c / n for n in ("charge_histories.png", "cross_sections.png", "interface.png")]
-    # the studies
+    # the studies: each picture drawn on its own Figure (fepen.post.study_figures)
+    from fepen.post import study_figures as sf
+    from fepen.post.figures import new_figure, save_figure
+
+    def draw(name, size, fn, *args):
+        fig = new_figure(size)
+        fn(fig, *args)
+        written.append(save_figure(fig, base / name))
+
     res = {"v_bl_m_s": 400.0, "tol_m_s": 2.0, "a": 0.9, "p": 2.0,
            "curve": [{"v_m_s": v, "residual_speed_m_s": limits.recht_ipson(v, 400.0, 0.9, 2.0).item()}
                      for v in (420.0, 450.0, 500.0)],
@@ -161,17 +169,17 @@ def draw_all(base: Path) -> list[Path]:
     from fepen import scene as fscene
 
     sc = fscene.Scene(None, ["effects.fidelity=rigid", "target.thickness=0.3"])
-    limits._limit_figure(res, base / "ballistic_limit.png", sc)
+    x = np.linspace(400.0, 600.0, 50)
+    draw("ballistic_limit.png", (6.4, 4.6), sf.limit, res, limits.scene_line(sc),
+         (x, limits.recht_ipson(x, 400.0, 0.9, 2.0)))
     rico = {"speeds_m_s": [300.0, 600.0], "critical_obliquity_deg": [60.0, 70.0], "tol_deg": 0.5,
             "map": [{"v_m_s": v, "obliquity_deg": o, "outcome": "ricochet" if o > 65 else "embedded"}
                     for v in (300.0, 600.0) for o in (0.0, 40.0, 80.0)]}
-    limits._ricochet_figure(rico, base / "ricochet.png", sc)
-    written += [base / "ballistic_limit.png", base / "ricochet.png"]
-    depth.figure({"table1": [{"depth": 0.3, "default": 0.31}, {"depth": 0.5, "default": 0.47}]}, base / "depth.png")
-    written.append(base / "depth.png")
-    accuracy_cost.pareto([{"process_s": 10.0, "nose_error": 0.05, "H_vs_finest": 0.02, "group": "mesh", "shot": "C3",
-                           "name": "h 4 mm"}], base / "pareto.png")
-    written.append(base / "pareto.png")
+    draw("ricochet.png", (6.4, 4.8), sf.ricochet, rico, limits.scene_line(sc))
+    draw("depth.png", (6.6, 6.4), sf.depth, {"table1": [{"depth": 0.3, "default": 0.31},
+                                                        {"depth": 0.5, "default": 0.47}]})
+    draw("pareto.png", (12, 5), sf.pareto, [{"process_s": 10.0, "nose_error": 0.05, "H_vs_finest": 0.02,
+                                             "group": "mesh", "shot": "C3", "name": "h 4 mm"}])
     grid = sweep.Sweep("grid", {"effects.fidelity": "rigid"}, ["impact.velocity", "target.compressive_strength"],
                        [{"impact.velocity": v, "target.compressive_strength": f} for v in (500.0, 600.0)
                         for f in (3.5e7, 4.5e7)])
@@ -189,7 +197,7 @@ def draw_all(base: Path) -> list[Path]:
               "experiment.Hy_mm": shot(s["impact.shot"]).Hy_mm, "fidelity": "rigid"} for s in shots.shots]
     for name, (s, r) in {"grid": (grid, srows), "mc": (mc, mrows), "shots": (shots, trows)}.items():
         (sw / name).mkdir()
-        written += sweep_figures.write(s, list(r[0]), r, sw / name)
+        written += sweep.draw(s, list(r[0]), r, sw / name)
     val = base / "validate"
     (val / "C1").mkdir(parents=True)
     write_history(val / "C1")

@@ -64,3 +64,12 @@ def test_model_draws_have_the_models_moments():
 def test_depth_quantiles():
     q = sampling.depth_quantiles(np.r_[np.arange(1.0, 102.0), np.nan])
     assert (q["P10_mm"], q["P50_mm"], q["P90_mm"], q["mean_mm"], q["shots"]) == (11.0, 51.0, 91.0, 51.0, 101)
+
+
+def test_depth_quantiles_of_a_slab_say_through_beyond_the_stopped_shots():
+    """30 of 100 shots perforate (+inf): P10 and P50 are depths, P90 lies among the perforations."""
+    d = np.r_[np.arange(1.0, 71.0), np.full(30, np.inf)]
+    q = sampling.depth_quantiles(d)
+    assert q["P10_mm"] == pytest.approx(np.percentile(d[:70], 10 * 99 / 69)) and q["P90_mm"] is None
+    assert q["P50_mm"] == pytest.approx(50.5) and q["mean_mm"] == pytest.approx(35.5)
+    assert (q["shots"], q["stopped"]) == (100, 70)

@@ -98,15 +98,6 @@ def test_plan_of_the_shipped_scatter_takes_its_scene_and_overrides():
     assert np.mean([s["impact.velocity"] for s in slab.inputs]) == pytest.approx(315.0, abs=15.0)
 
 
-def test_depth_quantiles_of_a_slab_say_through_beyond_the_stopped_shots():
-    """30 of 100 shots perforate (+inf): P10 and P50 are depths, P90 lies among the perforations."""
-    d = np.r_[np.arange(1.0, 71.0), np.full(30, np.inf)]
-    q = unc.depth_quantiles(d)
-    assert q["P10_mm"] == pytest.approx(np.percentile(d[:70], 10 * 99 / 69)) and q["P90_mm"] is None
-    assert q["P50_mm"] == pytest.approx(50.5) and q["mean_mm"] == pytest.approx(35.5)
-    assert (q["shots"], q["stopped"]) == (100, 70)
-
-
 def test_the_drawn_strengths_keep_the_base_scenes_basis():
     """The default concrete's 40 MPa is a cube strength; a given strength is read on cylinders unless its basis
     is given: the study pins the base's basis, so the strengths drawn about 40 MPa are cube strengths too."""

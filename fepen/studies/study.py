@@ -1,0 +1,341 @@
+"""The study skeleton: every study fepen runs (``fepen sweep``, ``fepen validate``, ``fepen validate-depth``,
+``fepen study NAME``, the calibrations) is a Study, run by one function (``run``) on one executor
+(fepen.studies.engine.execute) into a folder owned by manifest (fepen.io.rundir.study_directory), and found in one
+registry (``REGISTRY``) that feeds the command line (fepen.cli.study) and the API (``fepen.study``).
+
+A study is four separable things (ASE's eos: produce, analyse, draw, command):
+
+    plan(**options) -> plan          read and check everything: InputError before anything is written
+    digest(plan) -> str | None       what makes its folder resumable (None: it runs again each time)
+    rounds(plan)                     a generator of Rounds of shots (each ``yield`` receives the round's records),
+                                     or of Subs: whole studies run in a folder of its own
+    result(plan, records) -> dict    pure: the records in, the study's result out (rank 0)
+    write(plan, result, out)         its files (rank 0): by default NAME.json, NAME.md (report) and NAME.png
+                                     (figure, drawn on a Figure fepen.post gives it)
+    lines(result) -> list[str]       what the console says
+
+A new study is one file: a subclass with a name, its options and these methods, and ``@register``.
+"""
+
+from __future__ import annotations
+
+import time
+from collections.abc import Callable, Iterator, Sequence
+from dataclasses import dataclass, field
+from pathlib import Path
+
+__all__ = ["Round", "Sub", "Study", "RunInfo", "run", "register", "get", "public", "set_option", "numbers",
+           "STUDIES", "REGISTRY", "study_names"]
+
+#: every study by name, in the order the command line lists them: (its module, its class). A module is imported
+#: only when its study is asked for (fepen.cli.study builds its parser from them; fepen.study runs one).
+STUDIES = {
+    "sweep": ("fepen.studies.sweep", "SweepStudy"),
+    "validate": ("fepen.studies.validate", "Validate"),
+    "validate-depth": ("fepen.studies.depth", "ValidateDepth"),
+    "accuracy-cost": ("fepen.studies.accuracy_cost", "AccuracyCost"),
+    "ballistic-limit": ("fepen.studies.limits", "BallisticLimit"),
+    "ricochet": ("fepen.studies.limits", "Ricochet"),
+    "uncertainty": ("fepen.studies.uncertainty", "Uncertainty"),
+    "calibration": ("fepen.studies.calibration", "Calibration"),
+    "wear-calibration": ("fepen.studies.wear_calibration", "WearCalibration"),
+    "prediction-errors": ("fepen.studies.prediction_errors", "PredictionErrors"),
+}
+#: the studies registered so far (``register``), by name
+REGISTRY: dict[str, type] = {}
+
+
+def register(cls: type) -> type:
+    """A class decorator: the study joins REGISTRY under its ``name``, which STUDIES must list (a study of a
+    test may add itself to STUDIES first)."""
+    if STUDIES.get(cls.name, (None, None))[1] != cls.__name__:
+        raise ValueError(f"study {cls.name!r} ({cls.__name__}) is not in fepen.studies.study.STUDIES")
+    REGISTRY[cls.name] = cls
+    return cls
+
+
+def get(name: str) -> type:
+    """The Study class of a name (its module imported on first use).
+
+    Raises:
+        InputError: naming the study, when there is none of that name.
+    """
+    if name not in STUDIES:
+        from fepen.errors import InputError
+
+        raise InputError("study", f"no study {name!r}; the studies: {', '.join(STUDIES)}")
+    if name not in REGISTRY:
+        import importlib
+
+        importlib.import_module(STUDIES[name][0])
+    return REGISTRY[name]
+
+
+def study_names(command: str | None = None) -> list[str]:
+    """The studies' names: all, or those a command runs ("study": ``fepen study NAME``)."""
+    return [n for n in STUDIES if command is None or get(n).command == command]
+
+
+def set_option(parser, help: str) -> None:
+    """--set KEY=VALUE, repeatable, into ``args.sets`` (a study's own options, as the command line has them)."""
+    parser.add_argument("--set", dest="sets", action="append", default=[], metavar="KEY=VALUE", help=help)
+
+
+def numbers(option: str, text: str) -> list[float]:
+    """The positive finite numbers of a comma-separated option value; InputError naming ``option`` else."""
+    import math
+
+    from fepen.errors import InputError
+
+    try:
+        values = [float(x) for x in text.split(",")]
+    except ValueError:
+        values = []
+    if not values or not all(math.isfinite(v) and v > 0 for v in values):
+        raise InputError(option, f"comma-separated positive numbers, got {text!r}")
+    return values
+
+
+@dataclass
+class Round:
+    """One round of shots a study hands the executor.
+
+    Attributes:
+        scenes: the shots' resolved Scenes, in order.
+        folder: where the round's records are kept, under the study's folder ("": the folder itself; a killed
+            study resumes a round from its records).
+        keep: Scene -> whether the shot keeps its results folder (None: the deformable shots do).
+        shot_folder: (round folder, index) -> a kept shot's folder (None: ROUND/shots/NNNNN).
+        batch: the rigid shots that keep no folder may run together (fepen.runs.batch).
+        label: the progress bar's and the console's word for the shots ("": the round says nothing).
+        then: the next round depends on this one's records: every rank receives them (else rank 0 alone).
+        process: 0, or each shot a whole ``fepen run`` process on this many ranks (its wall time is the
+            process's; fepen.studies.engine.process_shot).
+    """
+
+    scenes: Sequence
+    folder: str = ""
+    keep: Callable | None = None
+    shot_folder: Callable | None = None
+    batch: bool = True
+    label: str = "shots"
+    then: bool = False
+    process: int = 0
+
+
+class Study:
+    """The protocol every study fills in (module docstring); the defaults write NAME.json, NAME.md, NAME.png.
+
+    Class attributes:
+        name: the registry's name (``fepen study NAME``, ``fepen.study(NAME)``).
+        help: its line in ``fepen study --help``.
+        command: "study" (a sub-command of ``fepen study``), or the top-level command that runs it
+            ("sweep", "validate", "validate-depth"), or "" (the API and ``python -m`` only: the calibrations).
+        names: what it writes into its folder (a file fepen did not write there under one of them is refused
+            before any shot runs).
+        out: its default folder.
+    """
+
+    name: str = ""
+    help: str = ""
+    command: str = "study"
+    names: tuple = ()
+    out: str = "results/study"
+
+    # ---- the command line ---------------------------------------------------------------------------------
+    @classmethod
+    def add_arguments(cls, parser) -> None:
+        """Its options (the common ones, --out, --fresh, --ranks-per-shot, are added by fepen.cli.study)."""
+
+    @classmethod
+    def options(cls, args) -> dict:
+        """plan()'s keyword arguments from parsed command-line arguments."""
+        return {}
+
+    # ---- the study ----------------------------------------------------------------------------------------
+    def plan(self, **options):
+        """Read and check everything the study needs; InputError before anything is written."""
+        raise NotImplementedError
+
+    def digest(self, plan) -> str | None:
+        """What makes the folder resumable: a folder of the same study with another digest is refused."""
+        return None
+
+    def prepare(self, plan, out: Path, comm) -> None:
+        """Before the first round (every rank; the folder claimed): e.g. the tables of what is drawn."""
+
+    def rounds(self, plan) -> Iterator[Round]:
+        """The rounds of shots; ``records = yield Round(...)`` gives each round's records ({index: record})."""
+        raise NotImplementedError
+
+    def result(self, plan, records: list[dict], info) -> dict:
+        """The study's result from every round's records (rank 0; info: RunInfo)."""
+        raise NotImplementedError
+
+    def report(self, result: dict) -> str | None:
+        """NAME.md, or None."""
+        return None
+
+    def figure(self, result: dict, fig) -> bool:
+        """Draw NAME.png on ``fig`` (a matplotlib Figure of fepen.post.figures.new_figure); False: no picture."""
+        return False
+
+    def figure_size(self, result: dict) -> tuple[float, float]:
+        return (8.0, 5.0)
+
+    def write(self, plan, result: dict, out: Path, info) -> None:
+        """Its files (rank 0): NAME.json, and NAME.md and NAME.png when it has them (info: RunInfo)."""
+        from mpi4py import MPI
+
+        from fepen.io import files
+        from fepen.post.figures import new_figure, save_figure
+
+        files.write_json(out / f"{self.json_name}.json", public(result), MPI.COMM_SELF)
+        text = self.report(result)
+        if text is not None:
+            files.write_text(out / f"{self.json_name}.md", text, MPI.COMM_SELF)
+        fig = new_figure(self.figure_size(result))
+        if self.figure(result, fig):
+            save_figure(fig, out / f"{self.json_name}.png")
+
+    @property
+    def json_name(self) -> str:
+        """The stem of its files (the name with _ for -)."""
+        return self.name.replace("-", "_")
+
+    def lines(self, result: dict) -> list[str]:
+        """What the console says at the end."""
+        return []
+
+
+@dataclass
+class Sub:
+    """A study run inside another's folder, as one of its rounds (the uncertainty study's two samples are two
+    sweeps): ``result = yield Sub(...)`` gives its public result.
+
+    Attributes:
+        study: the Study. plan: its plan. folder: its folder under the outer study's. label: put before each of
+            its console lines.
+    """
+
+    study: Study
+    plan: object
+    folder: str
+    label: str = ""
+
+
+@dataclass
+class RunInfo:
+    """How the study is being run, for its result and its files: when it began, the shots run now (the rest came
+    from the records of an earlier, killed run), the ranks, and the console."""
+
+    t0: float
+    ranks: int
+    ranks_per_shot: int
+    say: Callable = print
+    ran: int = 0
+    records: list = field(default_factory=list)
+
+    @property
+    def wall_s(self) -> float:
+        """Wall seconds since the study began."""
+        return time.perf_counter() - self.t0
+
+
+def run(study: Study, plan, out, comm=None, ranks_per_shot: int = 1, fresh: bool = False, say=print,
+        progress: bool = True) -> dict:
+    """Run a study into its folder: claim it (fepen.io.rundir.study_directory, with the digest), prepare, every
+    round on the executor (fepen.studies.engine.execute: MPI groups taking shots from a queue, rigid shots in
+    batches, records kept so that a killed study resumes), the result, the files, the console's lines.
+
+    Args:
+        study: the Study. plan: its plan (study.plan(...)). out: the folder. comm: the communicator (None:
+            COMM_WORLD). ranks_per_shot: ranks of each shot's group. fresh: remove what the study wrote in OUT
+            first and run every shot again. say: prints lines (rank 0). progress: the shots' bar (rank 0).
+
+    Returns:
+        The result without its private entries (every rank; public), with "wall_s" and "ran" added when the
+        study's own result has none.
+    """
+    from mpi4py import MPI
+
+    from fepen.io import files, rundir
+    from fepen.studies import engine
+
+    comm = MPI.COMM_WORLD if comm is None else comm
+    engine.check_ranks_per_shot(ranks_per_shot, comm.size)
+    info = RunInfo(time.perf_counter(), comm.size, ranks_per_shot, say)
+    digest = study.digest(plan)
+    with rundir.study_directory(out, comm, fresh, study.name, study.names, digest=digest):
+        out = files.prepare(Path(out), comm)
+        study.prepare(plan, out, comm)
+        _rounds(study, plan, out, comm, info, progress)
+        result = None
+        if comm.rank == 0:
+            result = study.result(plan, info.records, info)
+            study.write(plan, result, out, info)
+            say(*study.lines(result))
+            result = {"wall_s": info.wall_s, "ran": info.ran, **public(result)}
+        return comm.bcast(result, root=0)
+
+
+def public(result: dict) -> dict:
+    """A result without its private entries (names starting "_": rank 0's records and tables)."""
+    return {k: v for k, v in result.items() if not k.startswith("_")}
+
+
+def _rounds(study: Study, plan, out: Path, comm, info: RunInfo, progress: bool) -> None:
+    """Drive the study's rounds on the executor, each round's records into info.records (rank 0's; the other
+    ranks' only for a round whose records decide the next, Round.then)."""
+    from fepen.studies import engine
+
+    gen = study.rounds(plan)
+    records = None
+    while True:
+        try:
+            rnd = gen.send(records) if records is not None else next(gen)
+        except StopIteration:
+            return
+        if isinstance(rnd, Sub):
+            say = info.say if not rnd.label else (lambda *ls, n=rnd.label: info.say(*(f"{n}: {x}" for x in ls)))
+            records = run(rnd.study, rnd.plan, out / rnd.folder, comm, info.ranks_per_shot, False, say, progress)
+            info.ran += records["ran"]
+            continue
+        folder = out / rnd.folder if rnd.folder else out
+        if rnd.folder:  # fepen's or new in the study's folder, never a link; a refusal reaches every rank
+            from fepen.atomic import make_dir
+            from fepen.io import files
+
+            files.agree(comm, str(folder), lambda f=folder: make_dir(f))
+        recs, ran = engine.execute(len(rnd.scenes), lambda i, s=rnd.scenes: s[i], folder, comm, info.ranks_per_shot,
+                                   keep=rnd.keep, say=info.say if rnd.label else None, desc=rnd.label or "shots",
+                                   batch=engine.BATCH if rnd.batch else 1, progress=progress,
+                                   folder=rnd.shot_folder, process=rnd.process)
+        if comm.rank == 0:
+            _own_folders(out, folder, rnd)
+        records = comm.bcast(recs if comm.rank == 0 else None, root=0) if rnd.then and comm.size > 1 else recs
+        info.records.append(records)
+        info.ran += ran
+
+
+def _own_folders(out: Path, folder: Path, rnd: Round) -> None:
+    """Rank 0: the kept shots' folders in the study's manifest, whichever group made them (the other ranks'
+    writes are not recorded where they happen: fepen.atomic.Claim's strict owner is rank 0)."""
+    import os
+
+    from fepen import atomic
+    from fepen.studies import engine
+
+    claim = atomic.claim_of(out)
+    if claim is None:
+        return
+    how = engine.How(lambda sc: True, rnd.shot_folder, rnd.process)
+    tops = set()
+    for i in range(len(rnd.scenes)):
+        try:
+            tops.add(Path(os.path.abspath(how.where(folder, i))).relative_to(claim.dir).parts[0])
+        except (ValueError, IndexError):
+            continue
+    for top in sorted(tops):
+        if (claim.dir / top).is_dir() and not (claim.dir / top).is_symlink():
+            claim.own(top)
