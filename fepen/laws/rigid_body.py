@@ -4,34 +4,17 @@ rigid-body motion under the sum of the load points' forces (docs/theory.md §9).
 
 from __future__ import annotations
 
-import os
 from dataclasses import dataclass
-from pathlib import Path
 
 import numpy as np
 
-_KERNEL: dict = {}
-
 
 def _kernel():
-    """rigid_points and force_moment in C (fepen/laws/rigid_kernel.c), or None when they do not build or
-    FEPEN_KERNEL=numpy (the numpy expressions below, the reference) is set."""
-    if "lib" not in _KERNEL:
-        _KERNEL["lib"] = None
-        if os.environ.get("FEPEN_KERNEL", "").lower() not in ("numpy", "numba"):
-            import ctypes
+    """rigid_points and force_moment in C (fepen/laws/rigid_kernel.c, fepen.native's "rigid_body"), or None when
+    they do not build or FEPEN_KERNEL=python (the numpy expressions below, the reference) is set."""
+    from fepen import native
 
-            from fepen import native
-
-            lib, _KERNEL["why_not"] = native.load(Path(__file__).with_name("rigid_kernel.c"))
-            if lib is not None:
-                vp = ctypes.c_void_p
-                lib.rigid_points.argtypes = [ctypes.c_int32, *[vp] * 10]
-                lib.rigid_points.restype = None
-                lib.force_moment.argtypes = [ctypes.c_int32, vp, vp, vp]
-                lib.force_moment.restype = None
-                _KERNEL["lib"] = lib
-    return _KERNEL["lib"]
+    return native.kernel("rigid_body")
 
 
 def tet_mass_properties(p: np.ndarray, rho: np.ndarray):

@@ -1,4 +1,4 @@
-"""Rigid shots in batches: many shots of one projectile integrated by one compiled call (fepen/laws/rigid_batch.c)
+"""Rigid shots in batches: many shots of one projectile integrated by one compiled call (fepen/runs/rigid_batch.c)
 instead of one ``RigidRun.run()`` each, for the studies that run thousands of them (``fepen sweep``, the limit
 studies, ``fepen validate-depth``).
 
@@ -22,7 +22,6 @@ from __future__ import annotations
 
 import ctypes
 import time
-from pathlib import Path
 
 import numpy as np
 from mpi4py import MPI
@@ -39,33 +38,25 @@ SHOT_NUMBERS = ("mass", "dt", "hard_end", "thickness", "until_stopped", "history
                 "tail_z", *[f"I_inv_{i}{j}" for i in range(3) for j in range(3)])
 #: the per-shot results it writes (its R_ enum)
 RESULTS = ("t", "steps", "outcome", "work", "entered", "max_nose_mm", "max_error", "rows", "status")
-#: outcome codes of the kernel
-OUTCOMES = (None, "perforated", "ricochet", "embedded")
+#: outcome codes of the kernel (events_kernel.c's penetration_rule)
+OUTCOMES = events.OUTCOMES
 _R = {k: i for i, k in enumerate(RESULTS)}
 _KERNEL: dict = {}
 
 
 def kernel():
     """(the rigid_batch library, the addresses of rigid_kernel.c's rigid_points and force_moment, the Gauss rule
-    of the law) when the C kernels build and FEPEN_KERNEL is not numpy, else None."""
+    of the law) when the C kernels build and FEPEN_KERNEL is not python (fepen.native), else None."""
     if "fn" not in _KERNEL:
         _KERNEL["fn"] = None
         from fepen import native
-        from fepen.laws import rigid_body
 
-        body, law = rigid_body._kernel(), tg._point_kernel()
-        if body is None or law is None:
+        body, lib = native.kernel("rigid_body"), native.kernel("rigid_batch")
+        if body is None or lib is None:
             return None
-        lib, _KERNEL["why_not"] = native.load(Path(__file__).parents[1] / "laws" / "rigid_batch.c",
-                                              ("-ffp-contract=off",))
-        if lib is None:
-            return None
-        vp, i32 = ctypes.c_void_p, ctypes.c_int32
-        lib.rigid_batch.argtypes = [i32, i32, *[vp] * 8, i32, vp, vp, vp, vp, i32, vp, vp]
-        lib.rigid_batch.restype = i32
-        lib.batch_law.argtypes = [i32, *[vp] * 11, i32, vp, vp]
-        lib.batch_law.restype = None
-        _KERNEL["fn"] = (lib, [ctypes.cast(f, vp).value for f in (body.rigid_points, body.force_moment)], law.gauss)
+        vp = ctypes.c_void_p
+        _KERNEL["fn"] = (lib, [ctypes.cast(f, vp).value for f in (body.rigid_points, body.force_moment)],
+                         tg.crater_gauss())
     return _KERNEL["fn"]
 
 

@@ -10,15 +10,19 @@
     beyond the method   the equivalent plastic strain passed projectile.failure_strain, when the scene
                  gives one (fepen.errors)
 
-The rules are pure functions of a few reduced numbers; ``StopRules`` keeps their memory (entered,
-touched) for a run and its checkpoints.
+The penetration rules (perforated, ricochet, embedded) are written once, in C (events_kernel.c, beside this
+module), which the single and deformable runs call through ``penetration`` and the batched rigid shots
+(rigid_batch.c) include; ``StopRules`` keeps their memory (entered, touched) for a run and its checkpoints.
 """
 
 from __future__ import annotations
 
+import ctypes
 from dataclasses import asdict, dataclass
 
 import numpy as np
+
+from fepen import native
 
 #: the projectile is at rest (embedded) when ½ M |V|² falls to this fraction of the striking kinetic energy
 STOP_ENERGY = 1e-5
@@ -26,19 +30,32 @@ STOP_ENERGY = 1e-5
 REBOUND_FREE_S = 20e-6
 
 
-def embedded(v_cm: np.ndarray, axis: np.ndarray, mass: float, ke0: float) -> bool:
-    """The centre of mass no longer advances along the axis, or its kinetic energy is spent."""
-    return float(v_cm @ axis) <= 0.0 or 0.5 * mass * float(v_cm @ v_cm) <= STOP_ENERGY * ke0
+#: the outcomes of events_kernel.c's penetration_rule, by its return code
+OUTCOMES = (None, "perforated", "ricochet", "embedded")
 
 
-def perforated(y_max: float, thickness: float | None) -> bool:
-    """Every load point (highest y: y_max) is beyond the rear face y = −thickness."""
-    return thickness is not None and y_max < -thickness
+def penetration(y_min: float, y_max: float, v_cm: np.ndarray, axis: np.ndarray, mass: float, ke0: float,
+                thickness: float | None, until_stopped: bool, entered: bool) -> tuple[str | None, bool]:
+    """The penetration rules (perforated, ricochet, embedded) of events_kernel.c, their one home.
 
+    Args:
+        y_min, y_max: the load points' extent in y (m; the face is y = 0, the target below).
+        v_cm, axis: the centre of mass's velocity (m/s) and the unit axis, tail to nose.
+        mass, ke0: the projectile's mass (kg) and striking kinetic energy (J).
+        thickness: the target's (m), None for semi-infinite.
+        until_stopped: the run has no end time (only then is "embedded" an outcome).
+        entered: whether some load point has been below the face before.
 
-def ricochet(y_min: float, vy: float) -> bool:
-    """Every load point (lowest y: y_min) is above the face and the centre of mass moves away."""
-    return y_min > 0.0 and vy > 0.0
+    Returns:
+        (the outcome or None to go on, entered now).
+    """
+    flag = ctypes.c_int32(int(entered))
+    v = np.ascontiguousarray(v_cm, dtype=np.float64)
+    a = np.ascontiguousarray(axis, dtype=np.float64)
+    code = native.kernel("events").penetration_outcome(
+        float(y_min), float(y_max), v.ctypes.data, a.ctypes.data, float(mass), float(ke0),
+        -1.0 if thickness is None else float(thickness), int(until_stopped), STOP_ENERGY, ctypes.byref(flag))
+    return OUTCOMES[code], bool(flag.value)
 
 
 #: the run stops ("eroded") when erosion has left less than this fraction of the projectile's mass
@@ -68,16 +85,9 @@ class StopRules:
     def penetration(self, y_min: float, y_max: float, v_cm: np.ndarray, axis: np.ndarray, mass: float,
                     ke0: float) -> str | None:
         """The outcome in a concrete target from the load points' extent in y, or None to go on."""
-        self.entered = self.entered or y_min < 0.0
-        if not self.entered:
-            return None
-        if perforated(y_max, self.thickness):
-            return "perforated"
-        if ricochet(y_min, float(v_cm[1])):
-            return "ricochet"
-        if self.until_stopped and embedded(v_cm, axis, mass, ke0):
-            return "embedded"
-        return None
+        outcome, self.entered = penetration(y_min, y_max, v_cm, axis, mass, ke0, self.thickness, self.until_stopped,
+                                            self.entered)
+        return outcome
 
     def rebound(self, t: float, contact_nodes: int) -> str | None:
         """On the rigid wall: "rebound" once the body has been free of it for REBOUND_FREE_S."""

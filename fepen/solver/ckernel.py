@@ -5,59 +5,19 @@ node update, the kinematics pass, the nodal pressure and the fused stress-and-fo
 
 from __future__ import annotations
 
-import ctypes
-import os
-from pathlib import Path
-
 import numpy as np
 
 from fepen import native
 
-SOURCE = Path(__file__).with_name("cell_kernel.c")
-#: no fused multiply-adds: gcc contracts a vector loop's body and its scalar remainder differently, so a cell
-#: would round otherwise by where it falls in its block, and a run would depend on the partition
-#: (docs/theory.md §3.4)
-CONTRACT = ("-ffp-contract=off",)
-
-_lib = None
-_why_not = None
-
 
 def library():
-    """The loaded C kernel, or None (then ``why_not()`` says why) — built on first use."""
-    global _lib, _why_not
-    if _lib is not None or _why_not is not None:
-        return _lib
-    if os.environ.get("FEPEN_KERNEL", "").lower() == "numba":
-        _why_not = "FEPEN_KERNEL=numba"
-        return None
-    lib, why = native.load(SOURCE, CONTRACT)
-    if lib is None:
-        _why_not = why
-        return None
-    vp, i32, dbl = ctypes.c_void_p, ctypes.c_int32, ctypes.c_double
-    lib.update_begin.argtypes = [i32, i32, dbl, dbl, vp, vp, vp, vp, vp, vp, vp, vp, vp]
-    lib.update_begin.restype = None
-    lib.update_end.argtypes = [i32, vp, vp, vp, vp, vp, vp, vp]
-    lib.update_end.restype = None
-    lib.nodal_pressure.argtypes = [i32, vp, vp, vp, i32, vp]
-    lib.nodal_pressure.restype = None
-    lib.scatter_volumes.argtypes = [i32, vp, vp, vp, dbl, i32, i32, vp]
-    lib.scatter_volumes.restype = None
-    lib.scatter_forces.argtypes = [i32, vp, vp, dbl, i32, vp]
-    lib.scatter_forces.restype = None
-    lib.kinematics_pass.argtypes = [i32, vp, vp, vp, vp, vp, vp, i32, vp, vp, vp]
-    lib.kinematics_pass.restype = None
-    lib.cell_pass.argtypes = [i32, vp, vp, dbl, vp, vp, vp, i32, vp, vp, vp, vp, vp, vp, vp, vp, vp]
-    lib.cell_pass.restype = i32
-    _lib = lib
-    return lib
+    """The loaded C kernel (fepen.native's "cells"), or None (then ``why_not()`` says why) — built on first use."""
+    return native.kernel("cells")
 
 
 def why_not() -> str | None:
     """Why the C kernel is not used (None when it is)."""
-    library()
-    return _why_not
+    return native.why_not("cells")
 
 
 def _addr(a: np.ndarray, dtype=np.float64) -> int:

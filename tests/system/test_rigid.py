@@ -26,9 +26,8 @@ CLOSED_FORM = ["effects.fidelity=rigid", f"target.quasi_static_stress={SIGMA_S}"
 
 def nose_force(sc, law, g, crh, speed):
     """The target's forces on load points g moving along the axis at speed, and the closed-form axial force."""
-    st = tg.SurfaceState(g["X"] - [0.0, 1.0, 0.0], np.tile([0.0, -speed, 0.0], (len(g["X"]), 1)), g["N"],
-                         g["area0"], g["radius"], g["R_meridian"], g["sin_phi0"], np.array([0.0, -1.0, 0.0]))
-    f, _ = tg.forces(law, st)
+    f, _ = tg.normal_stress(law, g["X"] - [0.0, 1.0, 0.0], np.tile([0.0, -speed, 0.0], (len(g["X"]), 1)), g["N"],
+                            g["area0"], g["radius"], g["R_meridian"], g["sin_phi0"], np.array([0.0, -1.0, 0.0]))
     a = 0.5 * sc.projectile.diameter
     return f, math.pi * a * a * (SIGMA_S + tg.ogive_nose_factor(crh) * 2400.0 * speed**2)
 

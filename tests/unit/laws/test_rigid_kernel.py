@@ -4,10 +4,11 @@ against RigidBody's numpy expressions, on a random body, state and forces."""
 import numpy as np
 import pytest
 
+from fepen import native
 from fepen.laws import rigid_body as rb
 
 LIB = rb._kernel()
-pytestmark = pytest.mark.skipif(LIB is None, reason=str(rb._KERNEL.get("why_not")))
+pytestmark = pytest.mark.skipif(LIB is None, reason=str(native.why_not("rigid_body")))
 
 
 def random_body(seed, k=500):

@@ -1,15 +1,13 @@
-"""The C transcription of the target law (fepen/laws/target_kernel.c) against the numpy reference
-(target.point_forces) on random surface states, with every switch of the law."""
+"""The target law's one home (fepen/laws/target_kernel.c, target.point_forces) against an independent numpy
+oracle of its equations (target_oracle.py) on random surface states, with every switch of the law."""
 
 import math
 
 import numpy as np
 import pytest
+import target_oracle as oracle
 
 from fepen.laws import target as tg
-
-KERNEL = tg._point_kernel()
-pytestmark = pytest.mark.skipif(KERNEL is None, reason=str(tg._KERNEL.get("why_not")))
 
 CA = tg.cavity_ratio(40e6, 32.5e9, 4e6)
 LAWS = {
@@ -51,14 +49,14 @@ def random_state(k, seed):
 
 
 @pytest.mark.parametrize("name", LAWS)
-def test_c_kernel_is_the_numpy_law(name):
+def test_the_compiled_law_is_the_oracle(name):
     law = tg.TargetLaw(**{**dict(density=2400.0, Y=40e6, E=32.5e9, T=4e6, lam=0.67, sigma_s=300e6, c_over_a=CA,
                                  D=0.0236), **LAWS[name]})
     for seed in range(3):
         state = random_state(400, seed)
         for axis in (state[-1], None):  # with and without the wake rule
-            f_ref, s_ref = tg.point_forces(law, *state[:-1], axis)
-            f_c, s_c = KERNEL(law, *state[:-1], axis)
+            f_ref, s_ref = oracle.point_forces(law, *state[:-1], axis)
+            f_c, s_c = tg.point_forces(law, *state[:-1], axis)
             scale = np.abs(f_ref).max()
             assert scale > 0.0 and s_ref[3] > 10  # the state loads many points
             np.testing.assert_allclose(f_c, f_ref, rtol=1e-12, atol=1e-13 * scale)
@@ -69,12 +67,18 @@ def test_c_kernel_is_the_numpy_law(name):
         assert tg.point_forces(no_crater, *state[:-1], axis)[1][3] > s_ref[3]
 
 
-def test_load_on_points_uses_either_and_they_agree(monkeypatch):
-    law = tg.TargetLaw(density=2400.0, Y=40e6, E=32.5e9, T=4e6, lam=0.67, sigma_s=300e6, c_over_a=CA,
-                       crater="energy")
+def test_load_on_points_is_the_law_plus_the_linear_crater():
+    """load_on_points: the law's forces and sums, scaled by the linear crater's factor at the tip's depth."""
+    law = tg.TargetLaw(density=2400.0, Y=40e6, E=32.5e9, T=4e6, lam=0.67, sigma_s=300e6, c_over_a=CA, D=0.0236,
+                       k=2.0)
     state = random_state(300, 7)
-    a = tg.load_on_points(law, *state)
-    monkeypatch.setitem(tg._KERNEL, "fn", None)
-    b = tg.load_on_points(law, *state)
-    np.testing.assert_allclose(a.total, b.total, rtol=1e-11)
-    assert a.loaded == b.loaded
+    f, sums = oracle.point_forces(law, *state)
+    plain = tg.load_on_points(law, *state)
+    np.testing.assert_allclose(plain.total, sums[:3], rtol=1e-11)
+    assert plain.loaded == sums[3]
+    crater = tg.ForrestalCrater(law, 0.367, 600.0, 3.0)
+    scaled = tg.load_on_points(law, *state, crater=crater, tip_depth=0.01)
+    factor = crater.scale(0.01, -float(plain.total @ state[-1]))
+    assert 0.0 < factor < 1.0
+    np.testing.assert_allclose(scaled.total, factor * plain.total, rtol=1e-14)
+    np.testing.assert_allclose(scaled.force, factor * plain.force, rtol=1e-14)

@@ -12,7 +12,7 @@ from hypothesis import HealthCheck, given, settings
 from hypothesis import strategies as st
 from mpi4py import MPI
 
-from fepen import scene
+from fepen import native, scene
 from fepen.errors import InputError, SimulationError
 from fepen.laws import target as tg
 from fepen.laws.rigid_body import RigidState
@@ -21,7 +21,7 @@ from fepen.runs.rigid import RigidRun
 from fepen.studies import engine
 
 KERNEL = batch.kernel()
-pytestmark = pytest.mark.skipif(KERNEL is None, reason=str(batch._KERNEL.get("why_not")))
+pytestmark = pytest.mark.skipif(KERNEL is None, reason=str(native.why_not("rigid_batch")))
 #: the summary keys of the machine, not of the shot
 MACHINE = ("wall_s", "time_split_s", "peak_memory_bytes", "versions")
 
@@ -91,7 +91,7 @@ def test_the_batch_law_is_point_forces_bitwise():
         st_ = RigidState(c, q / np.linalg.norm(q), s.V * rng.uniform(0.05, 1.5), rng.normal(0.0, 0.05, 3))
         x, v, n, _arm = run.body.points(st_)
         axis = np.ascontiguousarray(-run.body.at(st_)[1][:, 1])
-        f0, sums0 = tg._point_kernel()(run.law, x, v, n, g["area0"], g["radius"], g["R_meridian"], g["sin_phi0"],
+        f0, sums0 = tg.point_forces(run.law, x, v, n, g["area0"], g["radius"], g["R_meridian"], g["sin_phi0"],
                                        axis)
         f, sums = np.zeros((k, 3)), np.zeros(5)
         arrays = [np.ascontiguousarray(a, dtype=float) for a in (

@@ -1,4 +1,5 @@
-"""The stop rules (fepen.runs.events) on plain numbers: one definition for the rigid and deformable runs."""
+"""The stop rules (fepen.runs.events, events_kernel.c) on plain numbers: one definition for the rigid, the
+batched rigid and the deformable runs."""
 
 import numpy as np
 import pytest
@@ -8,27 +9,32 @@ from fepen.runs import events
 AXIS = np.array([0.0, -1.0, 0.0])  # nose down, into the target
 
 
+def outcome(y_min=-0.01, y_max=0.2, v=(0.0, -10.0, 0.0), m=0.4, ke0=0.5 * 0.4 * 800.0**2, thickness=None,
+            until_stopped=True, entered=False):
+    return events.penetration(y_min, y_max, np.array(v), AXIS, m, ke0, thickness, until_stopped, entered)[0]
+
+
 def test_embedded_when_the_centre_stops_advancing_or_its_energy_is_spent():
-    m, ke0 = 0.4, 0.5 * 0.4 * 800.0**2
-    assert not events.embedded(np.array([0.0, -10.0, 0.0]), AXIS, m, ke0)
-    assert events.embedded(np.array([0.0, 1e-3, 0.0]), AXIS, m, ke0)  # moving back along the axis
-    assert events.embedded(np.array([5.0, 0.0, 0.0]), AXIS, m, ke0)  # sideways only: V·a = 0
+    assert outcome() is None
+    assert outcome(v=(0.0, 1e-3, 0.0)) == "embedded"  # moving back along the axis
+    assert outcome(v=(5.0, 0.0, 0.0)) == "embedded"  # sideways only: V·a = 0
     # the energy rule: ½ M V² = STOP_ENERGY KE0 exactly at V = 800 sqrt(STOP_ENERGY)
     v = 800.0 * np.sqrt(events.STOP_ENERGY)
-    assert events.embedded(np.array([0.0, -v * (1 - 1e-9), 0.0]), AXIS, m, ke0)
-    assert not events.embedded(np.array([0.0, -v * (1 + 1e-6), 0.0]), AXIS, m, ke0)
+    assert outcome(v=(0.0, -v * (1 - 1e-9), 0.0)) == "embedded"
+    assert outcome(v=(0.0, -v * (1 + 1e-6), 0.0)) is None
+    assert outcome(v=(0.0, 1e-3, 0.0), until_stopped=False) is None  # a run with an end time never embeds
 
 
 def test_perforation_needs_a_finite_target_and_every_point_beyond_its_rear_face():
-    assert not events.perforated(-1.0, None)
-    assert events.perforated(-0.2001, 0.2)
-    assert not events.perforated(-0.1999, 0.2)
+    assert outcome(y_min=-1.1, y_max=-1.0) is None
+    assert outcome(y_min=-0.3, y_max=-0.2001, thickness=0.2) == "perforated"
+    assert outcome(y_min=-0.3, y_max=-0.1999, thickness=0.2) is None
 
 
 def test_ricochet_needs_every_point_above_the_face_and_the_centre_moving_away():
-    assert events.ricochet(1e-6, 3.0)
-    assert not events.ricochet(-1e-6, 3.0)
-    assert not events.ricochet(1e-6, -3.0)
+    assert outcome(y_min=1e-6, v=(0.0, 3.0, 0.0), entered=True) == "ricochet"
+    assert outcome(y_min=1e-6, v=(0.0, 3.0, 0.0), entered=False) is None  # never entered: not a ricochet
+    assert outcome(y_min=1e-6, v=(0.0, -3.0, 0.0), entered=True) is None
 
 
 @pytest.mark.parametrize("until_stopped", [True, False])

@@ -3,9 +3,9 @@
  * The load points and the force sums are the single path's own compiled functions (rigid_kernel.c's
  * rigid_points and force_moment, passed in as function pointers and called on all the points: they are
  * vectorised, so a point's rounding depends on its place in the array); the target law is target_kernel.c's
- * point_forces, included and built as that file is built (a * b + c contracted alike), with three shortcuts
- * that change no bit (law_points). The glue between them (quaternions, omega, the crater scale, the stage
- * states, the work, the stop rules, the history rows' depth and energy error) repeats the single path's numpy
+ * law_at_point and the stop rules events_kernel.c's penetration_rule, both included (the law built as that
+ * file is built, a * b + c contracted alike). The glue between them (quaternions, omega, the crater scale, the
+ * stage states, the work, the history rows' depth and energy error) repeats the single path's numpy
  * and Python expressions operation by operation, in their order, built without contracting a * b + c into
  * one rounding (-ffp-contract=off, fepen.runs.batch), so that a shot's trajectory is bitwise the single
  * path's. tests/unit/runs/test_batch.py holds the two together. */
@@ -14,77 +14,29 @@
 #include <stdlib.h>
 #include <string.h>
 
-/* The law's parameter enum, clip01 and cavity_stress, and the law below, built as the single path builds
+/* The law (law_constants, law_at_point), built as the single path builds
  * target_kernel.c (a * b + c contracted as there) */
 #pragma GCC push_options
 #pragma GCC optimize("fp-contract=fast")
-#include "target_kernel.c"
+#include "../laws/target_kernel.c"
 
-static inline double mx(double a, double b) { return a > b ? a : b; }
-static inline double mn(double a, double b) { return a < b ? a : b; }
 
-/* point_forces on k points, with the same operations on every loaded point, and three shortcuts that change no
- * bit: ell = sqrt(area) given; the free-surface stress where the plastic zone is whole (ca = c/a) computed
- * once; the forces of the points it loads (their indices into idx, in order) the only ones summed (the others
- * are zero). f is written only at those points. Returns how many. */
+/* The law (target_kernel.c's law_at_point) on k points with one shortcut that changes no bit: ell = sqrt(area)
+ * given. f is written only at the points it loads (their indices into idx, in order), and only their forces are
+ * summed (the others are zero). Returns how many. */
 __attribute__((noinline)) static int32_t law_points(int32_t k, const double *x, const double *v, const double *n,
                                                     const double *area, const double *ell, const double *radius,
                                                     const double *Rm, const double *sphi0, const double *axis,
                                                     const double *p, const double *gauss, int32_t ng, double *f,
                                                     int32_t *idx, double *sums) {
-    const double thk = p[P_THICKNESS], sin_min = sin(p[P_PHI_MIN]), sin_onset = sin(p[P_ONSET]);
-    const double ref = p[P_FREE_SURFACE] != 0.0 ? cavity_stress(p, p[P_C_OVER_A]) : 1.0;
-    const double whole = p[P_GIVEN_SIGMA_S] != 0.0 ? p[P_SIGMA_S] * ref / ref : ref;
-    const double mu_s = p[P_MU], mu_d = p[P_MU_DYNAMIC], decay = p[P_MU_DECAY];
+    const LawConstants c = law_constants(p);
     int32_t m = 0;
     for (int j = 0; j < 5; ++j) sums[j] = 0.0;
     for (int32_t i = 0; i < k; ++i) {
-        const double *xi = x + 3 * i, *vi = v + 3 * i, *ni = n + 3 * i;
-        double y = xi[1];
-        double frac = clip01(0.5 - (y + p[P_TOP]) / ell[i]);
-        if (p[P_LOWER] >= 0.0) frac *= clip01(0.5 + (y + p[P_LOWER]) / ell[i]);
-        if (!(frac > 0.0)) continue;
-        double vn = vi[0] * ni[0] + vi[1] * ni[1] + vi[2] * ni[2];
-        double speed = sqrt(vi[0] * vi[0] + vi[1] * vi[1] + vi[2] * vi[2]);
-        double sin_phi = speed > 0.0 ? vn / mx(speed, 1e-300) : 0.0;
-        int loaded = sin_phi > SIN_TOL;
-        if (axis) loaded = loaded && (vi[0] * axis[0] + vi[1] * axis[1] + vi[2] * axis[2] > 0.0);
-        if (p[P_SEPARATION] != 0.0) loaded = loaded && sin_phi > sin_min;
-        if (!loaded || !(vn > 0.0)) continue;
-        double depth = mx(-y, 0.0), Le = thk >= 0.0 ? mn(depth, mx(thk - depth, 0.0)) : depth;
-        double s = p[P_SIGMA_S];
-        if (p[P_FREE_SURFACE] != 0.0) {
-            double ca = fmin(p[P_C_OVER_A], 1.0 + Le / (p[P_SURFACE_RANGE] * mx(radius[i], 1e-12)));
-            if (ca == p[P_C_OVER_A]) s = whole;
-            else s = p[P_GIVEN_SIGMA_S] != 0.0 ? p[P_SIGMA_S] * cavity_stress(p, ca) / ref : cavity_stress(p, ca);
-        }
-        if (p[P_ONSET] > 0.0) s *= mn(sin_phi / sin_onset, 1.0);
-        double sg = (s + p[P_B] * p[P_DENSITY] * vn * vn) * frac;
-        if (p[P_CRATER] == 2.0 && -y < p[P_K] * p[P_D]) {
-            double rho = mx(radius[i], 1e-12), l = (p[P_C_OVER_A] - 1.0) * rho, integral = 0.0;
-            for (int32_t g = 0; g < ng; ++g) {
-                double w = 0.5 * l * (gauss[g] + 1.0), q = rho / (rho + w);
-                integral += 0.5 * l * gauss[ng + g] * (1.0 + w / Rm[i]) * (1.0 + w * sphi0[i] / rho) * q * q * q * q;
-            }
-            double e_kin = 0.5 * p[P_LOCK_DENSITY] * vn * vn * integral;
-            double e_str = p[P_CRUSH_STRAIN] * p[P_Y] * (2.0 * rho * Le + Le * Le) / rho;
-            if (e_kin - e_str >= 0.0) sg = 0.0;
-        }
-        double pa = sg * area[i], *fi = f + 3 * i;
-        fi[0] = -pa * ni[0];
-        fi[1] = -pa * ni[1];
-        fi[2] = -pa * ni[2];
-        if (p[P_FRICTION] != 0.0 && mu_s > 0.0) {
-            double vt[3] = {vi[0] - vn * ni[0], vi[1] - vn * ni[1], vi[2] - vn * ni[2]};
-            double st = sqrt(vt[0] * vt[0] + vt[1] * vt[1] + vt[2] * vt[2]);
-            if (st > 1e-9) {
-                double mu = (decay == 0.0 || mu_d == mu_s) ? mu_s : mu_d + (mu_s - mu_d) * exp(-decay * st);
-                double c = mu * pa / st;
-                fi[0] -= c * vt[0];
-                fi[1] -= c * vt[1];
-                fi[2] -= c * vt[2];
-            }
-        }
+        double sg = 0.0;
+        if (!law_at_point(p, &c, x + 3 * i, v + 3 * i, n + 3 * i, area[i], ell[i], radius[i], Rm[i], sphi0[i], axis,
+                          gauss, ng, f + 3 * i, &sg))
+            continue;
         if (sg > 0.0) {
             sums[3] += 1.0;
             sums[4] += area[i];
@@ -101,6 +53,9 @@ __attribute__((noinline)) static int32_t law_points(int32_t k, const double *x, 
 }
 
 #pragma GCC pop_options
+
+/* the stop rules (penetration_rule), built here without contraction as there */
+#include "events_kernel.c"
 
 typedef void (*points_fn)(int32_t, const double *, const double *, const double *, const double *,
                           const double *, const double *, double *, double *, double *, double *);
@@ -277,7 +232,8 @@ static void one_shot(Body *b, const double *sp, const double *law, double *y, do
     double t = 0.0, work = 0.0, next = 0.0, prev[13], R[9], w[3];
     double max_nose = -INFINITY, max_error = -INFINITY, rows = 0.0;
     int64_t steps = 0;
-    int outcome = 0, entered = 0, status = 0;
+    int outcome = 0, status = 0;
+    int32_t entered = 0;
     const double dt = sp[S_DT], interval = sp[S_HISTORY], thk = sp[S_THICKNESS];
     double F[3] = {0.0, 0.0, 0.0}; /* a row's force: at the start of the last step (at t = 0 the initial one) */
     if (interval > 0.0) {
@@ -310,15 +266,10 @@ static void one_shot(Body *b, const double *sp, const double *law, double *y, do
             if (yi < ymin) ymin = yi;
             if (yi > ymax) ymax = yi;
         }
-        entered = entered || ymin < 0.0;
-        if (!entered) continue;
         double a[3];
         axis_of(y, a);
-        if (thk >= 0.0 && ymax < -thk) outcome = 1;
-        else if (ymin > 0.0 && y[8] > 0.0) outcome = 2;
-        else if (sp[S_UNTIL_STOPPED] != 0.0 &&
-                 (dot3(y + 7, a) <= 0.0 || 0.5 * sp[S_MASS] * dot3(y + 7, y + 7) <= sp[S_STOP_ENERGY] * sp[S_KE0]))
-            outcome = 3;
+        outcome = penetration_rule(ymin, ymax, y + 7, a, sp[S_MASS], sp[S_KE0], thk, sp[S_UNTIL_STOPPED] != 0.0,
+                                   sp[S_STOP_ENERGY], &entered);
         if (outcome == 3 && dot3(y + 7, a) <= 0.0) { /* RigidRun.stop_rules: back to where V.a vanishes */
             double ap[3];
             axis_of(prev, ap);
