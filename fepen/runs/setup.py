@@ -61,9 +61,12 @@ def target_law(scene):
     """The target's law (docs/theory.md §8, §16, §17): a TargetLaw of target.material, or a Layered target of
     target.layers."""
     layers = scene.get("target.layers")
+    fc = scene.derived["target.fc_cylinder"]
     if layers:
+        layers = [{**c, "fc_cylinder": f} for c, f in zip(layers, fc)]
         return fl.build(layers, lambda c: material_law(scene, c, c.get("thickness")))
     c = {k: scene.get(f"target.{k}") for k in CONSTANTS}
+    c["fc_cylinder"] = fc
     c["crater"] = scene.effects.crater
     c["family"] = TARGETS[scene.target.material]["family"]
     return material_law(scene, c, scene.get("target.thickness"))
@@ -71,7 +74,8 @@ def target_law(scene):
 
 def material_law(scene, c: dict, thickness: float | None) -> tg.TargetLaw:
     """The TargetLaw of one target material's constants ``c`` (target.* names without the prefix, absent ones
-    None or missing, plus "crater" and "family"), with the scene's effects, friction and separation.
+    None or missing, plus "crater", "family" and "fc_cylinder", Scene.derived's strength), with the scene's
+    effects, friction and separation.
 
     Families (fepen/data/targets.toml): concrete, rock and soil by the Mohr–Coulomb cavity expansion (σ_s by
     target.strength_model), metal by Forrestal–Warren's power-law cavity expansion (fepen.laws.target.
@@ -90,7 +94,7 @@ def material_law(scene, c: dict, thickness: float | None) -> tg.TargetLaw:
         T, lam, ca, crush, density = Y, 0.0, tg.metal_cavity_ratio(E, Y), 0.0, get("density")
         given_flag = True
     else:
-        Y = tg.cylinder_strength(get("compressive_strength"), get("strength_basis") or "cylinder")
+        Y = get("fc_cylinder")  # the compressive strength on the cylinder basis (Scene.derived)
         T, lam = get("tensile_strength"), get("pressure_hardening")
         E = get("youngs_modulus") or tg.youngs_modulus_aci(Y)
         density = get("density")
@@ -421,11 +425,12 @@ def envelope_facts(scene, built: Built | None = None) -> dict:
     L = built.shape.length if built is not None else p.length
     target = ("layered" if scene.get("target.layers") else "a rigid wall" if t.kind != "concrete" else t.material)
     mass = scene.get("projectile.mass")  # absent for a fixed cavity or a CAD body: from the body
+    fc = scene.derived["target.fc_cylinder"]  # a layered target's are its layers' (its verdict: not validated)
     if mass is None and built is not None and isinstance(built.shape, Shape):  # a CAD body's: from its mesh
         fill = scene.charge.material.density if scene.effects.charge else None
         mass = built.shape.mass(built.shell_density, fill)
     values = {"D_m": D, "L_over_D": L / D, "crh": scene.get("projectile.crh"), "mass_kg": mass, "V_m_s": i.velocity,
-              "fc_cylinder_Pa": tg.cylinder_strength(t.compressive_strength, t.strength_basis),
+              "fc_cylinder_Pa": None if isinstance(fc, list) else fc,
               "rho_kg_m3": t.density, "obliquity_deg": i.obliquity_deg, "attack_deg": i.attack_deg}
     return {"law": t.strength_model, "target": target, "nose": "CAD body" if p.get("cad") else p.nose,
             "thickness_m": scene.get("target.thickness"), "fidelity": scene.effects.fidelity,

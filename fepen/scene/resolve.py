@@ -102,7 +102,7 @@ def _concrete_law(where: str, c: dict, family: str, given: set) -> None:
     if c.get("strength_model") == "metal":
         raise InputError(f"{where}.strength_model", f"'metal' is the law of a metal target.material (6061-T6511, "
                                                     f"armour-steel), not of a {family} one")
-    fc, T = cylinder_strength(c["compressive_strength"], c.get("strength_basis") or "cylinder"), c["tensile_strength"]
+    fc, T = c["fc_cylinder"], c["tensile_strength"]
     if T >= fc:
         key = _given_one(given, "tensile_strength", "compressive_strength")
         cube = "" if fc == c["compressive_strength"] else f" (of the {c['compressive_strength']:g} Pa cube)"
@@ -357,7 +357,7 @@ def _check_projectile_keys(flat: dict, given: dict) -> None:
         check(flat, given)
 
 
-def _check_across(flat: dict, given: dict) -> None:
+def _check_across(flat: dict, given: dict, derived: dict) -> None:
     """The checks across keys of the resolved values, in this order (the first refusal is the one reported);
     each layer's and the mass rule of a shot were checked as they resolved."""
     _check_projectile_keys(flat, given)
@@ -365,7 +365,8 @@ def _check_across(flat: dict, given: dict) -> None:
                   _rigid_step_within_end, _charge_hardening):
         check(flat, given)
     if "target.layers" not in flat:
-        _check_target("target", {k: flat[f"target.{k}"] for k in CONSTANTS if f"target.{k}" in flat},
+        _check_target("target", {**{k: flat[f"target.{k}"] for k in CONSTANTS if f"target.{k}" in flat},
+                                 "fc_cylinder": derived["target.fc_cylinder"]},
                       TARGETS[flat["target.material"]]["family"], {k[7:] for k in given if k.startswith("target.")})
 
 
@@ -393,10 +394,18 @@ def _resolve_steel(flat: dict, given: dict) -> None:
             flat[name] = SCHEMA[name].check(name, value)
 
 
-def _tensile_default(fc: float, basis: str | None = "cylinder") -> float:
+def _tensile_default(fc_cylinder: float) -> float:
     """target.tensile_strength when neither the scene nor the material gives it: f_c / 10, of the cylinder
-    strength (a cube strength converted, fepen.laws.target.cylinder_strength)."""
-    return 0.1 * cylinder_strength(fc, basis or "cylinder")
+    strength."""
+    return 0.1 * fc_cylinder
+
+
+def _fc_cylinder(c: dict) -> float | None:
+    """A target's compressive strength on the cylinder basis the law takes (Pa): the user's or the material's
+    strength on its strength_basis, a cube strength converted (fepen.laws.target.cylinder_strength). The one
+    conversion: the scene keeps the value (Scene.derived) and every law, check and default reads it."""
+    fc = c.get("compressive_strength")
+    return None if fc is None else cylinder_strength(fc, c.get("strength_basis") or "cylinder")
 
 
 def _material_constants(name: str, given: dict, crater_given: str | None) -> dict:
@@ -406,18 +415,20 @@ def _material_constants(name: str, given: dict, crater_given: str | None) -> dic
     if "compressive_strength" in given and "strength_basis" in out:  # a material's basis goes with its strength
         out["strength_basis"] = "cylinder"
     out.update(given)
-    if "tensile_strength" not in out and "compressive_strength" in out:
-        out["tensile_strength"] = _tensile_default(out["compressive_strength"], out.get("strength_basis"))
+    out["fc_cylinder"] = _fc_cylinder(out)
+    if "tensile_strength" not in out and out["fc_cylinder"] is not None:
+        out["tensile_strength"] = _tensile_default(out["fc_cylinder"])
     out["crater"] = crater_given or TARGETS[name].get("crater", "energy")
     out["family"] = TARGETS[name]["family"]
     _metal_constants_known(name, out)
     return out
 
 
-def _resolve_layers(flat: dict, given: dict, crater: str | None) -> None:
-    """Each [[target.layers]] table with its material's constants, checked as a target material."""
+def _resolve_layers(flat: dict, given: dict, crater: str | None) -> list:
+    """Each [[target.layers]] table with its material's constants, checked as a target material; returns each
+    layer's cylinder strength (Pa, None for a metal)."""
     _layers_alone(flat, given)
-    out = []
+    out, fc = [], []
     for i, layer in enumerate(flat["target.layers"]):
         where = f"target.layers[{i}]"
         _layer_family(where, layer)
@@ -426,16 +437,20 @@ def _resolve_layers(flat: dict, given: dict, crater: str | None) -> None:
                                       crater or layer.get("crater"))}
         _check_target(where, here, here["family"], set(layer))
         _layer_lock(where, here)
+        fc.append(here.pop("fc_cylinder"))
         out.append(here)
     flat["target.layers"] = out
     flat.pop("target.material", None)  # each layer names its own
+    return fc
 
 
-def _resolve_target(flat: dict, given: dict) -> None:
-    """The named target material's constants for every target key the user did not give; each layer's."""
+def _resolve_target(flat: dict, given: dict) -> dict:
+    """The named target material's constants for every target key the user did not give; each layer's.
+    Returns what they imply, computed here once: {"target.fc_cylinder": the cylinder strength (Pa), or a list of
+    each layer's}."""
     crater = flat["effects.crater"] if "effects.crater" in given else None
     if "target.layers" in flat:
-        _resolve_layers(flat, given, crater)
+        return {"target.fc_cylinder": _resolve_layers(flat, given, crater)}
     else:
         mine = {k: flat[f"target.{k}"] for k in CONSTANTS if f"target.{k}" in given}
         constants = _material_constants(flat["target.material"], mine, crater)
@@ -443,9 +458,10 @@ def _resolve_target(flat: dict, given: dict) -> None:
             if k in constants:
                 flat[f"target.{k}"] = SCHEMA[f"target.{k}"].check(f"target.{k}", constants[k])
         flat["effects.crater"] = constants["crater"]
+    fc = _fc_cylinder({k: flat.get(f"target.{k}") for k in ("compressive_strength", "strength_basis")})
     if "target.tensile_strength" not in flat:
-        flat["target.tensile_strength"] = _tensile_default(flat["target.compressive_strength"],
-                                                           flat.get("target.strength_basis"))
+        flat["target.tensile_strength"] = _tensile_default(fc)
+    return {"target.fc_cylinder": fc}
 
 
 #: the keys that name a file the projectile is read from
@@ -476,8 +492,8 @@ def resolve(given: dict[str, Any]) -> Scene:
             flat[name] = os.path.abspath(flat[name])
     _resolve_shot(flat, given)
     _resolve_steel(flat, given)
-    _resolve_target(flat, given)
-    _check_across(flat, given)
+    derived = _resolve_target(flat, given)
+    _check_across(flat, given, derived)
 
     tree: dict[str, Any] = {}
     for name, value in flat.items():
@@ -486,7 +502,7 @@ def resolve(given: dict[str, Any]) -> Scene:
         for part in parts[:-1]:
             node = node.setdefault(part, {})
         node[parts[-1]] = value
-    return Scene._resolved(tree, set(given))
+    return Scene._resolved(tree, set(given), derived)
 
 
 # ---------------------------------------------------------------------------------------------------------
@@ -712,7 +728,9 @@ class Scene(Section):
     Raises:
         InputError: naming the key and what is allowed.
 
-    ``scene.explicit`` is the set of dotted keys the user gave.
+    ``scene.explicit`` is the set of dotted keys the user gave; ``scene.derived`` what the keys imply, computed
+    once as the scene resolves: {"target.fc_cylinder": the target's compressive strength on the cylinder
+    basis (Pa; a list, one per layer, for target.layers; None for a metal)}.
     """
 
     def __init__(self, source=None, sets=()):
@@ -723,12 +741,14 @@ class Scene(Section):
         resolved = resolve(given)
         object.__setattr__(self, "_values", object.__getattribute__(resolved, "_values"))
         object.__setattr__(self, "explicit", resolved.explicit)
+        object.__setattr__(self, "derived", resolved.derived)
 
     @classmethod
-    def _resolved(cls, values: dict[str, Any], explicit: set[str]) -> Scene:
+    def _resolved(cls, values: dict[str, Any], explicit: set[str], derived: dict) -> Scene:
         out = object.__new__(cls)
         Section.__init__(out, values)
         object.__setattr__(out, "explicit", frozenset(explicit))
+        object.__setattr__(out, "derived", dict(derived))
         return out
 
     def with_sets(self, sets) -> Scene:

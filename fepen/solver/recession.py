@@ -21,7 +21,6 @@ areas feed back into σ_n.
 
 from __future__ import annotations
 
-import numba
 import numpy as np
 import scipy.sparse as sp
 from mpi4py import MPI
@@ -111,8 +110,9 @@ class Recession:
     def add(self, force: np.ndarray, n: np.ndarray, v: np.ndarray, dt: float) -> None:
         """Record one step's heat at the surface's points (their target forces, normals, velocities): the
         heat of fepen.laws.wear.heat_rates × Δt, a third to each of the point's facet nodes."""
-        q = np.zeros(len(force))
-        self.heat_total += _heat_to_nodes(force, n, v, self.surface.tri, self.mu * dt, self.heat_nodes, q)
+        q = wear.heat_rates(force, n, v, self.mu) * dt
+        np.add.at(self.heat_nodes, self.surface.tri.ravel(), np.repeat(q / 3.0, 3))
+        self.heat_total += float(q.sum())
         if self.zone_end is not None:
             self._heat_exact.add(q[q > 0.0])
 
@@ -231,22 +231,3 @@ class Recession:
         return out
 
 
-@numba.njit(cache=True)
-def _heat_to_nodes(force, n, v, tri, coef, out, q_out):
-    """Add coef × max(−f·n, 0) × |v_t| of each point to its facet's three nodes in ``out`` and into q_out
-    (per point); returns the sum (the same heat as fepen.laws.wear.heat_rates × Δt, in one pass)."""
-    total = 0.0
-    for i in range(force.shape[0]):
-        fn = -(force[i, 0] * n[i, 0] + force[i, 1] * n[i, 1] + force[i, 2] * n[i, 2])
-        if fn <= 0.0:
-            continue
-        vn = v[i, 0] * n[i, 0] + v[i, 1] * n[i, 1] + v[i, 2] * n[i, 2]
-        t0 = v[i, 0] - vn * n[i, 0]
-        t1 = v[i, 1] - vn * n[i, 1]
-        t2 = v[i, 2] - vn * n[i, 2]
-        q = coef * fn * np.sqrt(t0 * t0 + t1 * t1 + t2 * t2)
-        total += q
-        q_out[i] = q
-        for k in range(3):
-            out[tri[i, k]] += q / 3.0
-    return total

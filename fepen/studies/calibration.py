@@ -104,7 +104,7 @@ def _positions(summary: dict) -> tuple:
 
 def _cylinder(row) -> float:
     """The shot's cylinder strength (Pa): the row's strength on its basis (the paper's Table 1: C40 cube)."""
-    return tg.cylinder_strength(row.fc, getattr(row, "strength_basis", "cylinder"))
+    return row.fc_cylinder
 
 
 def jobs(sets: dict, node_list: list[dict], extra=()) -> list[tuple]:

@@ -16,6 +16,7 @@ the paper's eight shots (docs/paper.md).
 from __future__ import annotations
 
 import csv
+import functools
 import io
 import math
 from dataclasses import dataclass
@@ -61,6 +62,12 @@ class Row:
     obliquity_deg: float = 0.0
     attack_deg: float = 0.0
     strength_basis: str = "cylinder"
+
+    @functools.cached_property
+    def fc_cylinder(self) -> float:
+        """fc on the cylinder basis the law takes (Pa): a cube strength converted once
+        (fepen.laws.target.cylinder_strength)."""
+        return tg.cylinder_strength(self.fc, self.strength_basis)
 
 
 def read_set(path) -> list[Row]:
@@ -140,9 +147,9 @@ def closed_form_depth(row: Row, S: float | None = None, k: float = 2.0) -> float
         V1² = (m V² − π a² k D S f_c) / (m + π a² k D N* ρ)   (P > k D; else the crater alone)
 
     with Forrestal's S = 82.6 f_c^−0.544 unless S is given, and k = 2 (their 4a); f_c the row's cylinder
-    strength (a cube strength converted, fepen.laws.target.cylinder_strength).
+    strength (Row.fc_cylinder).
     """
-    fc = tg.cylinder_strength(row.fc, row.strength_basis)
+    fc = row.fc_cylinder
     S = tg.forrestal_S(fc) if S is None else S
     a, m, N, rho = 0.5 * row.D, row.mass, tg.ogive_nose_factor(row.crh), row.rho
     R, kD = S * fc, k * row.D

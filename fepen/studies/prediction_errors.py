@@ -30,7 +30,6 @@ from pathlib import Path
 
 from fepen.data.prediction_errors import COLUMNS, read
 from fepen.data.prediction_errors import path as shipped_path
-from fepen.laws import target as tg
 from fepen.studies import depth
 from fepen.studies.study import Round, Study, register
 
@@ -52,7 +51,7 @@ def _role(set_name: str) -> str:
 
 def _features(row: depth.Row) -> dict:
     return {"D_m": row.D, "L_over_D": row.L / row.D, "crh": row.crh, "mass_kg": row.mass, "V_m_s": row.V,
-            "fc_cylinder_Pa": tg.cylinder_strength(row.fc, row.strength_basis), "rho_kg_m3": row.rho,
+            "fc_cylinder_Pa": row.fc_cylinder, "rho_kg_m3": row.rho,
             "obliquity_deg": row.obliquity_deg, "attack_deg": row.attack_deg}
 
 
