@@ -79,7 +79,7 @@ def measure(size: float, stable_step: str, end_time: float, comm) -> dict:
     for o in run.outputs:
         o.write = _timed(o.write, acc, "outputs")
     run.stop_rules = _timed(run.stop_rules, acc, "rules")
-    s.times = explicit.StepTimes()
+    s.clock.times = explicit.StepTimes()
     steps0 = s.step_count
     comm.barrier()
     t0, c0 = time.perf_counter(), time.process_time()
@@ -89,14 +89,14 @@ def measure(size: float, stable_step: str, end_time: float, comm) -> dict:
     load = os.getloadavg()[0]
     loop = summary["time_split_s"]["time_loop"]  # without the closing outputs and analyses
     steps = s.step_count - steps0
-    tm = s.times
+    tm = s.clock.times
     parts = {"kinematics": tm.kinematics, "material": tm.material, "assembly": tm.assembly,
              "target": tm.boundary, "target_comm": tm.target_comm, "update": tm.update, **acc}
     parts["rest"] = loop - sum(v for k, v in parts.items() if k != "target_comm")
     parts = {k: comm.allreduce(v, op=MPI.MAX) for k, v in parts.items()}
     # the bare assembly of the internal-force form, on the state at the end
 
-    arr = s.fint_fn.x.array.copy()
+    arr = s.node.fint_fn.x.array.copy()
     reps = 200
     for _ in range(10):
         diagnostics.assemble_form(s, arr)

@@ -34,7 +34,7 @@ def measure(h_mm, comm, kernel):
     s.set_initial(velocity=lambda X: np.tile([0.0, -300.0, 0.0], (len(X), 1)))
     for _ in range(20):  # compile and warm up
         s.step()
-    s.times = explicit.StepTimes()
+    s.clock.times = explicit.StepTimes()
     comm.barrier()
     t0 = time.perf_counter()
     for _ in range(STEPS):
@@ -46,14 +46,14 @@ def measure(h_mm, comm, kernel):
         s.assemble_internal_force()
     comm.barrier()
     bare = (time.perf_counter() - t0) / STEPS
-    tm = s.times
+    tm = s.clock.times
     split = {k: comm.allreduce(getattr(tm, k), op=MPI.MAX) / STEPS
              for k in ("kinematics", "material", "assembly", "boundary", "update")}
     mat = setup.projectile_material(sc)
     c = float(tetra.dilatational_speed(mat.E, mat.nu, mat.density))
     h_over_c = info["shortest_altitude_m"] / c
     return dict(kernel=kernel, h=h_mm, cells=info["cells"], full=full, bare=bare, split=split,
-                cell_steps=info["cells"] / full, dt=s.dt0, dt_ratio=s.dt0 / h_over_c,
+                cell_steps=info["cells"] / full, dt=s.clock.dt0, dt_ratio=s.clock.dt0 / h_over_c,
                 plastic=comm.allreduce(int((s.eps_p > 0).sum()), op=MPI.SUM))
 
 

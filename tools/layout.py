@@ -132,6 +132,42 @@ def large_classes(limit: int = 300, roots=("fepen",)) -> list[tuple[str, int, st
     return out
 
 
+def _assigned(node, name: str) -> set[str]:
+    """The attributes ``name.X`` that assignments under node set (tuple targets and chains included)."""
+    out = set()
+    for n in ast.walk(node):
+        targets = n.targets if isinstance(n, ast.Assign) else [n.target] if isinstance(
+            n, (ast.AugAssign, ast.AnnAssign)) else []
+        for t in targets:
+            for e in (t.elts if isinstance(t, ast.Tuple) else [t]):
+                if isinstance(e, ast.Attribute) and isinstance(e.value, ast.Name) and e.value.id == name:
+                    out.add(e.attr)
+    return out
+
+
+def many_attributes(limit: int = 40, roots=("fepen",)) -> list[tuple[str, int, str, int]]:
+    """(path, line, name, count) of every class whose instances get more than ``limit`` attributes: those its
+    methods set on self, and those the module's functions set on a first parameter annotated with the class
+    (the set-up functions of a class split into pieces count as its own)."""
+    out = []
+    for root in roots:
+        for p in sorted((ROOT / root).rglob("*.py")):
+            tree = ast.parse(p.read_text())
+            functions = [n for n in tree.body if isinstance(n, ast.FunctionDef)]
+            for c in (n for n in ast.walk(tree) if isinstance(n, ast.ClassDef)):
+                names = set()
+                for m in (n for n in c.body if isinstance(n, ast.FunctionDef) and n.args.args):
+                    names |= _assigned(m, m.args.args[0].arg)
+                for f in functions:
+                    first = f.args.args[0] if f.args.args else None
+                    ann = getattr(first, "annotation", None)
+                    if ann is not None and c.name in (getattr(ann, "id", None), getattr(ann, "value", None)):
+                        names |= _assigned(f, first.arg)
+                if len(names) > limit:
+                    out.append((str(p.relative_to(ROOT)), c.lineno, c.name, len(names)))
+    return out
+
+
 #: the floors of the package, bottom up (README "Layout"): a module may import only its own floor and below.
 #: Top-level modules not named here sit on floor 0 (errors, atomic, version, native).
 FLOORS = {"fepen.data": 0, "fepen.stats": 1, "fepen.laws": 1, "fepen.geometry": 2, "fepen.solver": 3, "fepen.io": 4,

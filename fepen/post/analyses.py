@@ -92,7 +92,7 @@ class Gauges:
         for c in self.cells:
             val = 0.0
             if c >= 0:
-                F = np.einsum("ai,aj->ij", x[s.dofs[c]], s.grad0[c])
+                F = np.einsum("ai,aj->ij", x[s.dofs[c]], s.cell.grad0[c])
                 val = float(np.log(np.linalg.norm(F @ np.array([0.0, 1.0, 0.0]))))
             out.append(val)
         return list(self.comm.allreduce(np.array(out), op=MPI.SUM))
@@ -302,7 +302,7 @@ def nose_profile(solver, shape, tip_node, tail_node, tri: np.ndarray, out: Path)
     tip, tail = probes.node_value(solver, tip_node, x), probes.node_value(solver, tail_node, x)
     axis = unit_axis(tip, tail)  # tail to nose
     nodes = np.unique(tri)
-    nodes = nodes[~solver.orphans[nodes]]
+    nodes = nodes[~solver.node.orphans[nodes]]
     rel = x[nodes] - tail
     along = rel @ axis
     behind = shape.length - along  # distance behind the original tip position

@@ -119,7 +119,7 @@ class DeformableRun(Run):
         if not (self.rules.entered or y_min < 0.0):
             return None  # not in the target yet
         axis = unit_axis(probes.node_value(s, m.tip, x), probes.node_value(s, m.tail, x))
-        return y_min, y_max, diagnostics.momentum_velocity(s), axis, s.total_mass, s.ke0
+        return y_min, y_max, diagnostics.momentum_velocity(s), axis, s.total_mass, s.sums.ke0
 
     def _after_erosion(self) -> None:
         """If the nose-tip (tail) node lost its last cell, the foremost (rearmost) live node along the axis
@@ -129,10 +129,10 @@ class DeformableRun(Run):
         axis = unit_axis(probes.node_value(s, m.tip, x), probes.node_value(s, m.tail, x))
         for name, sign in (("tip", 1.0), ("tail", -1.0)):
             owner, local = getattr(m, name)
-            dead = self.comm.bcast(bool(s.orphans[local]) if self.comm.rank == owner else None, root=owner)
+            dead = self.comm.bcast(bool(s.node.orphans[local]) if self.comm.rank == owner else None, root=owner)
             if not dead:
                 continue
-            ahead = np.where(s.orphans[: s.n_owned], -np.inf, sign * (x[: s.n_owned] @ axis))
+            ahead = np.where(s.node.orphans[: s.n_owned], -np.inf, sign * (x[: s.n_owned] @ axis))
             k = int(np.argmax(ahead)) if len(ahead) else -1
             best = float(ahead[k]) if k >= 0 else -np.inf
             _, owner = self.comm.allreduce((best, self.comm.rank), op=MPI.MAXLOC)
@@ -237,11 +237,11 @@ class DeformableRun(Run):
 
     def summary_extra(self, loop_s: float) -> dict:
         s, m = self.solver, self.model
-        return {"dt_s": s.dt_min,
+        return {"dt_s": s.clock.dt_min,
                 "time_split_s": {"mesh": m.mesh_s, "setup_jit": m.setup_s,
                                  "time_loop": loop_s - self.output_s, "output": self.output_s},
                 "mass_kg": s.total_mass, "cells": self.pm.mesh.topology.index_map(3).size_global,
-                "stress_kernel": s.kernel, "step_gain": s.step_gain, **self.closing.summary(),
+                "stress_kernel": s.kernel, "step_gain": s.clock.step_gain, **self.closing.summary(),
                 "acceleration_filter_hz": self.shot.outputs.acceleration_filter_hz}
 
     def stop_extra(self) -> dict:

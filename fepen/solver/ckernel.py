@@ -53,16 +53,16 @@ class CellPasses:
             raise RuntimeError(why_not())
         n = len(mat)
         self.n = n
-        self._dofs = np.ascontiguousarray(dofs, dtype=np.int32)
+        self.dofs32 = np.ascontiguousarray(dofs, dtype=np.int32)
         assert sT.shape == (6, n) and Fc.shape == (n, 4, 3) and x.shape == v.shape
         self._out = np.zeros(4)
         self._keep = (x, v, mat, orient, vol0, speed, params, G_m, nodal_p, sT, eps_p, temp, sy0, cvol,
                       cell_dt, Fc, totals)
         a = _addr
-        self._kin = (n, a(x), a(self._dofs, np.int32), a(mat, np.int64), a(orient), a(vol0), a(speed))
+        self._kin = (n, a(x), a(self.dofs32, np.int32), a(mat, np.int64), a(orient), a(vol0), a(speed))
         self._kin_out = (a(cvol), a(cell_dt), a(self._out))
         self._cell_x = (n, a(x), a(v))
-        self._cell_rest = (a(self._dofs, np.int32), a(mat, np.int64), a(orient), params.shape[0], a(params), a(G_m),
+        self._cell_rest = (a(self.dofs32, np.int32), a(mat, np.int64), a(orient), params.shape[0], a(params), a(G_m),
                            a(nodal_p), a(sT), a(eps_p), a(temp), a(sy0), a(Fc), a(totals))
         self._lib = lib
 

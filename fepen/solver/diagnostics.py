@@ -67,19 +67,20 @@ def energies(solver) -> Energies:
     ke = s.kinetic_energy(s.velocity_at_step())
     nm = len(s.materials)
     w_int, w_ext = work_sums(s)
+    w = s.sums
     sums = c.allreduce(np.concatenate([_elastic_by_material(s), _bilinear_plastic(s),
-                                       [s._plastic, s._heat, s._w_if_n, s._w_if_t, s._removed[1], s._removed[2]]]),
-                       op=MPI.SUM)
+                                       [w.plastic, w.heat, w.interface_normal, w.interface_tangential, w.removed[1],
+                                        w.removed[2]]]), op=MPI.SUM)
     elastic, bilinear = sums[:nm], sums[nm: 2 * nm]
     plastic, heat, w_n, w_t, removed_ke, removed_ie = sums[2 * nm:]
-    return Energies(ke, w_int, w_ext, float(np.sum(elastic)), plastic, heat, s.ke0 or 0.0, w_n, -w_t, removed_ke,
+    return Energies(ke, w_int, w_ext, float(np.sum(elastic)), plastic, heat, w.ke0 or 0.0, w_n, -w_t, removed_ke,
                     removed_ie, tuple(elastic), tuple(_plastic_by_material(s.materials, plastic, heat, bilinear)))
 
 
 def work_sums(solver) -> tuple[float, float]:
     """(internal, external) work done since the start (J), all ranks: exact sums of each owned node's
     running sum (the same on any partition)."""
-    return tuple(assembly.exact_sum(solver._work[: solver.n_owned], solver.comm))
+    return tuple(assembly.exact_sum(solver.sums.work[: solver.n_owned], solver.comm))
 
 
 def _cell_J(solver) -> np.ndarray:
@@ -101,14 +102,14 @@ def _elastic_by_material(solver) -> np.ndarray:
     sd = s.s  # column-major: whole columns are cheap, rows are not
     ss = sd[:, 0] ** 2 + sd[:, 1] ** 2 + sd[:, 2] ** 2 + 2.0 * (sd[:, 3] ** 2 + sd[:, 4] ** 2 + sd[:, 5] ** 2)
     per_cell = J * s.vol0 * ss / (4.0 * G)
-    if s.nodal:
-        v0, v = s.nodal_vol0[:n], s.nodal_vol[:n]
+    if s.passes.nodal:
+        v0, v = s.node.vol0[:n], s.node.vol[:n]
         has = v0 > 0.0
         lj = np.log(np.where(has, v, 1.0) / np.where(has, v0, 1.0))
-        out = 0.5 * s.bulk * np.sum(v0 * lj * lj, axis=0)
+        out = 0.5 * s.cell.bulk * np.sum(v0 * lj * lj, axis=0)
     else:
         lj = np.log(np.where(live, J, 1.0))
-        per_cell += s.vol0 * 0.5 * s.bulk[mat] * lj * lj
+        per_cell += s.vol0 * 0.5 * s.cell.bulk[mat] * lj * lj
         out = np.zeros(nm)
     return out + np.bincount(np.where(live, mat, 0), weights=np.where(live, per_cell, 0.0), minlength=nm)
 
@@ -175,7 +176,7 @@ def body_accelerations(solver, axis: np.ndarray) -> np.ndarray:
     cells (interface nodes share theirs)."""
     n = solver.n_owned
     along = solver.acc[:n] @ axis
-    return assembly.exact_sum(solver.mass_by_material[:n] * along[:, None], solver.comm) / solver.body_mass
+    return assembly.exact_sum(solver.node.mass_by_material[:n] * along[:, None], solver.comm) / solver.node.body_mass
 
 
 @dataclass
@@ -202,7 +203,7 @@ def bodies(solver, e: Energies) -> Bodies:
     s = solver
     n, nm = s.n_owned, len(s.materials)
     v = s.velocity_at_step()[:n]
-    mb = s.mass_by_material[:n]
+    mb = s.node.mass_by_material[:n]
     whole = assembly.exact_sum(s.mass[:n, None] * v[:, :2], s.comm)
     kinetic, momentum = np.zeros(nm), np.zeros((nm, 2))
     for k in range(1, nm):
@@ -227,8 +228,8 @@ def tied_interface_force(solver, body: int = 1) -> np.ndarray:
     charge enclosed in the shell, the external term is zero."""
     s = solver
     n = s.n_owned
-    mb = s.mass_by_material[:n, body]
-    share = np.where(mb > 0.0, mb / s._mass_div[:n], 0.0)
+    mb = s.node.mass_by_material[:n, body]
+    share = np.where(mb > 0.0, mb / s.node.mass_div[:n], 0.0)
     return assembly.exact_sum(mb[:, None] * s.acc[:n] - share[:, None] * s.fext[:n], s.comm)
 
 
@@ -262,7 +263,7 @@ def axial_stress(solver, axis: np.ndarray) -> np.ndarray:
     """Normal Cauchy stress along the axis of the owned cells (Pa): a·s·a plus the cells' mean stress."""
     sd = solver.s
     pm = solver.nodal_p[solver.dofs, np.maximum(solver.mat, 0)[:, None]].mean(axis=1) * (solver.mat >= 0) \
-        if solver.nodal else 0.0
+        if solver.passes.nodal else 0.0
     ax, ay, az = axis
     return (sd[:, 0] * ax * ax + sd[:, 1] * ay * ay + sd[:, 2] * az * az
             + 2 * (sd[:, 3] * ax * ay + sd[:, 4] * ay * az + sd[:, 5] * ax * az)) + pm
@@ -271,4 +272,4 @@ def axial_stress(solver, axis: np.ndarray) -> np.ndarray:
 def assemble_form(solver, out: np.ndarray) -> None:
     """The solver's internal force through dolfinx: the compiled form assembled into ``out`` (the flat array
     of a V function, zeroed by the caller), no ghost sum (the reference, and the benchmarks' floor)."""
-    dx.assemble_into(out, solver.form, solver._consts, solver._coeffs)
+    dx.assemble_into(out, solver.internal.form, solver.internal.consts, solver.internal.coeffs)

@@ -65,8 +65,8 @@ class Erosion:
     def check(self) -> int:
         """Erode the live cells past the criteria (collective). Returns how many, all ranks."""
         s = self.solver
-        step = s.cell_dt * (s.safety * s.step_gain)
-        cells = np.flatnonzero(law.failed(s.eps_p, step, s.dt0, self.strain, self.step_ratio) & (s.mat >= 0))
+        step = s.cell.dt * (s.clock.safety * s.clock.step_gain)
+        cells = np.flatnonzero(law.failed(s.eps_p, step, s.clock.dt0, self.strain, self.step_ratio) & (s.mat >= 0))
         return self._remove(cells)
 
     def _erode_inverted(self, x: np.ndarray) -> bool:

@@ -15,6 +15,7 @@ from fepen import dolfinx_api as dx
 from fepen.errors import SimulationError
 from fepen.laws import materials as M
 from fepen.solver import assembly, ckernel, failures, kernels, reference
+from fepen.solver import state as st
 
 dx.quiet()  # quiet dolfinx wherever the solver is used
 
@@ -64,7 +65,7 @@ class Interface(Protocol):
 
     def __call__(self, solver: ExplicitSolver) -> None:
         """Add the constraint forces of the coming step to ``solver.acc``; report their work
-        (``solver.add_interface_work``)."""
+        (into ``solver.sums``: interface_normal, interface_tangential)."""
 
     def summary(self) -> dict:
         """Largest gap, interpenetration and slip (mm), fractions of pairs open and sliding."""
@@ -75,9 +76,13 @@ class Interface(Protocol):
 
 #: the solver's state between two steps (checkpoints): nodal and cell arrays, and scalars; the work sums
 #: are each rank's own partial sums
-STATE_ARRAYS = ("U", "Vel", "acc", "fint", "fext", "s", "eps_p", "temp", "sy0", "X", "mat", "_removed", "_work")
-STATE_SCALARS = ("t", "step_count", "dt", "dt_prev", "dt0", "dt_min", "_plastic", "_heat",
-                 "ke0", "_w_if_n", "_w_if_t", "dt_stable", "_land_at")
+STATE_ARRAYS = {"U": "U", "Vel": "Vel", "acc": "acc", "fint": "node.fint", "fext": "fext", "s": "s",
+                "eps_p": "eps_p", "temp": "temp", "sy0": "cell.sy0", "X": "X", "mat": "mat",
+                "_removed": "sums.removed", "_work": "sums.work"}
+STATE_SCALARS = {"t": "t", "step_count": "step_count", "dt": "dt", "dt_prev": "dt_prev", "dt0": "clock.dt0",
+                 "dt_min": "clock.dt_min", "_plastic": "sums.plastic", "_heat": "sums.heat", "ke0": "sums.ke0",
+                 "_w_if_n": "sums.interface_normal", "_w_if_t": "sums.interface_tangential",
+                 "dt_stable": "clock.dt_stable", "_land_at": "clock.land_at"}
 
 
 class ExplicitSolver:
@@ -103,22 +108,23 @@ class ExplicitSolver:
                  nodal_pressure: bool = True, external: Load | None = None, kernel: str | None = None):
         self.mesh = mesh
         self.comm = mesh.comm
-        self.safety = safety
-        self.nodal = nodal_pressure
+        self.clock, self.sums = st.Clock(safety), st.WorkSums()
+        self.node, self.cell, self.internal, self.passes = st.NodeData(), st.CellData(), st.Internal(), st.Passes(
+            nodal_pressure)
         self.external = external
         _reference_body(self, mesh)
         _material_tables(self, materials, cell_material)
         nm = len(materials)
         imap = self.V.dofmap.index_map
         _nodal_arrays(self, self.V, imap, nm)
-        self._lumped_mass(imap, nm)
+        self.lumped_mass(imap, nm)
         self.initial_mass = self.total_mass
         _cell_state(self)
-        _internal_force_form(self, self.V, self.Q)
+        _internal_force_form(self, self.V, self.internal.Q)
         _stress_kernel(self, kernel)
         _clock(self)
 
-    def _lumped_mass(self, imap, nm: int, orphans_allowed: bool = False) -> None:
+    def lumped_mass(self, imap, nm: int, orphans_allowed: bool = False) -> None:
         """Lumped mass: ρ_e V0_e / 4 to each node, per material (the bodies' masses, for their mass-averaged
         accelerations) and in all; eroded cells give none. ``_mass_div`` is the mass the accelerations are
         divided by: the mass itself, or after an erosion a copy with 1 on the nodes left without a cell
@@ -128,15 +134,15 @@ class ExplicitSolver:
         mvec = dx.new_vector(imap, bs=nm)
         arr = mvec.array.reshape(-1, nm)
         _per_material_to_nodes(self, 0.25 * rho * self.vol0, mvec)
-        self.mass_by_material = arr[: self.n_nodes].copy()
-        self.mass = self.mass_by_material.sum(axis=1)
-        self.body_mass = assembly.exact_sum(self.mass_by_material[: self.n_owned], self.comm)
-        self.orphans = self.mass <= 0.0
-        if not orphans_allowed and np.any(self.orphans[: self.n_owned]):
+        self.node.mass_by_material = arr[: self.n_nodes].copy()
+        self.mass = self.node.mass_by_material.sum(axis=1)
+        self.node.body_mass = assembly.exact_sum(self.node.mass_by_material[: self.n_owned], self.comm)
+        self.node.orphans = self.mass <= 0.0
+        if not orphans_allowed and np.any(self.node.orphans[: self.n_owned]):
             raise SimulationError("a node has no mass (an orphan node in the mesh)")
-        self._mass_div = self.mass
-        if np.any(self.orphans):
-            self._mass_div = np.where(self.orphans, 1.0, self.mass)
+        self.node.mass_div = self.mass
+        if np.any(self.node.orphans):
+            self.node.mass_div = np.where(self.node.orphans, 1.0, self.mass)
         self.total_mass = assembly.exact_sum(self.mass[: self.n_owned], self.comm)
 
     # ------------------------------------------------------------------------------------------------
@@ -144,24 +150,25 @@ class ExplicitSolver:
         dx.scatter_reverse_add(vec)
         vec.scatter_forward()
 
-    def _volumes_to_nodes(self, cvol: np.ndarray, vec) -> None:
+    def volumes_to_nodes(self, cvol: np.ndarray, vec) -> None:
         """Nodal volumes per material (the vector vec), Σ V_e / 4 over live cells, the terms on the volume
         grid (exact sums: the same on any partition), ghosts summed and refreshed."""
         arr = vec.array.reshape(-1, len(self.materials))
-        if self._nodes is not None:
-            self._nodes.scatter_volumes(self._cells._dofs, self.mat, cvol, self.volume_quantum, arr)
+        if self.passes.nodes is not None:
+            self.passes.nodes.scatter_volumes(self.passes.cells.dofs32, self.mat, cvol, self.internal.volume_quantum,
+                                              arr)
         else:
-            kernels.grid_scatter(self.dofs, self.mat, cvol.reshape(-1, 1, 1), False, self.volume_quantum, arr)
+            kernels.grid_scatter(self.dofs, self.mat, cvol.reshape(-1, 1, 1), False, self.internal.volume_quantum, arr)
         self._ghost_sum(vec)
 
     def _cells_to_nodes(self, Fc: np.ndarray, out: np.ndarray) -> None:
         """The cells' nodal forces Fc (n_cells, 4, 3) summed into out (n_nodes, 3), the terms on the force
         grid (exact sums: the same on any partition), ghost terms summed to their owners (ghost rows stale)."""
-        if self._nodes is not None:
-            self._nodes.scatter_forces(self._cells._dofs, Fc, self.force_quantum, out)
+        if self.passes.nodes is not None:
+            self.passes.nodes.scatter_forces(self.passes.cells.dofs32, Fc, self.internal.force_quantum, out)
         else:
-            kernels.grid_scatter(self.dofs, self.mat, Fc, True, self.force_quantum, out)
-        dx.scatter_reverse_add(self.fint_fn.x)
+            kernels.grid_scatter(self.dofs, self.mat, Fc, True, self.internal.force_quantum, out)
+        dx.scatter_reverse_add(self.node.fint_fn.x)
 
     def positions(self) -> np.ndarray:
         """Current node positions (n_nodes, 3), ghosts included."""
@@ -171,8 +178,8 @@ class ExplicitSolver:
         """Safety x min over cells of (shortest altitude / dilatational speed), current mesh, all ranks."""
         # a scratch array: nodal_vol must keep the ghost-summed volumes of the last step (energies use them)
         _, _, h_c, _ = kernels.volumes_and_step(self.positions(), self.dofs, self.orient, self.vol0,
-                                                       self.mat, self.speed, np.empty(self.n_cells))
-        return self.safety * self.step_gain * self.comm.allreduce(h_c, op=MPI.MIN)
+                                                       self.mat, self.cell.speed, np.empty(self.n_cells))
+        return self.clock.safety * self.clock.step_gain * self.comm.allreduce(h_c, op=MPI.MIN)
 
     def calibrate_step(self, iterations: int = 400, rtol: float = 1e-5) -> tuple[float, float]:
         """The critical step of the undeformed body by power iteration; sets ``step_gain`` (module function
@@ -190,16 +197,16 @@ class ExplicitSolver:
             self.U[:] = displacement(self.X) if callable(displacement) else displacement
         if velocity is not None:
             self.Vel[:] = velocity(self.X) if callable(velocity) else velocity
-        if self.fixed is not None:
-            self.Vel[self.fixed] = 0.0
+        if self.node.fixed is not None:
+            self.Vel[self.node.fixed] = 0.0
         self._forces(0.0)
         n = self.n_owned
-        self.acc[:n] = (self.fext[:n] - self.fint[:n]) / self._mass_div[:n, None]
-        if self.fixed is not None:
-            self.acc[self.fixed] = 0.0
-        self.a_fn.x.scatter_forward()
-        self.ke0 = self.kinetic_energy(self.Vel)
-        self.dt_stable = self.dt0 = self.dt_min = self.stable_step()
+        self.acc[:n] = (self.fext[:n] - self.node.fint[:n]) / self.node.mass_div[:n, None]
+        if self.node.fixed is not None:
+            self.acc[self.node.fixed] = 0.0
+        self.node.a_fn.x.scatter_forward()
+        self.sums.ke0 = self.kinetic_energy(self.Vel)
+        self.clock.dt_stable = self.clock.dt0 = self.clock.dt_min = self.stable_step()
         _choose_step(self)
         if self.interface is not None:
             self.interface(self)
@@ -216,59 +223,59 @@ class ExplicitSolver:
     # ------------------------------------------------------------------------------------------------
     def _forces(self, dt: float, x_ready: bool = False) -> float:
         """Internal and external forces at the current positions; returns the new stable-step estimate
-        (h/c over the current mesh, before the safety factor) on this rank. x_ready: ``self._x`` already
+        (h/c over the current mesh, before the safety factor) on this rank. x_ready: ``self.node.x`` already
         holds X + U (the C update pass wrote it)."""
-        if self._cells is not None:
+        if self.passes.cells is not None:
             return self._forces_c(dt, x_ready)
         t0 = perf_counter()
-        x = np.add(self.X, self.U, out=self._x)
+        x = np.add(self.X, self.U, out=self.node.x)
         with_step = self.step_count % STEP_EVERY == 0
-        jmin, worst, h_c, self._step_cell = kernels.volumes_and_step(
-            x, self.dofs, self.orient, self.vol0, self.mat, self.speed, self.cvol, with_step, self.cell_dt)
+        jmin, worst, h_c, self.cell.step_cell = kernels.volumes_and_step(
+            x, self.dofs, self.orient, self.vol0, self.mat, self.cell.speed, self.cell.vol, with_step, self.cell.dt)
         if self._any_inverted(jmin):
             if self.on_inverted is None or not self.on_inverted(x):
                 failures.inverted(self, x, jmin, worst)
-            jmin, worst, h_c, self._step_cell = kernels.volumes_and_step(  # the inverted cells eroded
-                x, self.dofs, self.orient, self.vol0, self.mat, self.speed, self.cvol, with_step, self.cell_dt)
+            jmin, worst, h_c, self.cell.step_cell = kernels.volumes_and_step(  # the inverted cells eroded
+                x, self.dofs, self.orient, self.vol0, self.mat, self.cell.speed, self.cell.vol, with_step, self.cell.dt)
             if self._any_inverted(jmin):
                 failures.inverted(self, x, jmin, worst)
-        self._volumes_to_nodes(self.cvol, self._nvol)
+        self.volumes_to_nodes(self.cell.vol, self.node.nvol)
         t1 = perf_counter()
-        if self.nodal:
-            kernels.nodal_pressures(self.nodal_vol, self.nodal_vol0, self.bulk, self.nodal_p)
+        if self.passes.nodal:
+            kernels.nodal_pressures(self.node.vol, self.node.vol0, self.cell.bulk, self.nodal_p)
         self._stress_update(x, dt)
         t2 = perf_counter()
         self.assemble_internal_force()
         t3 = perf_counter()
         self._external_forces()
-        self.times.add(t0, t1, t2, t3, perf_counter())
+        self.clock.times.add(t0, t1, t2, t3, perf_counter())
         return h_c
 
     def _forces_c(self, dt: float, x_ready: bool) -> float:
         """_forces through the C passes (fepen/solver/cell_kernel.c): the kinematics pass (cvol, J, h/c),
         the nodal volumes and pressures, the fused stress-and-force pass (Fc), the nodal forces."""
         t0 = perf_counter()
-        x = self._x if x_ready else np.add(self.X, self.U, out=self._x)
+        x = self.node.x if x_ready else np.add(self.X, self.U, out=self.node.x)
         with_step = self.step_count % STEP_EVERY == 0
-        cells = self._cells
-        jmin, worst, h_c, self._step_cell = cells.kinematics(with_step)
+        cells = self.passes.cells
+        jmin, worst, h_c, self.cell.step_cell = cells.kinematics(with_step)
         if self._any_inverted(jmin):
             if self.on_inverted is None or not self.on_inverted(x):
                 failures.inverted(self, x, jmin, worst)
-            jmin, worst, h_c, self._step_cell = cells.kinematics(with_step)  # the inverted cells eroded
+            jmin, worst, h_c, self.cell.step_cell = cells.kinematics(with_step)  # the inverted cells eroded
             if self._any_inverted(jmin):
                 failures.inverted(self, x, jmin, worst)
-        self._volumes_to_nodes(self.cvol, self._nvol)
+        self.volumes_to_nodes(self.cell.vol, self.node.nvol)
         t1 = perf_counter()
-        self._nodes.nodal_pressure(self.nodal_vol, self.nodal_vol0, self.bulk, self.nodal_p)
+        self.passes.nodes.nodal_pressure(self.node.vol, self.node.vol0, self.cell.bulk, self.nodal_p)
         cells.cells(dt)
-        self._plastic += self._totals[0]
-        self._heat += self._totals[1]
+        self.sums.plastic += self.sums.totals[0]
+        self.sums.heat += self.sums.totals[1]
         t2 = perf_counter()
-        self._cells_to_nodes(self.Fc, self.fint)
+        self._cells_to_nodes(self.cell.Fc, self.node.fint)
         t3 = perf_counter()
         self._external_forces()
-        self.times.add(t0, t1, t2, t3, perf_counter())
+        self.clock.times.add(t0, t1, t2, t3, perf_counter())
         return h_c
 
     def _external_forces(self) -> None:
@@ -280,27 +287,27 @@ class ExplicitSolver:
     def _stress_update(self, x: np.ndarray, dt: float) -> None:
         """Every cell's stress over the step and P into the packed coefficient; plastic work and heat (the
         numba reference)."""
-        kernels.stress_update(x, self.Vel, dt, self.dofs, self.grad0, self.vol0, self.mat, self.params,
-                              self.nodal_p, self.nodal, self.s, self.eps_p, self.temp, self.sy0,
-                              self.P_packed, self._totals)
-        self._plastic += self._totals[0]
-        self._heat += self._totals[1]
+        kernels.stress_update(x, self.Vel, dt, self.dofs, self.cell.grad0, self.vol0, self.mat, self.cell.params,
+                              self.nodal_p, self.passes.nodal, self.s, self.eps_p, self.temp, self.cell.sy0,
+                              self.internal.P_packed, self.sums.totals)
+        self.sums.plastic += self.sums.totals[0]
+        self.sums.heat += self.sums.totals[1]
 
     def assemble_internal_force(self) -> None:
         """f_int = ∫ P : ∇_X w dX from the packed P on the owned nodes: each cell's four nodal forces with
         its reference gradients (kernels.internal_force_cells: the compiled form's vector to round-off, at a
         fraction of dolfinx's cost, which rebuilds each cell's geometry), summed at the nodes in the
         partition-independent order (contributions of other ranks' cells included; ghost rows are stale)."""
-        kernels.internal_force_cells(self.P_packed, self.dofs, self.grad0, self.vol0, self.Fc)
-        self._cells_to_nodes(self.Fc, self.fint)
+        kernels.internal_force_cells(self.internal.P_packed, self.dofs, self.cell.grad0, self.vol0, self.cell.Fc)
+        self._cells_to_nodes(self.cell.Fc, self.node.fint)
 
     def _any_inverted(self, jmin: float) -> bool:
         """Whether a live cell on any rank is inverted (or NaN); every rank gets the same answer."""
         bad = not (jmin > 0.0)
         if self.comm.size > 1:  # every rank must stop together (and rank 0 must be able to say why)
-            self._flag[0] = 1.0 if bad else 0.0
-            self.comm.Allreduce(MPI.IN_PLACE, self._flag, op=MPI.MAX)
-            bad = self._flag[0] > 0.0
+            self.passes.flag[0] = 1.0 if bad else 0.0
+            self.comm.Allreduce(MPI.IN_PLACE, self.passes.flag, op=MPI.MAX)
+            bad = self.passes.flag[0] > 0.0
         return bad
 
     def step(self) -> None:
@@ -309,52 +316,53 @@ class ExplicitSolver:
         n = self.n_owned
         t0 = perf_counter()
         h = 0.5 * (self.dt_prev + dt)
-        if self._nodes is not None:  # the C node passes: x = X + U written too
-            self._nodes.update_begin(h, dt, n, self.acc, self.Vel, self.U, self.X, self._x, self._du, self.fint,
-                                     self.fext, self._work)
+        if self.passes.nodes is not None:  # the C node passes: x = X + U written too
+            self.passes.nodes.update_begin(h, dt, n, self.acc, self.Vel, self.U, self.X, self.node.x, self.node.du,
+                                           self.node.fint, self.fext, self.sums.work)
         else:
             self.Vel += h * self.acc
-            du = np.multiply(dt, self.Vel, out=self._du)
+            du = np.multiply(dt, self.Vel, out=self.node.du)
             self.U += du
-            kernels.work_halves(du, self.fint, self.fext, n, self._work)
-        self.times.update += perf_counter() - t0
-        h_c = self._forces(dt, x_ready=self._nodes is not None)
+            kernels.work_halves(du, self.node.fint, self.fext, n, self.sums.work)
+        self.clock.times.update += perf_counter() - t0
+        h_c = self._forces(dt, x_ready=self.passes.nodes is not None)
         t0 = perf_counter()
-        du = self._du
-        if self._nodes is not None:
-            self._nodes.update_end(n, self.fint, self.fext, self._mass_div, self.fixed, du, self.acc, self._work)
+        du = self.node.du
+        if self.passes.nodes is not None:
+            nd = self.node
+            self.passes.nodes.update_end(n, nd.fint, self.fext, nd.mass_div, nd.fixed, du, self.acc, self.sums.work)
         else:
-            self.acc[:n] = (self.fext[:n] - self.fint[:n]) / self._mass_div[:n, None]
-            if self.fixed is not None:
-                self.acc[self.fixed] = 0.0
-            kernels.work_halves(du, self.fint, self.fext, n, self._work)
-        self.a_fn.x.scatter_forward()
-        self.t = self._land_at if self._land_at >= 0.0 else self.t + dt
+            self.acc[:n] = (self.fext[:n] - self.node.fint[:n]) / self.node.mass_div[:n, None]
+            if self.node.fixed is not None:
+                self.acc[self.node.fixed] = 0.0
+            kernels.work_halves(du, self.node.fint, self.fext, n, self.sums.work)
+        self.node.a_fn.x.scatter_forward()
+        self.t = self.clock.land_at if self.clock.land_at >= 0.0 else self.t + dt
         self.step_count += 1
         self.dt_prev = dt
-        self.times.update += perf_counter() - t0
+        self.clock.times.update += perf_counter() - t0
         if self.step_count % STEP_EVERY == 1:
             self._new_step(h_c)
         _choose_step(self)
         if self.interface is not None:
             t0 = perf_counter()
             self.interface(self)
-            self.times.boundary += perf_counter() - t0
+            self.clock.times.boundary += perf_counter() - t0
 
     def _new_step(self, h_c: float) -> None:
         """The next Δt from this rank's h/c (all ranks agree), or SimulationError if it collapsed."""
-        new = self.safety * self.step_gain * self.comm.allreduce(h_c, op=MPI.MIN)
-        if not (new > 1e-3 * self.dt0):
+        new = self.clock.safety * self.clock.step_gain * self.comm.allreduce(h_c, op=MPI.MIN)
+        if not (new > 1e-3 * self.clock.dt0):
             failures.step_collapsed(self, h_c, new)
-        self.dt_stable = new
-        self.dt_min = min(self.dt_min, new)
+        self.clock.dt_stable = new
+        self.clock.dt_min = min(self.clock.dt_min, new)
 
     def state(self) -> dict[str, np.ndarray]:
         """This rank's state between two steps: STATE_ARRAYS, the reference positions ``X`` and the
         STATE_SCALARS packed in ``scalars`` (for checkpoints; the arrays are views, copy to keep)."""
-        out = {k: getattr(self, k) for k in STATE_ARRAYS}
+        out = {k: _get(self, where) for k, where in STATE_ARRAYS.items()}
         out["X0"] = self.X0
-        out["scalars"] = np.array([float(getattr(self, k)) for k in STATE_SCALARS])
+        out["scalars"] = np.array([float(_get(self, where)) for where in STATE_SCALARS.values()])
         return out
 
     def restore(self, state) -> None:
@@ -363,22 +371,31 @@ class ExplicitSolver:
         X0 = state["X0"] if "X0" in state else state["X"]
         if not (X0.shape == self.X0.shape and np.array_equal(X0, self.X0)):
             raise ValueError("the state was taken on another mesh or partition")
-        for k in STATE_ARRAYS:
+        for k, where in STATE_ARRAYS.items():
             if k in state:
-                np.copyto(getattr(self, k), state[k])
-        for k, v in zip(STATE_SCALARS, state["scalars"]):
-            setattr(self, k, int(v) if k == "step_count" else float(v))
+                np.copyto(_get(self, where), state[k])
+        for (k, where), v in zip(STATE_SCALARS.items(), state["scalars"]):
+            _set(self, where, int(v) if k == "step_count" else float(v))
         changed = bool(np.any(self.mat < 0)) or not np.array_equal(self.X, self.X0)  # eroded or receded
         if self.comm.allreduce(changed, op=MPI.LOR):  # rebuild (collective)
-            removed = self._removed.copy()
+            removed = self.sums.removed.copy()
             reference.rebuild(self, np.arange(self.n_cells))
-            self.P_packed[: self.n_cells][self.mat < 0] = 0.0
-            self._removed[:] = removed
+            self.internal.P_packed[: self.n_cells][self.mat < 0] = 0.0
+            self.sums.removed[:] = removed
 
-    def add_interface_work(self, normal: float, tangential: float) -> None:
-        """Add this rank's share of the interface forces' work over the step (J)."""
-        self._w_if_n += normal
-        self._w_if_t += tangential
+
+def _get(s: ExplicitSolver, where: str):
+    """The solver's value at a dotted path ("clock.dt0")."""
+    out = s
+    for part in where.split("."):
+        out = getattr(out, part)
+    return out
+
+
+def _set(s: ExplicitSolver, where: str, value) -> None:
+    """Set the solver's value at a dotted path."""
+    *path, last = where.split(".")
+    setattr(_get(s, ".".join(path)) if path else s, last, value)
 
 
 def _choose_step(s: ExplicitSolver) -> None:
@@ -388,7 +405,7 @@ def _choose_step(s: ExplicitSolver) -> None:
     differences take any shorter step; the stable step bounds it from above). Equal steps, not one short one
     before each landing: a step that changes every interval pumps energy into the highest modes (a C3 run at
     300 m/s, elastic: an energy error of 2.6e-3 with one short step per microsecond, 1.2e-5 without landing)."""
-    dt, s._land_at = s.dt_stable, -1.0
+    dt, s.clock.land_at = s.clock.dt_stable, -1.0
     if s.landing is not None:
         target = s.landing(s.t, dt)
         r = target - s.t
@@ -396,7 +413,7 @@ def _choose_step(s: ExplicitSolver) -> None:
             n = max(1, math.ceil(r / dt * (1.0 - 1e-12)))
             dt = r / n
             if n == 1:
-                s._land_at = target
+                s.clock.land_at = target
     s.dt = dt
 
 
@@ -423,36 +440,36 @@ def calibrate_step(s: ExplicitSolver, iterations: int = 400, rtol: float = 1e-5)
     eps = 1e-9 * L
     lam = lam_prev = 0.0
     for it in range(iterations):
-        if s.fixed is not None:
-            d[s.fixed] = 0.0
+        if s.node.fixed is not None:
+            d[s.node.fixed] = 0.0
         norm = np.sqrt(s.comm.allreduce(float(np.sum(s.mass[:n, None] * d[:n] ** 2)), op=MPI.SUM))
         d /= norm
         s.U[:] = eps * d
         s.Vel[:] = eps * d
         s.s[:] = 0.0
         s._forces(1.0)  # increment v dt = eps d from the reference: f_int = K eps d
-        Kd = s.fint[:n] / eps
+        Kd = s.node.fint[:n] / eps
         lam = s.comm.allreduce(float(np.sum(d[:n] * Kd)), op=MPI.SUM)
         s.Vel[:n] = Kd / s.mass[:n, None]
-        s.v.x.scatter_forward()
+        s.node.v.x.scatter_forward()
         d = s.Vel.copy()
         if it > 30 and abs(lam - lam_prev) < rtol * lam:
             break
         lam_prev = lam
     s.external = external
-    for a in (s.U, s.Vel, s.s, s.fint, s.fext, s.acc):
+    for a in (s.U, s.Vel, s.s, s.node.fint, s.fext, s.acc):
         a[:] = 0.0
     s.eps_p[:] = 0.0
     _, _, h_c, _ = kernels.volumes_and_step(s.positions(), s.dofs, s.orient, s.vol0, s.mat,
-                                               s.speed, np.empty(s.n_cells))
+                                               s.cell.speed, np.empty(s.n_cells))
     h_c = s.comm.allreduce(h_c, op=MPI.MIN)
     dt_crit = 2.0 / np.sqrt(lam)
     # rounded down to a multiple of GAIN_QUANTUM: the Rayleigh quotient of a 1e-9 L displacement carries
     # round-off of ~1e-6 that depends on the partition; rounded, the step is the same on any number of
     # ranks (unless the gain falls within ~1e-6 of a multiple), and at most GAIN_QUANTUM / 2 smaller
-    s.step_gain = max(math.floor(dt_crit / h_c / GAIN_QUANTUM) * GAIN_QUANTUM, GAIN_QUANTUM)
-    s.dt = s.dt_stable = s.dt0 = s.dt_min = s.stable_step()
-    return dt_crit, s.step_gain
+    s.clock.step_gain = max(math.floor(dt_crit / h_c / GAIN_QUANTUM) * GAIN_QUANTUM, GAIN_QUANTUM)
+    s.dt = s.clock.dt_stable = s.clock.dt0 = s.clock.dt_min = s.stable_step()
+    return dt_crit, s.clock.step_gain
 
 
 #: the grids' ranges: a nodal sum is exact while its partial sums stay below 2^53 quanta, here FORCE_RANGE x
@@ -467,8 +484,8 @@ def _grids(s: ExplicitSolver) -> tuple[float, float]:
     """The quanta (powers of two) that the cells' nodal forces and volumes are rounded to before they are
     summed at the nodes (docs/theory.md §3.4): the same on every rank (a maximum over all of them) and over
     the run, from the reference body."""
-    area = 3.0 * s.vol0[:, None] * np.linalg.norm(s.grad0, axis=2) if s.n_cells else np.zeros((0, 4))
-    local = np.array([float(area.max(initial=0.0)) * float(s.bulk.max()), float(s.vol0.max(initial=0.0))])
+    area = 3.0 * s.vol0[:, None] * np.linalg.norm(s.cell.grad0, axis=2) if s.n_cells else np.zeros((0, 4))
+    local = np.array([float(area.max(initial=0.0)) * float(s.cell.bulk.max()), float(s.vol0.max(initial=0.0))])
     top = local.copy()
     s.comm.Allreduce(local, top, op=MPI.MAX)
     return tuple(2.0 ** (math.ceil(math.log2(r * v)) - 52) for r, v in zip((FORCE_RANGE, VOLUME_RANGE), top))
@@ -480,13 +497,13 @@ def _per_material_to_nodes(s: ExplicitSolver, cell_values: np.ndarray, vec) -> N
     ghosts refreshed."""
     nm = len(s.materials)
     if nm == 1:
-        np.multiply(cell_values, s.mat >= 0, out=s._cvol4[:, 0])  # eroded cells give nothing
-        vals = s._cvol4
+        np.multiply(cell_values, s.mat >= 0, out=s.cell.vol4[:, 0])  # eroded cells give nothing
+        vals = s.cell.vol4
     else:
         live = s.mat >= 0
         vals = np.zeros((s.n_cells, nm))
         vals[np.flatnonzero(live), s.mat[live]] = cell_values[live]
-    s._cell_sum(vals, vec.array.reshape(-1, nm))
+    s.node.cell_sum(vals, vec.array.reshape(-1, nm))
     vec.scatter_forward()
 
 
@@ -497,7 +514,7 @@ def _reference_body(s: ExplicitSolver, mesh) -> None:
     """The function spaces, the node and cell numbering, the reference positions and gradients."""
     V = dx.vector_space(mesh)
     Q = dx.tensor_dg0_space(mesh)
-    s.V, s.Q = V, Q
+    s.V, s.internal.Q = V, Q
     imap = V.dofmap.index_map
     s.n_owned = imap.size_local
     s.n_nodes = imap.size_local + imap.num_ghosts
@@ -508,119 +525,119 @@ def _reference_body(s: ExplicitSolver, mesh) -> None:
     s.X0 = s.X.copy()  # X moves only where a surface recedes (fepen.solver.recession)
     # the mesh geometry's node of each dof, so that a moved reference reaches the assembled form
     gdofs = dx.geometry_dofs(mesh)
-    s._geometry_node = np.zeros(s.n_nodes, dtype=np.int64)
-    s._geometry_node[dx.cell_dofs(V).ravel()] = gdofs.ravel()
-    s.geometry_x = mesh.geometry.x
-    assert np.allclose(s.geometry_x[s._geometry_node, :3], s.X)
-    s.X[:] = s.geometry_x[s._geometry_node, :3]  # the mesh's own numbers (tabulated ones may differ in
+    s.node.geometry_node = np.zeros(s.n_nodes, dtype=np.int64)
+    s.node.geometry_node[dx.cell_dofs(V).ravel()] = gdofs.ravel()
+    s.node.geometry_x = mesh.geometry.x
+    assert np.allclose(s.node.geometry_x[s.node.geometry_node, :3], s.X)
+    s.X[:] = s.node.geometry_x[s.node.geometry_node, :3]  # the mesh's own numbers (tabulated ones may differ in
     s.X0[:] = s.X  # the last bit), so that writing X back into the geometry changes nothing
-    s.grad0, s.vol0, s.orient = kernels.reference_gradients(s.X, s.dofs)
+    s.cell.grad0, s.vol0, s.orient = kernels.reference_gradients(s.X, s.dofs)
     # each node's input-mesh number (the same on any partition) and the cells' nodal sums in their order
-    s.input_index = np.asarray(mesh.geometry.input_global_indices, dtype=np.int64)[s._geometry_node]
-    s._cell_sum = assembly.NodalSum(s.comm, imap, s.dofs, assembly.input_keys(s.dofs, s.input_index))
-    s.cvol = np.zeros(n_cells)  # each cell's current volume
-    s._cvol4 = np.zeros((n_cells, 1))
-    s._cells = s._nodes = None  # the C passes (_stress_kernel)
-    s.Fc = np.zeros((n_cells, 4, 3))  # each cell's internal forces on its nodes
+    s.node.input_index = np.asarray(mesh.geometry.input_global_indices, dtype=np.int64)[s.node.geometry_node]
+    s.node.cell_sum = assembly.NodalSum(s.comm, imap, s.dofs, assembly.input_keys(s.dofs, s.node.input_index))
+    s.cell.vol = np.zeros(n_cells)  # each cell's current volume
+    s.cell.vol4 = np.zeros((n_cells, 1))
+    s.passes.cells = s.passes.nodes = None  # the C passes (_stress_kernel)
+    s.cell.Fc = np.zeros((n_cells, 4, 3))  # each cell's internal forces on its nodes
 
 
 def _material_tables(s: ExplicitSolver, materials: list[M.Material], cell_material: np.ndarray) -> None:
     """Each cell's material (−1: eroded) and the materials' parameters, wave speeds and bulk moduli."""
     s.materials = materials
-    s.params = np.stack([m.params for m in materials])
+    s.cell.params = np.stack([m.params for m in materials])
     s.mat = np.ascontiguousarray(cell_material, dtype=np.int64)  # −1: an eroded cell
     assert len(s.mat) == s.n_cells
-    s.cell_dt = np.full(s.n_cells, np.inf)  # each cell's altitude / wave speed, every STEP_EVERY steps
+    s.cell.dt = np.full(s.n_cells, np.inf)  # each cell's altitude / wave speed, every STEP_EVERY steps
     #: this rank's removed mass (owned nodes), kinetic energy carried away, stored elastic energy of
     #: the removed cells (J); see fepen.solver.reference
-    s._removed = np.zeros(3)
-    s.speed = np.array([float(np.sqrt((m.bulk_modulus + 4.0 * m.shear_modulus / 3.0) / m.density))
+    s.sums.removed = np.zeros(3)
+    s.cell.speed = np.array([float(np.sqrt((m.bulk_modulus + 4.0 * m.shear_modulus / 3.0) / m.density))
                         for m in materials])
-    s.bulk = np.array([m.bulk_modulus for m in materials])
-    s.force_quantum, s.volume_quantum = _grids(s)
+    s.cell.bulk = np.array([m.bulk_modulus for m in materials])
+    s.internal.force_quantum, s.internal.volume_quantum = _grids(s)
 
 
 def _cell_state(s: ExplicitSolver) -> None:
     """Stress, plastic strain, temperature and static flow stress of each cell, at rest."""
     n_cells = s.n_cells
-    s._sT = np.zeros((6, n_cells))  # component-major for the C trial pass
-    s.s = s._sT.T  # (n_cells, 6) view: xx, yy, zz, xy, yz, xz
+    s.cell.sT = np.zeros((6, n_cells))  # component-major for the C trial pass
+    s.s = s.cell.sT.T  # (n_cells, 6) view: xx, yy, zz, xy, yz, xz
     s.eps_p = np.zeros(n_cells)
     s.temp = np.array([m.params[M.TROOM] for m in s.materials])[s.mat].astype(float)
-    s._totals = np.zeros(4)
-    s.sy0 = np.empty(n_cells)
-    kernels.static_flow_stress(s.mat, s.params, s.eps_p, s.temp, s.sy0)
+    s.sums.totals = np.zeros(4)
+    s.cell.sy0 = np.empty(n_cells)
+    kernels.static_flow_stress(s.mat, s.cell.params, s.eps_p, s.temp, s.cell.sy0)
 
 
 def _clock(s: ExplicitSolver) -> None:
     """Time, the first stable step, the work sums, no hooks yet."""
-    s.step_gain = 1.0  # stable step = safety * step_gain * min(h/c); see calibrate_step
+    s.clock.step_gain = 1.0  # stable step = safety * step_gain * min(h/c); see calibrate_step
     s.t = s.dt_prev = 0.0
     s.step_count = 0
-    s.dt = s.dt_stable = s.dt0 = s.dt_min = s.stable_step()
+    s.dt = s.clock.dt_stable = s.clock.dt0 = s.clock.dt_min = s.stable_step()
     # the next time a step must end on, from the time now (fepen.runs.outputs.Landing), or None: every step
     # the stable step; _land_at: the time the coming step ends on when it lands (else -1)
     s.landing = None
-    s._land_at = -1.0
+    s.clock.land_at = -1.0
     # the work sums: each node's internal and external work (_work, summed exactly when asked: work_sums),
     # this rank's plastic work, heat, and the interface's normal and tangential work
-    s._work = np.zeros((s.n_nodes, 2))
-    s._plastic = s._heat = s._w_if_n = s._w_if_t = 0.0
+    s.sums.work = np.zeros((s.n_nodes, 2))
+    s.sums.plastic = s.sums.heat = s.sums.interface_normal = s.sums.interface_tangential = 0.0
     s.interface = None
     # called with the current positions when a live cell inverts (collective): True if it eroded the
     # inverted cells (fepen.solver.erosion), False or None to stop the run
     s.on_inverted = None
-    s.ke0 = None
-    s.times = StepTimes()
+    s.sums.ke0 = None
+    s.clock.times = StepTimes()
 
 
 def _nodal_arrays(s: ExplicitSolver, V, imap, nm: int) -> None:
     """Nodal vectors (ghosted, block size 3) and nodal scalars per material; the reference nodal volumes."""
-    s.u = dx.function(V, "displacement")
-    s.v = dx.function(V, "velocity")
-    s.fint_fn = dx.function(V)
-    s.U, s.Vel = s.u.x.array.reshape(-1, 3), s.v.x.array.reshape(-1, 3)
-    s.a_fn = dx.function(V, "acceleration")
-    s.acc = s.a_fn.x.array.reshape(-1, 3)
-    s.fint = s.fint_fn.x.array.reshape(-1, 3)
-    s._du = np.zeros_like(s.fint)  # the displacement increment of the step (for the work of the forces)
-    s.fixed = None  # (n_nodes, 3) bool: velocity components held at zero (symmetry planes)
+    s.node.u = dx.function(V, "displacement")
+    s.node.v = dx.function(V, "velocity")
+    s.node.fint_fn = dx.function(V)
+    s.U, s.Vel = s.node.u.x.array.reshape(-1, 3), s.node.v.x.array.reshape(-1, 3)
+    s.node.a_fn = dx.function(V, "acceleration")
+    s.acc = s.node.a_fn.x.array.reshape(-1, 3)
+    s.node.fint = s.node.fint_fn.x.array.reshape(-1, 3)
+    s.node.du = np.zeros_like(s.node.fint)  # the displacement increment of the step (for the work of the forces)
+    s.node.fixed = None  # (n_nodes, 3) bool: velocity components held at zero (symmetry planes)
     s.fext = np.zeros((s.n_nodes, 3))
-    s._nvol = dx.new_vector(imap, bs=nm)
-    s._nvol0 = dx.new_vector(imap, bs=nm)
-    s.nodal_vol = s._nvol.array.reshape(-1, nm)
-    s.nodal_vol0 = s._nvol0.array.reshape(-1, nm)
-    s.nodal_p = np.zeros_like(s.nodal_vol0)
-    kernels.volumes_and_step(s.X, s.dofs, s.orient, s.vol0, s.mat, s.speed, s.cvol)
-    s._volumes_to_nodes(s.cvol, s._nvol0)
+    s.node.nvol = dx.new_vector(imap, bs=nm)
+    s.node.nvol0 = dx.new_vector(imap, bs=nm)
+    s.node.vol = s.node.nvol.array.reshape(-1, nm)
+    s.node.vol0 = s.node.nvol0.array.reshape(-1, nm)
+    s.nodal_p = np.zeros_like(s.node.vol0)
+    kernels.volumes_and_step(s.X, s.dofs, s.orient, s.vol0, s.mat, s.cell.speed, s.cell.vol)
+    s.volumes_to_nodes(s.cell.vol, s.node.nvol0)
 
 
 def _internal_force_form(s: ExplicitSolver, V, Q) -> None:
     """The internal-force form, with P packed once and rewritten in place each step."""
     n_cells = s.n_cells
-    s.P = dx.function(Q, "P")
-    s.form = dx.internal_force_form(s.P, V)
-    s._consts, s._coeffs = dx.pack(s.form)
-    key = next(iter(s._coeffs))
-    s.P_packed = s._coeffs[key]
-    assert s.P_packed.shape[1] == 9 and s.P_packed.shape[0] >= n_cells
+    s.internal.P = dx.function(Q, "P")
+    s.internal.form = dx.internal_force_form(s.internal.P, V)
+    s.internal.consts, s.internal.coeffs = dx.pack(s.internal.form)
+    key = next(iter(s.internal.coeffs))
+    s.internal.P_packed = s.internal.coeffs[key]
+    assert s.internal.P_packed.shape[1] == 9 and s.internal.P_packed.shape[0] >= n_cells
 
 
 def _stress_kernel(s: ExplicitSolver, kernel: str | None) -> None:
     """The step's kernels: the C passes (fepen.solver.ckernel: kinematics, fused stress and force, node
     update), or the numba kernels alone (the reference; also the plain element's)."""
     materials = s.materials
-    s._x = np.empty((s.n_nodes, 3))  # current positions X + U of the last force evaluation (the kernels')
-    s._flag = np.zeros(1)
-    s._cells = s._nodes = None
+    s.node.x = np.empty((s.n_nodes, 3))  # current positions X + U of the last force evaluation (the kernels')
+    s.passes.flag = np.zeros(1)
+    s.passes.cells = s.passes.nodes = None
     if kernel not in (None, "C", "numba"):
         raise ValueError(f"kernel must be 'C', 'numba' or None, not {kernel!r}")
-    if kernel == "C" and (not s.nodal or ckernel.library() is None):
+    if kernel == "C" and (not s.passes.nodal or ckernel.library() is None):
         raise RuntimeError(f"the C kernel is not available: {ckernel.why_not() or 'plain element'}")
-    if s.nodal and kernel != "numba" and ckernel.library() is not None:
-        s.G_m = np.array([m.shear_modulus for m in materials])
-        s._cells = ckernel.CellPasses(s._x, s.Vel, s.dofs, s.mat, s.orient, s.vol0, s.speed, s.params, s.G_m,
-                                      s.nodal_p, s._sT, s.eps_p, s.temp, s.sy0, s.cvol, s.cell_dt, s.Fc,
-                                      s._totals)
-        s._nodes = ckernel.NodePasses()
-    s.kernel = "C" if s._cells is not None else "numba"
+    if s.passes.nodal and kernel != "numba" and ckernel.library() is not None:
+        s.cell.G_m = np.array([m.shear_modulus for m in materials])
+        c = s.cell
+        s.passes.cells = ckernel.CellPasses(s.node.x, s.Vel, s.dofs, s.mat, s.orient, s.vol0, c.speed, c.params, c.G_m,
+                                            s.nodal_p, c.sT, s.eps_p, s.temp, c.sy0, c.vol, c.dt, c.Fc, s.sums.totals)
+        s.passes.nodes = ckernel.NodePasses()
+    s.kernel = "C" if s.passes.cells is not None else "numba"

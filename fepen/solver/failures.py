@@ -32,9 +32,9 @@ def step_collapsed(solver, h_c: float, new: float) -> None:
     down to ``new`` (collective)."""
     s = solver
     _, owner = s.comm.allreduce((h_c, s.comm.rank), op=MPI.MIN)
-    c = s.X[s.dofs[s._step_cell]].mean(axis=0) if s.comm.rank == owner else None
+    c = s.X[s.dofs[s.cell.step_cell]].mean(axis=0) if s.comm.rank == owner else None
     c = s.comm.bcast(c, root=owner)
     raise SimulationError(
-        f"stable step collapsed to {new:.3g} s (initial {s.dt0:.3g} s) at step {s.step_count}, "
+        f"stable step collapsed to {new:.3g} s (initial {s.clock.dt0:.3g} s) at step {s.step_count}, "
         f"t = {s.t * 1e6:.3f} us: an element is nearly flat, {c[1] * 1e3:.1f} mm behind the nose "
         f"tip (radius {np.hypot(c[0], c[2]) * 1e3:.1f} mm) in the undeformed projectile")

@@ -62,8 +62,8 @@ def nearest_node(solver, point) -> tuple[tuple[int, int], float]:
     n = solver.n_owned
     d = np.sqrt(np.sum((solver.X0[:n] - np.asarray(point, dtype=float)) ** 2, axis=1))
     if n:
-        k = int(np.lexsort((solver.input_index[:n], d))[0])
-        mine = (float(d[k]), int(solver.input_index[k]), solver.comm.rank, k)
+        k = int(np.lexsort((solver.node.input_index[:n], d))[0])
+        mine = (float(d[k]), int(solver.node.input_index[k]), solver.comm.rank, k)
     else:
         mine = (np.inf, -1, solver.comm.rank, -1)
     dist, _, owner, local = min(solver.comm.allgather(mine))
@@ -91,7 +91,7 @@ def containing_cell(solver, point) -> tuple[int, int]:
     """
     p = np.asarray(point, dtype=float)
     dofs = solver.dofs[: solver.n_cells]
-    order = np.argsort(solver.input_index[dofs], axis=1, kind="stable")
+    order = np.argsort(solver.node.input_index[dofs], axis=1, kind="stable")
     canonical = np.take_along_axis(dofs, order, axis=1)
     X = solver.X0[canonical]
     near = np.flatnonzero(np.all(X.min(axis=1) <= p + 1e-12, axis=1) & np.all(X.max(axis=1) >= p - 1e-12, axis=1)
@@ -101,9 +101,9 @@ def containing_cell(solver, point) -> tuple[int, int]:
         lam = _barycentric(X[near], p)
         inside = near[np.all(lam >= -INSIDE_TOLERANCE, axis=1)]
         if len(inside):
-            keys = solver.input_index[canonical[inside]]
+            keys = solver.node.input_index[canonical[inside]]
             k = int(inside[np.lexsort(keys.T[::-1])[0]])
-            best = (tuple(int(v) for v in solver.input_index[canonical[k]]), solver.comm.rank, k)
+            best = (tuple(int(v) for v in solver.node.input_index[canonical[k]]), solver.comm.rank, k)
     found = [b for b in solver.comm.allgather(best) if b is not None]
     if not found:
         return (-1, -1)
@@ -129,7 +129,7 @@ def cell_values(solver, handles, axis: np.ndarray) -> np.ndarray:
         vm = np.sqrt(1.5 * (sd[0] ** 2 + sd[1] ** 2 + sd[2] ** 2 + 2 * (sd[3] ** 2 + sd[4] ** 2 + sd[5] ** 2)))
         pm = mean_stress(solver, c)
         axial = (sd[0] * ax * ax + sd[1] * ay * ay + sd[2] * az * az
-                 + 2 * (sd[3] * ax * ay + sd[4] * ay * az + sd[5] * ax * az)) + (pm if solver.nodal else 0.0)
+                 + 2 * (sd[3] * ax * ay + sd[4] * ay * az + sd[5] * ax * az)) + (pm if solver.passes.nodal else 0.0)
         buf[k] = (vm, axial, -pm, solver.eps_p[c], solver.temp[c])
     if solver.comm.size > 1:
         solver.comm.Allreduce(MPI.IN_PLACE, buf, op=MPI.MAX)
@@ -139,7 +139,7 @@ def cell_values(solver, handles, axis: np.ndarray) -> np.ndarray:
 def mean_stress(solver, c: int) -> float:
     """A cell's mean (Cauchy) stress (Pa, positive in tension): the average of its nodes' pressures with the
     averaged-nodal-pressure element, else the trace of its stress over 3."""
-    if solver.nodal:
+    if solver.passes.nodal:
         m = max(int(solver.mat[c]), 0)
         d = solver.dofs[c]
         return 0.25 * (solver.nodal_p[d[0], m] + solver.nodal_p[d[1], m] + solver.nodal_p[d[2], m]

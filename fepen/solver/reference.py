@@ -24,12 +24,12 @@ def remove_cells(solver, cells: np.ndarray) -> None:
         J = np.empty(s.n_cells)
         kernels.cell_jacobians(s.positions(), s.dofs, s.orient, s.vol0, s.mat, J)
         G = np.array([m.shear_modulus for m in s.materials])[s.mat[cells]]
-        s._removed[2] += kernels.deviatoric_energy(s.s[cells], J[cells], s.vol0[cells], G)
+        s.sums.removed[2] += kernels.deviatoric_energy(s.s[cells], J[cells], s.vol0[cells], G)
         s.mat[cells] = -1
         s.s[cells] = 0.0
-        s.P_packed[cells] = 0.0
-        s.sy0[cells] = np.inf
-        s.cell_dt[cells] = np.inf
+        s.internal.P_packed[cells] = 0.0
+        s.cell.sy0[cells] = np.inf
+        s.cell.dt[cells] = np.inf
     rebuild(s, np.zeros(0, dtype=np.int64))
 
 
@@ -49,24 +49,24 @@ def rebuild(solver, cells: np.ndarray) -> None:
     s = solver
     if len(cells):
         g, v, o = kernels.reference_gradients(s.X, s.dofs[cells])
-        s.grad0[cells], s.vol0[cells], s.orient[cells] = g, v, o
-        if s.geometry_x is not None:
-            s.geometry_x[s._geometry_node, :3] = s.X
+        s.cell.grad0[cells], s.vol0[cells], s.orient[cells] = g, v, o
+        if s.node.geometry_x is not None:
+            s.node.geometry_x[s.node.geometry_node, :3] = s.X
     old = s.mass.copy()
     v = s.velocity_at_step()
-    kernels.volumes_and_step(s.X, s.dofs, s.orient, s.vol0, s.mat, s.speed, s.cvol, False)
-    s._volumes_to_nodes(s.cvol, s._nvol0)
+    kernels.volumes_and_step(s.X, s.dofs, s.orient, s.vol0, s.mat, s.cell.speed, s.cell.vol, False)
+    s.volumes_to_nodes(s.cell.vol, s.node.nvol0)
     nm = len(s.materials)
-    s._lumped_mass(s.V.dofmap.index_map, nm, orphans_allowed=True)
+    s.lumped_mass(s.V.dofmap.index_map, nm, orphans_allowed=True)
     n = s.n_owned
     dm = old[:n] - s.mass[:n]
-    s._removed[0] += float(dm.sum())
-    s._removed[1] += 0.5 * float(np.sum(dm[:, None] * v[:n] ** 2))
-    if np.any(s.orphans):
+    s.sums.removed[0] += float(dm.sum())
+    s.sums.removed[1] += 0.5 * float(np.sum(dm[:, None] * v[:n] ** 2))
+    if np.any(s.node.orphans):
         for a in (s.Vel, s.acc):
-            a[s.orphans] = 0.0
+            a[s.node.orphans] = 0.0
 
 
 def removed_mass(solver) -> float:
     """Mass removed so far (kg), all ranks."""
-    return solver.comm.allreduce(float(solver._removed[0]), op=MPI.SUM)
+    return solver.comm.allreduce(float(solver.sums.removed[0]), op=MPI.SUM)

@@ -24,7 +24,7 @@ class RigidWall:
 
     def __init__(self, solver, kappa: float = 0.5):
         n = solver.n_owned
-        self.k = kappa * solver.mass[:n] / solver.dt0**2
+        self.k = kappa * solver.mass[:n] / solver.clock.dt0**2
         self.force = np.zeros(3)  # total force of the wall on the body (N), all ranks
         self.contact_nodes = 0
         self.area = 0.0  # a wall of nodes: no loaded area

@@ -37,7 +37,7 @@ class ShellChargeContact:
         self.nodal_n = self._nvec.array.reshape(-1, 3)
         self._facet_n = np.zeros((len(self.tri), 3))
         self._wall_sum = assembly.NodalSum(s.comm, s.V.dofmap.index_map, self.tri,
-                                           assembly.input_keys(self.tri, s.input_index))
+                                           assembly.input_keys(self.tri, s.node.input_index))
         # wall nodes: those of the owned wall facets, marked and ghost-summed
         mark = dx.new_vector(s.V.dofmap.index_map, bs=1)
         mark.array[np.unique(self.tri)] = 1.0
@@ -48,7 +48,7 @@ class ShellChargeContact:
         # coordinates are interpolated)
         from scipy.spatial import cKDTree
 
-        shell_nodes = np.flatnonzero(s.mass_by_material[:, 0] > 0.0)
+        shell_nodes = np.flatnonzero(s.node.mass_by_material[:, 0] > 0.0)
         tol = 1e-9 * max(float(np.ptp(s.X, axis=0).max()), 1e-300)
         dist, near = cKDTree(s.X[shell_nodes]).query(s.X[charge_wall], distance_upper_bound=tol)
         found = np.isfinite(dist)
@@ -96,11 +96,12 @@ class ShellChargeContact:
         self._work[:] = 0.0
         pair_work(s.Vel, s.acc, s.mass, self.pa, self.pb, self.normal, self.force, self.fn, s.dt_prev, dt,
                   dt_avg, self.count, self._work)
-        s.add_interface_work(self._work[0], self._work[1])
+        s.sums.interface_normal += self._work[0]
+        s.sums.interface_tangential += self._work[1]
         ia, ib = self._a_own, self._b_own
         s.acc[self.pa[ia]] += self.force[ia] * self._inv_ma
         s.acc[self.pb[ib]] -= self.force[ib] * self._inv_mb
-        s.a_fn.x.scatter_forward()
+        s.node.a_fn.x.scatter_forward()
 
     def resultant(self) -> np.ndarray:
         """The resultant of the last step's contact forces on the charge (N, world), all ranks: what the shell

@@ -46,7 +46,7 @@ class TargetLoad:
         if self._sum is None or self._sum_version != self.surf.version:
             tri = self.surf.tri
             self._sum = assembly.NodalSum(solver.comm, solver.V.dofmap.index_map, tri,
-                                          assembly.input_keys(tri, solver.input_index))
+                                          assembly.input_keys(tri, solver.node.input_index))
             self._sum_version = self.surf.version
         return self._sum
 
@@ -82,7 +82,7 @@ class TargetLoad:
         n_own = solver.n_owned
         solver.fext[:n_own] += self._nodes[:n_own]
         self.force, self.contact_nodes, self.area = load.total, load.loaded, load.area
-        solver.times.target_comm += comm_s
+        solver.clock.times.target_comm += comm_s
 
     def state(self) -> dict[str, np.ndarray]:
         """The load's last totals (for checkpoints; the same on every rank)."""

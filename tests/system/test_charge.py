@@ -38,7 +38,7 @@ def test_tied_charge_accelerations_balance_the_target_force(tied_150us):
     target (momentum balance, to round-off) at every recorded time; both bodies decelerate, and the charge,
     softer and lighter, oscillates about the shell's deceleration."""
     summary, rows, sim = tied_150us
-    m_shell, m_charge = sim.solver.body_mass
+    m_shell, m_charge = sim.solver.node.body_mass
     assert m_shell + m_charge == pytest.approx(0.367, abs=1e-3)  # the paper's 367 g, charge included
     assert 0.01 < m_charge < 0.05
     cols = sim.columns
@@ -88,7 +88,7 @@ def test_the_bodies_make_up_the_projectile(every_step):
     whole projectile's columns (kinetic_J, elastic_J + plastic_J, mass x (vx_m_s, vy_m_s)) to round-off at
     every step; at impact (one velocity) each body's share is its mass's."""
     summary, rows, sim = every_step
-    m_shell, m_charge = sim.solver.body_mass
+    m_shell, m_charge = sim.solver.node.body_mass
     mass = sim.solver.total_mass
     c = lambda name: _col(rows, sim, name)  # noqa: E731
     ke = c("kinetic_J")

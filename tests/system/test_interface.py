@@ -67,13 +67,13 @@ def test_energy_balance_holds_with_friction_and_the_wall_stays_closed():
     cols = sim.columns
     col = {k: rows[:, cols.index(k)] for k in cols}
     assert summary["energy_error"] < 1e-3
-    ke0 = sim.solver.ke0
+    ke0 = sim.solver.sums.ke0
     assert col["friction_J"][-1] > 10 * summary["energy_error"] * ke0
     assert np.all(np.diff(col["friction_J"]) >= -1e-12 * ke0)  # dissipation only grows
     h = 0.004
     assert col["interface_penetration_max_mm"].max() < 0.01 * h * 1e3
     assert col["interface_slip_max_mm"][-1] > 0.01 and col["interface_gap_max_mm"][-1] > 0.01
-    m_shell, m_charge = sim.solver.body_mass
+    m_shell, m_charge = sim.solver.node.body_mass
     mixed = (m_shell * col["shell_acc_g"] + m_charge * col["charge_acc_g"]) / (m_shell + m_charge)
     assert np.max(np.abs(mixed + col["decel_g"])) < 1e-6 * np.abs(col["decel_g"]).max()
     header = (sim.out / "history.csv").read_text().splitlines()[0].split(",")

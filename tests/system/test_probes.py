@@ -49,7 +49,7 @@ def test_output_times_are_multiples_of_the_interval(shot):
     assert np.all(np.abs(t[:-1] - k * interval) <= 1e-12 * np.maximum(t[:-1], interval))
     assert np.array_equal(k, np.arange(len(t) - 1))  # none skipped, none twice
     assert t[-1] == 3.05e-5
-    assert run.solver.dt_min < interval / 2  # several steps per row: the landing shortened some
+    assert run.solver.clock.dt_min < interval / 2  # several steps per row: the landing shortened some
 
 
 def test_probe_rows_are_the_history_rows(shot):

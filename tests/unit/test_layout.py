@@ -52,6 +52,12 @@ def test_no_class_over_300_lines():
     assert not big, "\n".join(f"{path}:{line} {name} ({n} lines)" for path, line, name, n in big)
 
 
+def test_no_class_over_40_attributes():
+    """Solver state and the like live in small named records (fepen.solver.state), not in one bag."""
+    many = layout.many_attributes(40)
+    assert not many, "\n".join(f"{path}:{line} {name} ({n} attributes)" for path, line, name, n in many)
+
+
 def test_no_import_up_a_floor():
     """laws < geometry < solver < io < post, scene < runs < studies < api < cli (function-level imports too)."""
     assert layout.upward_imports(GRAPH) == []

@@ -79,7 +79,7 @@ def test_bodies_add_up_to_the_whole_rod(heated):
     G = np.array([m.shear_modulus for m in s.materials])[s.mat]
     J = np.empty(s.n_cells)
     kernels.cell_jacobians(s.positions(), s.dofs, s.orient, s.vol0, s.mat, J)
-    whole = (kernels.volumetric_energy(s.nodal_vol, s.nodal_vol0, s.bulk, n)
+    whole = (kernels.volumetric_energy(s.node.vol, s.node.vol0, s.cell.bulk, n)
              + kernels.deviatoric_energy(s.s, J, s.vol0, G))
     assert e.elastic == pytest.approx(whole, rel=1e-12)
     assert e.plastic > 0.3 * e.initial_kinetic and min(e.plastic_by_body) > 0.01 * e.plastic  # both halves yield
@@ -121,6 +121,6 @@ def test_the_tie_force_is_the_rate_of_the_rear_body_momentum(heated):
     impulse = np.concatenate([np.zeros((1, 2)), np.cumsum(0.5 * np.diff(t)[:, None] * (f[1:] + f[:-1]), axis=0)])
     change = p - p[0]
     assert np.max(np.abs(impulse - change)) < 1e-9 * np.abs(change).max()
-    m_rear = s.body_mass[1]
+    m_rear = s.node.body_mass[1]
     assert change[-1, 1] > 0.1 * m_rear * V0 and np.mean(f[:, 1]) > 0.0
     assert math.isclose(float(p[0, 1]), -m_rear * V0, rel_tol=1e-12)

@@ -151,7 +151,7 @@ def test_isochoric_plastic_flow_locking(nodal, passes):
                          thermal=False)  # elastic-perfectly plastic
     s = explicit.ExplicitSolver(msh, [mat], np.zeros(msh.topology.index_map(3).size_local, dtype=np.int64),
                                 0.8, nodal)
-    s.fixed = np.abs(s.X) < 1e-9  # symmetry planes
+    s.node.fixed = np.abs(s.X) < 1e-9  # symmetry planes
     A0 = math.sqrt(T0 / (2 * math.pi * rho * (1 / a0 - 1 / b0)))
     s.set_initial(velocity=lambda X: A0 * X / np.linalg.norm(X, axis=1)[:, None] ** 3)
     inner = np.abs(np.linalg.norm(s.X, axis=1) - a0) < 1e-9
@@ -221,7 +221,7 @@ def free_vibration_grows(sc_mesh, dt_over_critical, steps=600):
     cells = np.zeros(sc_mesh.mesh.topology.index_map(3).size_local, dtype=np.int64)
     s = explicit.ExplicitSolver(sc_mesh.mesh, [mat], cells, 1.0)
     s.calibrate_step()
-    s.safety = dt_over_critical
+    s.clock.safety = dt_over_critical
     rng = np.random.default_rng(3)
     s.set_initial(velocity=lambda X: rng.standard_normal(X.shape))
     e0 = s.kinetic_energy(s.Vel)
@@ -254,13 +254,13 @@ def test_internal_force_is_the_compiled_forms_vector():
     pm = setup.mesh(scene.load(None, ["mesh.size=0.006"]), MPI.COMM_SELF)
     cells = np.zeros(pm.mesh.topology.index_map(3).size_local, dtype=np.int64)
     s = explicit.ExplicitSolver(pm.mesh, [M.elastic(210e9, 0.3, 7850.0)], cells, 0.8)
-    s.P_packed[: s.n_cells] = np.random.default_rng(5).standard_normal((s.n_cells, 9)) * 1e8
-    ref = np.zeros_like(s.fint_fn.x.array)
+    s.internal.P_packed[: s.n_cells] = np.random.default_rng(5).standard_normal((s.n_cells, 9)) * 1e8
+    ref = np.zeros_like(s.node.fint_fn.x.array)
     diagnostics.assemble_form(s, ref)
     s.assemble_internal_force()
     scale = np.abs(ref).max()
     # each cell's term is rounded to the force grid (exact sums on any partition): half a quantum per term
     terms = np.bincount(s.dofs.ravel(), minlength=s.n_nodes)[:, None]
-    err = np.abs(s.fint_fn.x.array.reshape(-1, 3) - ref.reshape(-1, 3))
-    assert np.all(err <= 0.5 * s.force_quantum * terms + 1e-12 * scale)
-    assert s.force_quantum < 1e-12 * scale
+    err = np.abs(s.node.fint_fn.x.array.reshape(-1, 3) - ref.reshape(-1, 3))
+    assert np.all(err <= 0.5 * s.internal.force_quantum * terms + 1e-12 * scale)
+    assert s.internal.force_quantum < 1e-12 * scale

@@ -274,7 +274,7 @@ def test_fused_pass_matches_the_numba_kernels_on_mixed_cells(seed):
     kin = cells.kinematics(True)
     nodes = ckernel.NodePasses()
     nv_c, np_c = np.zeros_like(nv), np.zeros_like(npres)
-    nodes.scatter_volumes(cells._dofs, mat, cvol, FINE, nv_c)
+    nodes.scatter_volumes(cells.dofs32, mat, cvol, FINE, nv_c)
     nodes.nodal_pressure(nv_c, nv0, bulk, np_c)
     assert np.allclose(nv_c, nv, rtol=1e-13, atol=0) and np.allclose(np_c, npres, rtol=1e-11, atol=1e-3)
     assert kin[1] == kin_ref[1] and kin[3] == kin_ref[3]
@@ -290,7 +290,7 @@ def test_fused_pass_matches_the_numba_kernels_on_mixed_cells(seed):
     assert np.allclose(tot, tot_ref, rtol=1e-11, atol=0)
     assert np.all(Fc[~live] == 0.0) and np.all(sT[:, ~live] == 0.0)
     f = np.zeros_like(X)
-    nodes.scatter_forces(cells._dofs, Fc, FINE, f)
+    nodes.scatter_forces(cells.dofs32, Fc, FINE, f)
     assert np.max(np.abs(f - f_ref)) <= 1e-11 * np.max(np.abs(f_ref))
     assert np.allclose(Fc.sum(axis=1), 0.0, atol=1e-12 * np.abs(Fc).max())  # each cell's forces balance
 
