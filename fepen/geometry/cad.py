@@ -8,8 +8,10 @@ solid of revolution) would be.
 from __future__ import annotations
 
 import hashlib
-from dataclasses import dataclass
+import math
+from dataclasses import dataclass, replace
 from pathlib import Path
+from typing import ClassVar
 
 import numpy as np
 
@@ -38,6 +40,13 @@ class CadBody:
     tip_point: tuple = ()
     tail_point: tuple = ()
 
+    #: not an exact solid: no meridian, surface or volume but its mesh's (Shape.exact is True)
+    exact: ClassVar[bool] = False
+    #: a CAD body is meshed solid: fepen sizes no cavity in it
+    has_cavity: ClassVar[bool] = False
+    #: the nose's length is not known (taken as 0: the whole body is calibre)
+    nose_length: ClassVar[float] = 0.0
+
     def __post_init__(self):
         for name in ("tip_point", "tail_point"):  # lists from JSON back to tuples
             object.__setattr__(self, name, tuple(float(v) for v in getattr(self, name)))
@@ -56,6 +65,23 @@ class CadBody:
     def tail(self) -> tuple:
         """The tracked tail-centre point (a mesh node; (0, length, 0) before meshing)."""
         return self.tail_point or (0.0, self.length, 0.0)
+
+    def outer_radius(self, z):
+        """The enclosing cylinder's radius at axial distances z from the tip (m): the calibre's half."""
+        return np.full(np.shape(z), self.radius) if np.ndim(z) else self.radius
+
+    def meshed_volume(self, charge: bool) -> float:
+        """The volume gmsh fills, as known before meshing (m^3): the enclosing cylinder's."""
+        return math.pi / 4.0 * self.diameter ** 2 * self.length
+
+    def crater_nose_factor(self) -> float:
+        """N* the linear crater takes: 0, as fepen always took it (a CAD body has no meridian)."""
+        return 0.0
+
+    def after_meshing(self) -> CadBody:
+        """The body with its tracked ends set to the mesh nodes gmsh just made (end_nodes)."""
+        tip, tail = end_nodes()
+        return replace(self, tip_point=tip, tail_point=tail)
 
 
 def digest(path: str) -> str:

@@ -139,7 +139,7 @@ def build(shape: Shape | cad.CadBody, opts: MeshOptions, charge: bool, seed: int
     import gmsh
 
     _stage("building")
-    if isinstance(shape, cad.CadBody):
+    if not shape.exact:  # a CadBody: imported, not revolved
         cad.build(shape.file, shape.scale)
         _size_and_mesh(opts, 0.0, seed)
         return

@@ -169,7 +169,7 @@ def _record(body: Shape | CadBody) -> dict:
         A Shape's fields and _CAD_FIELDS; for a CadBody, nose "cad", its calibre, length and CAD fields and
         every other Shape field at its default.
     """
-    if isinstance(body, CadBody):
+    if not body.exact:  # a CadBody
         rec = {f.name: f.default for f in fields(Shape)}
         rec.update(diameter=body.diameter, length=body.length, nose="cad", cad_file=body.file,
                    cad_scale=body.scale, cad_digest=body.digest, tip_point=body.tip_point,
@@ -253,11 +253,11 @@ def _verify_model(shape: Shape | CadBody, charge: bool, mass, rho_s, rho_c) -> N
         raise _BadEntry(f"it lacks the tags {sorted(t for _, t in need - groups)}")
     if charge != ((3, tags.CHARGE) in groups):
         raise _BadEntry("its charge does not match the shot's")
-    if mass is not None and not isinstance(shape, CadBody) and shape.has_cavity:
+    if mass is not None and shape.has_cavity:
         got = _gmsh_mass(rho_s, rho_c)
         if abs(got - mass) > max(MASS_TOLERANCE, 0.01 * mass):  # the sizing may stop short of its tolerance
             raise _BadEntry(f"its mass is {got:.6g} kg, the shot's {mass:.6g} kg")
-    if isinstance(shape, CadBody):
+    if not shape.exact:
         return
     volume = gmsh_model.tet_volumes(tags.SHELL).sum() + (gmsh_model.tet_volumes(tags.CHARGE).sum() if charge else 0.0)
     exact = shape.outer_volume() if charge else shape.shell_volume()
@@ -380,7 +380,7 @@ def _build_on_root(shape, opts, charge: bool, mass, rho_s, rho_c, use_cache: boo
     for _ in range(5):
         gmsh.clear()
         gmsh_model.build_best(current, opts, charge)
-        if mass is None or isinstance(current, CadBody) or not current.has_cavity:
+        if mass is None or not current.has_cavity:
             break
         error = _gmsh_mass(rho_s, rho_c) - mass
         if abs(error) <= MASS_TOLERANCE:
@@ -389,11 +389,7 @@ def _build_on_root(shape, opts, charge: bool, mass, rho_s, rho_c, use_cache: boo
         step = error / ((rho_s - (rho_c or 0.0)) * math.pi * r * r)
         current = replace(current, cavity_length=current.cavity_length + step)
         check(current)
-    if isinstance(current, CadBody):  # the tracked ends: mesh nodes
-        from fepen.geometry import cad
-
-        tip, tail = cad.end_nodes()
-        current = replace(current, tip_point=tip, tail_point=tail)
+    current = current.after_meshing()  # a CAD body's tracked ends: mesh nodes
     seconds = time.perf_counter() - t0
     if use_cache:
         try:
@@ -643,7 +639,7 @@ def metrics(pm: ProjectileMesh, density: dict, speed: dict, safety: float, nomin
 
     shell_v = total(vol[tag == tags.SHELL])
     charge_v = total(vol[tag == tags.CHARGE])
-    cad = isinstance(pm.shape, CadBody)  # no exact volume, no cavity sized
+    cad = not pm.shape.exact  # no exact volume, no cavity sized
     exact_total = None if cad else pm.shape.outer_volume() if pm.charge else pm.shape.shell_volume()
     volume = shell_v + charge_v
     h = nominal_size

@@ -88,7 +88,7 @@ def nose_zone(shape, X: np.ndarray, radius: np.ndarray) -> tuple[float, float]:
     Returns:
         (y_c, r_c) (m).
     """
-    if not isinstance(shape, Shape):
+    if not shape.exact:
         y_c = float(X[radius >= (1.0 - 1e-3) * radius.max(), 1].min())
         return y_c, float(radius.max())
     y_c = shape.nose_length

@@ -14,6 +14,7 @@ from __future__ import annotations
 import functools
 import math
 from dataclasses import dataclass
+from typing import ClassVar
 
 import numpy as np
 
@@ -196,6 +197,21 @@ class Shape:
             r_prev, z_prev = r, z1
         segs.append(P.Segment.line((r_prev, z_prev), (0.0, z_prev)))
         return segs
+
+    #: an exact solid of revolution: its meridian, surface and volumes are known (CadBody.exact is False)
+    exact: ClassVar[bool] = True
+
+    def meshed_volume(self, charge: bool) -> float:
+        """The volume gmsh fills (m^3): the outside with a meshed charge, the shell without."""
+        return self.outer_volume() if charge else self.shell_volume()
+
+    def crater_nose_factor(self) -> float | None:
+        """N* the linear crater takes: None (Forrestal's ogive formula) for a sharp ogive, else nose_factor."""
+        return None if self.nose == "ogive" and not self.meplat_diameter else self.nose_factor()
+
+    def after_meshing(self) -> Shape:
+        """The body after gmsh meshed it: unchanged (its ends are exact points)."""
+        return self
 
     @property
     def has_cavity(self) -> bool:

@@ -18,7 +18,6 @@ import numpy as np
 from mpi4py import MPI
 
 from fepen.geometry import tags
-from fepen.geometry.cad import CadBody
 from fepen.geometry.frames import unit_axis
 from fepen.solver import diagnostics, probes
 
@@ -312,10 +311,9 @@ def nose_profile(solver, shape, tip_node, tail_node, tri: np.ndarray, out: Path)
     if comm.rank == 0:
         behind = np.concatenate([p[0] for p in parts])
         radius = np.concatenate([p[1] for p in parts])
-        cad = isinstance(shape, CadBody)
-        reach = (0.0 if cad else shape.nose_length) + shape.diameter
+        reach = shape.nose_length + shape.diameter
         z0 = np.arange(0.0, reach + 1e-12, 0.25e-3)
-        r0 = np.full(z0.shape, shape.radius) if cad else shape.outer_radius(z0)
+        r0 = shape.outer_radius(z0)
         sel = behind <= reach
         k = np.floor(np.maximum(behind[sel], 0.0) / PROFILE_BIN).astype(int)
         r_after = np.zeros(k.max(initial=-1) + 1)

@@ -16,7 +16,6 @@ import os
 import numpy as np
 
 from fepen.errors import InputError
-from fepen.geometry.cad import CadBody
 
 #: tetrahedra per (meshed volume / size³): the measured 5.0 with a tenth more
 CELLS_PER_SIZE3 = 5.5
@@ -34,9 +33,7 @@ COARSEST = 0.5
 def meshed_volume(shape, charge: bool) -> float:
     """The volume gmsh fills (m^3): the body's outside with a meshed charge, its shell without; a CAD body's
     enclosing cylinder (its exact volume is known only once meshed)."""
-    if isinstance(shape, CadBody):
-        return math.pi / 4.0 * shape.diameter ** 2 * shape.length
-    return shape.outer_volume() if charge else shape.shell_volume()
+    return shape.meshed_volume(charge)
 
 
 def expected_cells(shape, size: float, nose_size: float | None, charge: bool) -> float:
@@ -45,7 +42,7 @@ def expected_cells(shape, size: float, nose_size: float | None, charge: bool) ->
     length back, over a cross-section growing as the square of the distance from the tip), times NOSE_MARGIN."""
     volume = meshed_volume(shape, charge)
     cells = CELLS_PER_SIZE3 * volume / size ** 3
-    if nose_size is not None and nose_size < size and not isinstance(shape, CadBody):
+    if nose_size is not None and nose_size < size:
         length = shape.nose_length
         if length > 0.0:
             r = np.linspace(0.0, length, 401)

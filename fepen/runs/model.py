@@ -11,7 +11,6 @@ from mpi4py import MPI
 
 from fepen.geometry import mesh as fmesh
 from fepen.geometry import revolution, tags
-from fepen.geometry.shape import Shape
 from fepen.laws import target as tg
 from fepen.runs import outputs, setup, shot
 from fepen.solver import erosion, explicit, probes, recession, rigid_wall, shell_charge, surface, target_load
@@ -110,7 +109,7 @@ def build(sh, comm: MPI.Comm = MPI.COMM_WORLD) -> Model:
 def _nose_zone(s, surf, shape) -> float:
     """The nose zone's end y_c (m) of the meshed body (fepen.geometry.revolution.nose_zone); a CAD body's
     from its surface nodes on every rank (collective)."""
-    if isinstance(shape, Shape):
+    if shape.exact:
         return revolution.nose_zone(shape, np.zeros((0, 3)), np.zeros(0))[0]
     xb = s.X[np.unique(surf.tri.ravel())]
     r = np.hypot(xb[:, 0], xb[:, 2])

@@ -15,7 +15,6 @@ from __future__ import annotations
 import numpy as np
 
 from fepen.errors import InputError
-from fepen.geometry.cad import CadBody
 from fepen.geometry.frames import unit_axis
 from fepen.io import probes as probes_io
 
@@ -32,7 +31,7 @@ def _outside_why(shape, point, charged: bool) -> str | None:
     tol = OUTLINE_TOLERANCE
     if not -tol <= y <= shape.length + tol:
         return f"y = {y:g} m is outside the body's length [0, {shape.length:g}] m (nose tip at the origin, axis +y)"
-    if isinstance(shape, CadBody):
+    if not shape.exact:  # a CadBody: its enclosing cylinder
         return None if r <= shape.radius + tol else f"its radius {r:g} m is past the body's {shape.radius:g} m"
     outer = float(shape.outer_radius(y))
     if r > outer + tol:

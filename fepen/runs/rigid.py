@@ -16,7 +16,6 @@ from mpi4py import MPI
 from fepen.errors import Interrupted, SimulationError
 from fepen.geometry import mesh as fmesh
 from fepen.geometry import revolution, tags
-from fepen.geometry.cad import CadBody
 from fepen.io import results
 from fepen.laws import energy, wear
 from fepen.laws import target as tg
@@ -127,9 +126,9 @@ class RigidRun(Run):
             self.history.clock.interval = 0.0  # never due: finish_loop records the final row
         self.check_finite = not history
         self.cells = 0  # no volume mesh unless asked for
-        if points is None and mass_properties is None and not isinstance(sh.built.shape, CadBody):
+        if points is None and mass_properties is None and sh.built.shape.exact:
             points, mass_properties = default_body(sh)
-        if points == "mesh" or (points is None and isinstance(sh.built.shape, CadBody)):  # a CAD body: only its mesh
+        if points == "mesh" or (points is None and not sh.built.shape.exact):  # a CAD body: only its mesh
             points, mass_properties, self.cells = mesh_points(sh, comm)
         if points is None:
             points = ring_points(sh.built.shape, sh.mesh.rigid_panel)

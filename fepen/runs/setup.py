@@ -249,7 +249,7 @@ def _check_base(scene, shape: Shape) -> None:
 def thin_target_note(scene, built: Built) -> str | None:
     """A line when the target, or one of its layers, is thinner than the nose is long: the nose is through
     before its shoulder enters, and the cavity-expansion law is a law of thick targets (docs/theory.md §16)."""
-    nose = 0.0 if isinstance(built.shape, CadBody) else built.shape.nose_length  # a CAD body's is unknown
+    nose = built.shape.nose_length  # a CAD body's is unknown: 0
     layers = scene.get("target.layers")
     if scene.target.kind != "concrete" or not nose:
         return None
@@ -319,7 +319,7 @@ def check_supported(scene, built: Built | None = None) -> Built:
         from fepen import dolfinx_api
 
         dolfinx_api.check_version()  # a mesh is made: only on the dolfinx releases fepen supports
-    if scene.effects.fidelity != "rigid" or isinstance(built.shape, CadBody):  # a volume mesh is made
+    if scene.effects.fidelity != "rigid" or not built.shape.exact:  # a volume mesh is made
         check_mesh_cost(scene, MPI.COMM_WORLD, built)
     if scene.effects.fidelity == "rigid" and scene.target.kind != "concrete":
         raise InputError("effects.fidelity", "'rigid' runs against target.kind = 'concrete'; a rigid "
@@ -426,7 +426,7 @@ def envelope_facts(scene, built: Built | None = None) -> dict:
     target = ("layered" if scene.get("target.layers") else "a rigid wall" if t.kind != "concrete" else t.material)
     mass = scene.get("projectile.mass")  # absent for a fixed cavity or a CAD body: from the body
     fc = scene.derived["target.fc_cylinder"]  # a layered target's are its layers' (its verdict: not validated)
-    if mass is None and built is not None and isinstance(built.shape, Shape):  # a CAD body's: from its mesh
+    if mass is None and built is not None and built.shape.exact:  # a CAD body's: from its mesh
         fill = scene.charge.material.density if scene.effects.charge else None
         mass = built.shape.mass(built.shell_density, fill)
     values = {"D_m": D, "L_over_D": L / D, "crh": scene.get("projectile.crh"), "mass_kg": mass, "V_m_s": i.velocity,

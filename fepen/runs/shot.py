@@ -12,7 +12,6 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
-from fepen.geometry.cad import CadBody
 from fepen.geometry.mass_rule import Built
 from fepen.laws import target as tg
 from fepen.laws import wear
@@ -137,11 +136,7 @@ class Shot:
         if self.law is None or self.law.crater != "linear":
             return None
         shape = self.built.shape
-        if isinstance(shape, CadBody):  # N* = 0, as fepen always took it: the N* of a CAD body's (empty) meridian
-            factor = 0.0
-        else:
-            factor = None if shape.nose == "ogive" and not shape.meplat_diameter else shape.nose_factor()
-        return tg.ForrestalCrater(self.law, mass, self.speed, self.crh, factor)
+        return tg.ForrestalCrater(self.law, mass, self.speed, self.crh, shape.crater_nose_factor())
 
 
 

@@ -13,7 +13,6 @@ from mpi4py import MPI
 
 from fepen import dolfinx_api as dx
 from fepen.geometry import projection, tags
-from fepen.geometry.cad import CadBody
 
 SUBDIVISION = 4  # facet patch areas: 4 x 4 sub-triangles projected on the exact surface
 
@@ -318,7 +317,7 @@ def outer_surface(V, facet_tags, shape, tag: int = tags.OUTER) -> Surface:
     """
     X = node_positions(V)
     tri, cells = oriented_facets(V, facet_tags, tag, with_cells=True)
-    if isinstance(shape, CadBody):  # no exact surface: the facets' areas, their normals smoothed across smooth edges
+    if not shape.exact:  # a CadBody: no exact surface: the facets' areas, their normals smoothed across smooth edges
         empty = np.zeros(0, dtype=np.int64)
         surf = Surface(np.zeros((0, 3), dtype=np.int64), np.zeros((0, 3)), np.zeros(0), np.zeros(0),
                        np.zeros((0, 3)), np.zeros((0, 3)), np.zeros(0), np.zeros(0), np.zeros(0), empty)

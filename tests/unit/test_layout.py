@@ -58,6 +58,19 @@ def test_no_class_over_40_attributes():
     assert not many, "\n".join(f"{path}:{line} {name} ({n} attributes)" for path, line, name, n in many)
 
 
+def test_body_kinds_carry_their_own_behaviour():
+    """No isinstance on a body kind (Shape, CadBody) outside the body kinds' own modules: a branch asks the
+    body (its exact flag, nose_length, outer_radius, meshed_volume, crater_nose_factor, after_meshing)."""
+    import re
+
+    homes = {"geometry/shape.py", "geometry/cad.py"}
+    found = [f"{p.relative_to(layout.PACKAGE)}:{i}" for p in sorted(layout.PACKAGE.rglob("*.py"))
+             if str(p.relative_to(layout.PACKAGE)) not in homes
+             for i, line in enumerate(p.read_text().splitlines(), 1)
+             if re.search(r"isinstance\([^)]*\b(CadBody|Shape)\b", line)]
+    assert not found, found
+
+
 def test_no_import_up_a_floor():
     """laws < geometry < solver < io < post, scene < runs < studies < api < cli (function-level imports too)."""
     assert layout.upward_imports(GRAPH) == []
