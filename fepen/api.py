@@ -15,7 +15,6 @@ communicator), as the command does.
 
 from __future__ import annotations
 
-import json
 import tempfile
 from dataclasses import dataclass, field
 from pathlib import Path
@@ -51,8 +50,9 @@ class Result:
     def history(self) -> np.ndarray:
         """history.csv as a numpy structured array: ``history["nose_y_mm"]`` (columns: docs/results.md)."""
         if self._history is None:
-            data = np.genfromtxt(self.out / "history.csv", delimiter=",", names=True, deletechars="")
-            self._history = np.atleast_1d(data)
+            from fepen.io import results
+
+            self._history = results.read(self.out).history()
         return self._history
 
     @property
@@ -97,14 +97,14 @@ def load(results_dir) -> Result:
     Raises:
         InputError: when the directory holds no finished run.
     """
-    out = Path(results_dir)
-    if not (out / "summary.json").is_file():
-        raise InputError("results_dir", f"{out} holds no finished run (no summary.json)")
-    summary = json.loads((out / "summary.json").read_text())
+    from fepen.io import results
+
+    files = results.read(results_dir)
+    out, summary = files.out, files.summary()
+    if summary is None:
+        raise InputError("results_dir", f"{out} holds no finished run (no readable summary.json)")
     scene = Scene(out / "scene.toml") if (out / "scene.toml").is_file() else Scene(summary.get("scene"))
-    fields = out / "fields.xdmf"
-    figures = {p.stem: p for p in sorted(out.glob("*.png"))}
-    return Result(out, summary, scene, fields if fields.is_file() else None, figures)
+    return Result(out, summary, scene, files.fields(), files.figures())
 
 
 def _comm(comm):

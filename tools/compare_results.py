@@ -7,11 +7,11 @@ history.csv must match to the character; summary.json key for key, except what m
 the largest relative difference per column or key. Exit 1 when anything differs.
 """
 
-import csv
-import json
 import math
 import sys
 from pathlib import Path
+
+from fepen.io import results
 
 #: summary keys that measure the machine or the software, not the physics
 VOLATILE = {"wall_s", "time_split_s", "peak_memory_bytes", "versions", "mesh_s"}
@@ -39,7 +39,7 @@ def _rel(a, b):
 
 def compare(a: Path, b: Path) -> list[str]:
     diffs = []
-    ha, hb = (list(csv.reader((d / "history.csv").open())) for d in (a, b))
+    ha, hb = ([h, *rows] for h, rows in (results.read(d).history_text() for d in (a, b)))
     if ha[0] != hb[0]:
         diffs.append(f"history.csv columns differ: {set(ha[0]) ^ set(hb[0])}")
     elif len(ha) != len(hb):
@@ -51,7 +51,7 @@ def compare(a: Path, b: Path) -> list[str]:
                 if x != y:
                     worst[name] = max(worst.get(name, 0.0), _rel(x, y))
         diffs += [f"history.csv {k}: largest relative difference {v:.3g}" for k, v in worst.items()]
-    sa, sb = (_flat(json.loads((d / "summary.json").read_text())) for d in (a, b))
+    sa, sb = (_flat(results.read(d).summary()) for d in (a, b))
     for k in sorted(set(sa) | set(sb)):
         if k.split(".")[0] in VOLATILE or k.endswith("mesh_s"):
             continue
@@ -63,11 +63,10 @@ def compare(a: Path, b: Path) -> list[str]:
 
 def main(a, b) -> int:
     a, b = Path(a), Path(b)
-    pairs = [(a, b)] if (a / "summary.json").exists() else [
-        (d, b / d.name) for d in sorted(a.iterdir()) if (d / "summary.json").exists()]
+    pairs = [(x, b if x == a else b / x.name) for x in results.finished_runs(a)]
     bad = 0
     for x, y in pairs:
-        if not (y / "summary.json").exists():
+        if not results.read(y).finished:
             print(f"{x.name}: missing in {b}")
             bad += 1
             continue

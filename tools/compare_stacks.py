@@ -13,12 +13,12 @@ its printed digits.
 from __future__ import annotations
 
 import argparse
-import csv
-import json
 import math
 import subprocess
 import sys
 from pathlib import Path
+
+from fepen.io import results
 
 ROOT = Path(__file__).resolve().parents[1]
 #: the two stacks' interpreters (make setup, make setup-current)
@@ -54,16 +54,15 @@ def printed(x: float) -> str:
     return f"{x:.6g}"
 
 
-def history(path: Path) -> tuple[list[str], list[list[float]]]:
-    with path.open() as f:
-        rows = list(csv.reader(f))
-    return rows[0], [[float(x) if x not in ("", "nan") else math.nan for x in r] for r in rows[1:]]
+def history(run: Path) -> tuple[list[str], list[list[float]]]:
+    columns, rows = results.read(run).history_text()
+    return columns, [[float(x) if x not in ("", "nan") else math.nan for x in r] for r in rows]
 
 
 def compare_shot(a: Path, b: Path) -> dict:
     """One shot's run directories on the two stacks: their depths, the largest relative differences (summary,
     history) with where they are, and the figures whose printed digits differ."""
-    sa, sb = (json.loads((d / "summary.json").read_text()) for d in (a, b))
+    sa, sb = (results.read(d).summary() for d in (a, b))
     na, nb = numbers(sa), numbers(sb)
     keys = sorted(set(na) & set(nb))
     worst_s = max(((rel(na[k], nb[k]), k) for k in keys), default=(0.0, ""))
@@ -74,7 +73,7 @@ def compare_shot(a: Path, b: Path) -> dict:
            "printed_differ": digits, "missing": missing, "history_rel": 0.0, "history_col": "", "rows": None,
            "state_rows": []}
     if (a / "history.csv").is_file() and (b / "history.csv").is_file():
-        (ca, ra), (cb, rb) = history(a / "history.csv"), history(b / "history.csv")
+        (ca, ra), (cb, rb) = history(a), history(b)
         out["rows"] = (len(ra), len(rb))
         if ca != cb or len(ra) != len(rb):
             out["history_rel"], out["history_col"] = math.inf, "columns or rows differ"

@@ -170,3 +170,129 @@ def finite_row(row, step, t) -> None:
     """Raise SimulationError if a history row holds a non-finite number."""
     if not all(math.isfinite(v) for v in row):
         raise SimulationError(f"non-finite state at step {step}, t = {t * 1e6:.3f} us")
+
+
+# ---------------------------------------------------------------------------------------------------------
+# reading a results directory back: one reader for fepen.load, the figures, ParaView and the tools
+# ---------------------------------------------------------------------------------------------------------
+class RunFiles:
+    """What a run's results directory holds, read one way for everyone who reads one (fepen.load, the
+    figures, ParaView's help, tools/compare_*). Nothing is read until asked; a file that is absent or does not
+    parse reads as None (or empty), so that a running or killed run's directory can be described too.
+
+    Args:
+        out: the results directory.
+    """
+
+    def __init__(self, out):
+        self.out = Path(out)
+
+    @property
+    def finished(self) -> bool:
+        """Whether the run finished (it wrote summary.json)."""
+        return (self.out / "summary.json").is_file()
+
+    def summary(self) -> dict | None:
+        """summary.json as a dict, or None."""
+        import json
+
+        try:
+            return json.loads((self.out / "summary.json").read_text())
+        except (OSError, ValueError):
+            return None
+
+    def history(self) -> np.ndarray:
+        """history.csv as a numpy structured array (``h["nose_y_mm"]``; columns as written, docs/results.md)."""
+        return np.atleast_1d(np.genfromtxt(self.out / "history.csv", delimiter=",", names=True, deletechars=""))
+
+    def history_text(self) -> tuple[list[str], list[list[str]]]:
+        """history.csv as text: (the header's columns, the rows), every figure as written (for comparisons to
+        the character)."""
+        with (self.out / "history.csv").open(newline="") as f:
+            rows = list(csv.reader(f))
+        return rows[0], rows[1:]
+
+    def given_scene(self) -> dict:
+        """The keys the user gave, as the scene.toml in the directory holds them (nested TOML tables), or {}."""
+        import tomllib
+
+        try:
+            return tomllib.loads((self.out / "scene.toml").read_text())
+        except (OSError, ValueError, UnicodeDecodeError):
+            return {}
+
+    def scene_keys(self) -> dict:
+        """Every key of the run's scene, flat and dotted: scene.toml's (the given keys as values, every resolved
+        key as a comment line, written_scene), else summary.json's scene; {} when neither is there."""
+        flat = written_scene(self.out / "scene.toml")
+        if flat:
+            return flat
+        tree = (self.summary() or {}).get("scene")
+        if not isinstance(tree, dict):
+            return {}
+        stack = [("", tree)]
+        while stack:
+            prefix, node = stack.pop()
+            for k, v in node.items():
+                if isinstance(v, dict):
+                    stack.append((f"{prefix}{k}.", v))
+                else:
+                    flat[f"{prefix}{k}"] = v
+        return flat
+
+    def fields(self) -> Path | None:
+        """fields.xdmf, or None when the run wrote none."""
+        p = self.out / "fields.xdmf"
+        return p if p.is_file() else None
+
+    def figures(self) -> dict[str, Path]:
+        """The run's pictures, by name: {"history": .../history.png, ...}."""
+        return {p.stem: p for p in sorted(self.out.glob("*.png"))}
+
+
+def read(out) -> RunFiles:
+    """The reader of a results directory (RunFiles)."""
+    return RunFiles(out)
+
+
+def finished_runs(folder) -> list[Path]:
+    """The finished runs in a folder: the folder itself when it is one, else its subfolders that are, by name."""
+    folder = Path(folder)
+    if RunFiles(folder).finished:
+        return [folder]
+    return [d for d in sorted(folder.iterdir()) if d.is_dir() and RunFiles(d).finished]
+
+
+def written_scene(path) -> dict:
+    """Every key of a scene.toml as fepen writes it into a results directory (the given keys as values, every
+    other resolved key as a comment line "# key = value" under its "# [section]"), flat and dotted; without
+    fepen.scene (reading files, not resolving scenes). Lines that are neither are skipped, and so are the
+    [[target.layers]] tables.
+
+    Args:
+        path: the scene.toml.
+
+    Returns:
+        {"impact.velocity": 584.3, ...}; empty when the file cannot be read.
+    """
+    import re
+    import tomllib
+
+    try:
+        lines = Path(path).read_text().splitlines()
+    except (OSError, UnicodeDecodeError):
+        return {}
+    header = re.compile(r"^(?:# )?\[([A-Za-z0-9_.]+)\]\s*$")
+    key = re.compile(r"^(?:# )?([A-Za-z_][A-Za-z0-9_]*) = (.+)$")
+    flat, section = {}, None
+    for line in lines:
+        if line.lstrip("# ").startswith("[["):
+            section = None
+        elif m := header.match(line):
+            section = m.group(1)
+        elif section is not None and (m := key.match(line)):
+            try:
+                flat[f"{section}.{m.group(1)}"] = tomllib.loads(f"v = {m.group(2)}")["v"]
+            except tomllib.TOMLDecodeError:
+                continue
+    return flat

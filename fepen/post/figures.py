@@ -17,6 +17,7 @@ from mpi4py import MPI
 from fepen.data import SHOTS, shot
 from fepen.geometry import mesh as fmesh
 from fepen.geometry import tags
+from fepen.io import results
 
 
 def pyvista():
@@ -112,41 +113,6 @@ def save_figure(fig, path, dpi: int = 110) -> Path:
     return path
 
 
-def read_written_scene(path) -> dict:
-    """Every key of a scene.toml as fepen writes it into a results directory (the given keys as values, every
-    other resolved key as a comment line "# key = value" under its "# [section]"), flat and dotted; without
-    fepen.scene (fepen.post reads files, not scenes). Lines that are neither are skipped, and so are the
-    [[target.layers]] tables.
-
-    Args:
-        path: the scene.toml.
-
-    Returns:
-        {"impact.velocity": 584.3, ...}; empty when the file cannot be read.
-    """
-    import re
-    import tomllib
-
-    try:
-        lines = Path(path).read_text().splitlines()
-    except (OSError, UnicodeDecodeError):
-        return {}
-    header = re.compile(r"^(?:# )?\[([A-Za-z0-9_.]+)\]\s*$")
-    key = re.compile(r"^(?:# )?([A-Za-z_][A-Za-z0-9_]*) = (.+)$")
-    flat, section = {}, None
-    for line in lines:
-        if line.lstrip("# ").startswith("[["):
-            section = None
-        elif m := header.match(line):
-            section = m.group(1)
-        elif section is not None and (m := key.match(line)):
-            try:
-                flat[f"{section}.{m.group(1)}"] = tomllib.loads(f"v = {m.group(2)}")["v"]
-            except tomllib.TOMLDecodeError:
-                continue
-    return flat
-
-
 def run_info(out) -> dict:
     """What a figure's title says of the run in a results directory, from its scene.toml (read_written_scene;
     else summary.json's scene); a value None when neither gives it.
@@ -159,23 +125,7 @@ def run_info(out) -> dict:
         "yield_Pa": the shell's Johnson–Cook A (its static yield stress) or None, "steel": its name,
         "charge_yield_Pa": the charge's initial yield stress}.
     """
-    out = Path(out)
-    flat = read_written_scene(out / "scene.toml")
-    if not flat:
-        try:
-            import json
-
-            tree = json.loads((out / "summary.json").read_text())["scene"]
-            stack = [("", tree)]
-            while stack:
-                prefix, node = stack.pop()
-                for k, v in node.items():
-                    if isinstance(v, dict):
-                        stack.append((f"{prefix}{k}.", v))
-                    else:
-                        flat[f"{prefix}{k}"] = v
-        except (OSError, ValueError, KeyError, TypeError, AttributeError):
-            flat = {}
+    flat = results.read(out).scene_keys()
     keys = {"shot": "impact.shot", "fidelity": "effects.fidelity", "velocity_m_s": "impact.velocity",
             "obliquity_deg": "impact.obliquity_deg", "charge": "effects.charge", "yield_Pa": "projectile.material.A",
             "steel": "projectile.material.name", "charge_yield_Pa": "charge.material.yield_stress"}
@@ -227,7 +177,7 @@ def history_figure(out: Path, experiment: str | None = None, comm=MPI.COMM_WORLD
     if comm.rank != 0:
         return
     out = Path(out)
-    data = np.atleast_1d(np.genfromtxt(out / "history.csv", delimiter=",", names=True))
+    data = results.read(out).history()
     name = experiment or run_info(out)["shot"]
     s = shot(name) if name else None
     fig = new_figure((12.5, 8.0))

@@ -65,23 +65,21 @@ def missing_fields(out: Path) -> str:
     Returns:
         One line naming the directory and the reason.
     """
-    import json
+    from fepen.io import results
 
-    out = Path(out)
+    files = results.read(out)
+    out = files.out
     fidelity = fields = None
     try:
-        summary = json.loads((out / "summary.json").read_text())
+        summary = files.summary()
         fidelity = summary.get("fidelity") or summary["scene"]["effects"]["fidelity"]
         fields = summary["scene"]["run"]["fields"]
-    except (OSError, ValueError, KeyError, TypeError):  # a running or killed run: its scene.toml, whose
-        try:                                              # given keys are values (the others comments)
-            import tomllib
-
-            given = tomllib.loads((out / "scene.toml").read_text())
-            fidelity = given.get("effects", {}).get("fidelity")
-            fields = given.get("run", {}).get("fields")
-        except (OSError, ValueError, AttributeError):
+    except (KeyError, TypeError, AttributeError):  # a running or killed run: its scene.toml, whose given keys
+        given = files.given_scene()                # are values (the others comments)
+        if not given:
             return f"{out} holds no fields.xdmf and no run's summary.json or scene.toml: not a run's results directory"
+        fidelity = given.get("effects", {}).get("fidelity")
+        fields = given.get("run", {}).get("fields")
     if fidelity == "rigid":
         return (f"{out} is a rigid run, which writes no fields (history.csv and summary.json only); run the scene "
                 "with effects.fidelity = 'plastic' or 'elastic' to see the projectile")

@@ -71,6 +71,14 @@ def test_body_kinds_carry_their_own_behaviour():
     assert not found, found
 
 
+def test_tests_mirror_the_package():
+    """Every subpackage of fepen has its folder of unit tests, holding at least one test file."""
+    unit = Path(__file__).resolve().parent
+    missing = [p.parent.name for p in layout.PACKAGE.glob("*/__init__.py")
+               if not any((unit / p.parent.name).glob("test_*.py"))]
+    assert not missing, f"no tests/unit/<name>/test_*.py for {missing}"
+
+
 def test_no_import_up_a_floor():
     """laws < geometry < solver < io < post, scene < runs < studies < api < cli (function-level imports too)."""
     assert layout.upward_imports(GRAPH) == []

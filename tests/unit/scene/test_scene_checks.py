@@ -9,7 +9,7 @@ from pathlib import Path
 from fepen import scene
 from fepen.scene import resolve
 
-ROOT = Path(__file__).resolve().parents[2]
+ROOT = Path(__file__).resolve().parents[3]
 HEADER = "Checks across keys, before anything is meshed (bad input, exit 2, naming the key):"
 
 #: the functions of resolve.py that refuse what the user gave before any key is known: not checks across keys

@@ -16,7 +16,7 @@ from fepen.errors import InputError
 from fepen.runs import setup
 from fepen.scene import Scene
 
-ROOT = Path(__file__).resolve().parents[2]
+ROOT = Path(__file__).resolve().parents[3]
 METAL = [name for name, t in TARGETS.items() if t["family"] == "metal"]
 
 
