@@ -42,10 +42,10 @@ def carry(friction: float, sign: float, size: float = 0.004, accel_g: float = 50
     s = explicit.ExplicitSolver(pm.mesh, [setup.projectile_material(sc), setup.charge_material(sc)], cm)
     contact = ShellChargeContact(s, pm.facet_tags, friction)
     s.interface = contact
-    m_shell, m_charge = s.body_mass
+    m_shell, m_charge = s.node.body_mass
     a0 = sign * accel_g * G0  # along +y, from the nose towards the tail: a deceleration of a nose-first flight
     n = s.n_owned
-    share = s.mass_by_material[:n, 0] * (m_shell + m_charge) / m_shell
+    share = s.node.mass_by_material[:n, 0] * (m_shell + m_charge) / m_shell
 
     def level(t):
         return a0 * (np.sin(0.5 * np.pi * t / ramp) ** 2 if t < ramp else 1.0)
