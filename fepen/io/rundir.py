@@ -512,3 +512,14 @@ def study_directory(out, comm, fresh: bool, kind: str, names, digest: str | None
     top-level names it writes, are refused before it starts where a file fepen did not write holds one. Each
     shot's own folder inside it is a run directory of its own."""
     return RunDirectory(out, comm, "force" if fresh else "continue", kind=kind, names=names, digest=digest)
+
+
+def own_name(out: Path, name: str) -> None:
+    """Rank 0: ``name`` in the claimed directory ``out`` is this command's before any other rank makes it. A
+    study's groups share OUT: another group's rank may be the first to create OUT/shots (its own claim of OUT
+    cannot tell rank 0's), and rank 0's claim, which guards the shots its own group keeps there, would then take
+    it for a user's. Nothing is created; a name already there stays whatever it is (a user's is refused as
+    before)."""
+    c = atomic.claim_of(out / name)
+    if c is not None and c.dir == Path(os.path.abspath(out)) and not os.path.lexists(out / name):
+        c.own(name)

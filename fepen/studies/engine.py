@@ -29,6 +29,7 @@ from pathlib import Path
 from mpi4py import MPI
 
 from fepen.errors import InputError, SimulationError
+from fepen.io import rundir
 
 __all__ = ["execute", "summaries", "run_shot", "run_shots", "process_shot", "How", "read_records",
            "check_ranks_per_shot", "RECORDS", "BATCH", "chunks"]
@@ -268,7 +269,7 @@ def execute(n: int, scene_of, out, comm=None, ranks_per_shot: int = 1, keep=None
     pending = comm.bcast([i for i in range(n) if i not in records] if comm.rank == 0 else None, root=0)
     groups = comm.size // k
     if out is not None and folder is None and comm.rank == 0 and groups > 1:
-        _own_shots_folder(out)
+        rundir.own_name(out, "shots")  # before another group's rank makes it
     if comm.rank == 0 and say is not None:
         done = n - len(pending)
         say(f"{desc}: {n}" + (f", {done} done before (OUT/{RECORDS})" if done else "")
@@ -308,17 +309,6 @@ def execute(n: int, scene_of, out, comm=None, ranks_per_shot: int = 1, keep=None
 def _shot_dir(out: Path, i: int) -> Path:
     return out / "shots" / f"{i:05d}"
 
-
-def _own_shots_folder(out: Path) -> None:
-    """Rank 0: the name OUT/shots is the study's before any group makes it. Another group's rank may be the
-    first to create it (its own claim of OUT cannot tell rank 0's), and rank 0's claim, which guards the
-    shots its own group keeps there, would then take it for a user's. Nothing is created; a name already
-    there stays whatever it is (a user's is refused as before)."""
-    from fepen import atomic
-
-    c = atomic.claim_of(out / "shots")
-    if c is not None and c.dir == Path(os.path.abspath(out)) and not os.path.lexists(out / "shots"):
-        c.own("shots")
 
 
 def _parallel(runs, scene_of, out, comm, k, how, log) -> None:

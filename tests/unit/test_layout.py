@@ -52,6 +52,13 @@ def test_no_class_over_300_lines():
     assert not big, "\n".join(f"{path}:{line} {name} ({n} lines)" for path, line, name, n in big)
 
 
+def test_no_study_module_over_400_lines():
+    """A study is one file (fepen.studies.study's skeleton does the rest): none grows past 400 lines."""
+    big = [(p.name, n) for p in sorted((layout.PACKAGE / "studies").glob("*.py"))
+           if (n := len(p.read_text().splitlines())) > 400]
+    assert not big, big
+
+
 def test_no_class_over_40_attributes():
     """Solver state and the like live in small named records (fepen.solver.state), not in one bag."""
     many = layout.many_attributes(40)
