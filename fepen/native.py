@@ -19,6 +19,7 @@ compiler's version and the CPU's flags: an edited source or another machine buil
 from __future__ import annotations
 
 import ctypes
+import functools
 import hashlib
 import os
 import re
@@ -195,9 +196,15 @@ def _source_bytes(source: Path, seen=None) -> bytes:
     return out
 
 
+@functools.lru_cache(maxsize=8)
+def _compiler(cc: str) -> str:
+    """The compiler's version text (asked once per process: a subprocess costs tens of milliseconds)."""
+    return subprocess.run([cc, "--version"], capture_output=True, text=True, check=True).stdout
+
+
 def _build(source: Path, cc: str, extra: tuple = ()) -> Path:
     flags = [*FLAGS, *extra]
-    version = subprocess.run([cc, "--version"], capture_output=True, text=True, check=True).stdout
+    version = _compiler(cc)
     key = hashlib.sha256(_source_bytes(source) + " ".join(flags).encode() + version.encode()
                          + _cpu_flags().encode())
     out = _folder() / f"{source.stem}-{key.hexdigest()[:16]}.so"

@@ -111,7 +111,8 @@ class Recession:
         """Record one step's heat at the surface's points (their target forces, normals, velocities): the
         heat of fepen.laws.wear.heat_rates × Δt, a third to each of the point's facet nodes."""
         q = wear.heat_rates(force, n, v, self.mu) * dt
-        np.add.at(self.heat_nodes, self.surface.tri.ravel(), np.repeat(q / 3.0, 3))
+        self.heat_nodes += np.bincount(self.surface.tri.ravel(), weights=np.repeat(q / 3.0, 3),
+                                       minlength=len(self.heat_nodes))
         self.heat_total += float(q.sum())
         if self.zone_end is not None:
             self._heat_exact.add(q[q > 0.0])
