@@ -110,18 +110,32 @@ def check_mesh(shape, size: float, nose_size: float | None, charge: bool, max_ce
 RIGID_STEP_FINER = 50.0
 
 
-def check_rigid_step(rigid_step: float | None, shape, shell_density: float, v0: float, law) -> None:
+#: the most RK4 steps a rigid shot given run.end_time may take (about 10 s of a run on one core): the run goes on
+#: to its end time even after the projectile has stopped or turned back, so an end time of a second would take
+#: 160,000 steps of the default shot, minutes of a free flight no test measured
+MAX_RIGID_STEPS = 20_000
+
+
+def check_rigid_step(rigid_step: float | None, shape, shell_density: float, v0: float, law,
+                     end_time: float | None = None) -> None:
     """Refuse a run.rigid_step so fine that a rigid shot would run for minutes or hours (InputError naming it):
     more than RIGID_STEP_FINER times finer than the shot's own step (fepen.runs.rigid.default_step, on the body's
-    mass from its exact volume, a CAD body's from its enclosing cylinder)."""
-    if rigid_step is None or law is None or v0 <= 0.0:
+    mass from its exact volume, a CAD body's from its enclosing cylinder); and a run.end_time that needs more than
+    MAX_RIGID_STEPS steps of the step the run will take."""
+    if law is None or v0 <= 0.0:
         return
     mass = shell_density * meshed_volume(shape, False)
     own = default_step(mass, v0, shape.diameter, law)
-    if rigid_step < own / RIGID_STEP_FINER:
+    if rigid_step is not None and rigid_step < own / RIGID_STEP_FINER:
         raise InputError("run.rigid_step", f"{rigid_step:g} s is {own / rigid_step:.3g} times finer than this shot's "
                                            f"own step ({own:.3g} s, whose results are converged): at least "
                                            f"{own / RIGID_STEP_FINER:.3g} s, or leave it out")
+    step = rigid_step if rigid_step is not None else own
+    if end_time is not None and end_time / step > MAX_RIGID_STEPS:
+        raise InputError("run.end_time", f"{end_time:g} s is about {end_time / step:.3g} RK4 steps of {step:.3g} s "
+                                         f"for this rigid shot; at most {MAX_RIGID_STEPS}: at most "
+                                         f"{MAX_RIGID_STEPS * step:.3g} s, or leave it out (the run then ends when "
+                                         "the projectile stops, perforates or ricochets)")
 
 
 #: the rigid fidelity's default RK4 step (default_step): the time to travel this fraction of a diameter at the

@@ -195,7 +195,7 @@ def resolve(scene, toml: bool = True) -> Shot:
                              bool(scene.run.fields), scene.run.checkpoint_interval)
     else:
         budget.check_rigid_step(scene.get("run.rigid_step"), built.shape, built.shell_density,
-                                float(np.linalg.norm(v)), law)
+                                float(np.linalg.norm(v)), law, end)
     e = scene.projectile.erosion
     probes = tuple(scene.get("output.probes") or ())
     run_probes.check_inside(built.shape, probes, scene.effects.charge)

@@ -345,7 +345,8 @@ SCHEMA: dict[str, Key] = {
                              doc="simulated time after the first contact at which the run ends (outcome "
                                  "'ended'); absent: until the projectile stops, perforates, ricochets or "
                                  "rebounds (at most 5 ms deformable, 50 ms rigid, or 20 times the time to "
-                                 "reach a layered target's last face if longer)"),
+                                 "reach a layered target's last face if longer); a rigid run may take at most "
+                                 "20,000 steps to it"),
     "run.output_interval": positive(5.0e-5, "s", 1.0,
                                     doc="simulated time between field outputs (fields.xdmf); a deformable run's "
                                         "history.csv records every tenth of it, at most 1 us apart"),

@@ -100,3 +100,18 @@ def test_a_rigid_step_fifty_times_finer_than_the_shots_own_is_refused():
     with pytest.raises(InputError) as err:
         budget.check_rigid_step(1e-12, BUILT.shape, BUILT.shell_density, 584.3, law)
     assert err.value.key == "run.rigid_step" and "at least" in err.value.message
+
+
+def test_a_rigid_end_time_past_the_step_budget_is_refused():
+    """A rigid run with run.end_time goes on to that time: 1 s of the default shot was 164,500 steps (50 s here,
+    150 s on CI) of a body that had stopped and drifted back. The budget counts the steps the run will take."""
+    law = setup.target_law(DEFAULT)
+    mass = BUILT.shell_density * budget.meshed_volume(BUILT.shape, False)
+    own = budget.default_step(mass, 584.3, BUILT.shape.diameter, law)
+    limit = budget.MAX_RIGID_STEPS * own
+    budget.check_rigid_step(None, BUILT.shape, BUILT.shell_density, 584.3, law, 0.99 * limit)
+    with pytest.raises(InputError) as err:
+        budget.check_rigid_step(None, BUILT.shape, BUILT.shell_density, 584.3, law, 1.01 * limit)
+    assert err.value.key == "run.end_time" and f"{limit:.3g} s" in err.value.message
+    # a coarser step of the user's own buys a longer end time in proportion
+    budget.check_rigid_step(2 * own, BUILT.shape, BUILT.shell_density, 584.3, law, 1.9 * limit)
