@@ -57,7 +57,7 @@ class Kernel:
 #: every compiled kernel fepen builds
 KERNELS = {
     "target": Kernel("laws/target_kernel.c", (), True, {
-        "point_forces": ([_i32, *[_vp] * 10, _i32, _vp, _vp, _vp], _i32),
+        "point_forces": ([_i32, *[_vp] * 10, _i32, _vp, _vp, _vp, _vp, _vp], _i32),
         "cavity_wall_stress": ([_dbl] * 3, _dbl)}),
     "materials": Kernel("laws/materials_kernel.c", NO_CONTRACT, True, {
         "material_radial_return": ([_dbl] * 5 + [_vp, _vp], _dbl),
@@ -67,7 +67,7 @@ KERNELS = {
     "rigid_body": Kernel("laws/rigid_kernel.c", (), False, {
         "rigid_points": ([_i32, *[_vp] * 10], None), "force_moment": ([_i32, _vp, _vp, _vp], None)}),
     "rigid_batch": Kernel("runs/rigid_batch.c", NO_CONTRACT, False, {
-        "rigid_batch": ([_i32, _i32, *[_vp] * 8, _i32, _vp, _vp, _vp, _vp, _i32, _vp, _vp], _i32),
+        "rigid_batch": ([_i32, _i32, *[_vp] * 8, _i32, _vp, _vp, _vp, _vp, _i32, _vp, _vp, _vp, _i32, _i32, _vp], _i32),
         "batch_law": ([_i32, *[_vp] * 11, _i32, _vp, _vp], None)}),
     "cells": Kernel("solver/cell_kernel.c", NO_CONTRACT, False, {
         "update_begin": ([_i32, _i32, _dbl, _dbl, *[_vp] * 9], None),

@@ -250,7 +250,7 @@ class PointLoad:
 
 
 def load_on_points(law: TargetLaw, x, v, n, area, radius, R_meridian, sin_phi0, axis, crater=None,
-                   tip_depth: float = 0.0, reduce=None) -> PointLoad:
+                   tip_depth: float = 0.0, reduce=None, tunnel=None, body_xi=None) -> PointLoad:
     """The target's forces on surface points: immersion, the law on the immersed points, the linear crater.
 
     The one implementation for the rigid and the deformable projectile (they differ only in where their
@@ -264,15 +264,17 @@ def load_on_points(law: TargetLaw, x, v, n, area, radius, R_meridian, sin_phi0, 
         reduce: the totals over the processes that share the points (a distributed surface), as
             ``reduce(f, sums)`` -> sums (5,), from this process's point forces f (k, 3) and its sums (force
             (3), loaded points, loaded area); None when this process holds them all.
+        tunnel: the run's fepen.laws.tunnel.Tunnel (its shoulder set for this state), or None: no tunnel.
+        body_xi: each point's distance behind the tip in the body frame (m), (k,), with a tunnel.
 
     Returns:
         The PointLoad.
     """
     kernel = point_forces
-    if getattr(law, "layered", False):  # a fepen.laws.layers.Layered target: layer by layer
+    if getattr(law, "layered", False):  # a fepen.laws.layers.Layered target: layer by layer, no tunnel
         f, sums = law.point_forces(kernel, x, v, n, area, radius, R_meridian, sin_phi0, axis)
     else:
-        f, sums = kernel(law, x, v, n, area, radius, R_meridian, sin_phi0, axis)
+        f, sums = kernel(law, x, v, n, area, radius, R_meridian, sin_phi0, axis, tunnel, body_xi)
     if reduce is not None:
         sums = reduce(f, sums)
     total = sums[:3]
@@ -283,7 +285,7 @@ def load_on_points(law: TargetLaw, x, v, n, area, radius, R_meridian, sin_phi0, 
     return PointLoad(f, total, int(sums[3]), float(sums[4]))
 
 
-def point_forces(law: TargetLaw, x, v, n, area, radius, R_meridian, sin_phi0, axis):
+def point_forces(law: TargetLaw, x, v, n, area, radius, R_meridian, sin_phi0, axis, tunnel=None, body_xi=None):
     """The law on every point (docs/theory.md §8), before any linear-crater scaling: target_kernel.c's
     point_forces, the law's one home, through fepen.native.
 
@@ -294,18 +296,21 @@ def point_forces(law: TargetLaw, x, v, n, area, radius, R_meridian, sin_phi0, ax
             radius of curvature there (m, inf where straight); sin_phi0: sin of the surface's angle to the
             axis, (k,) each.
         axis: the unit axis, tail to nose (3,), or None (no wake rule).
+        tunnel: a fepen.laws.tunnel.Tunnel, or None (§8.7); body_xi: the points' distances behind the tip
+            in the body frame (m), (k,), with a tunnel.
 
     Returns:
         (forces (k, 3) (N, zero where not loaded), sums (5,): force (3) (N), loaded points, loaded area (m^2)).
     """
-    f, sig, sums = _kernel()(law, x, v, n, area, radius, R_meridian, sin_phi0, axis)
+    f, sig, sums = _kernel()(law, x, v, n, area, radius, R_meridian, sin_phi0, axis, tunnel, body_xi)
     return f, sums
 
 
-def normal_stress(law: TargetLaw, x, v, n, area, radius, R_meridian, sin_phi0, axis=None):
+def normal_stress(law: TargetLaw, x, v, n, area, radius, R_meridian, sin_phi0, axis=None, tunnel=None,
+                  body_xi=None):
     """(forces (k, 3) (N), σ_n (k,) (Pa, weighted by the immersed fraction, zero where not loaded)) on the
     points, with the same arguments as point_forces."""
-    f, sig, _ = _kernel()(law, x, v, n, area, radius, R_meridian, sin_phi0, axis)
+    f, sig, _ = _kernel()(law, x, v, n, area, radius, R_meridian, sin_phi0, axis, tunnel, body_xi)
     return f, sig
 
 
@@ -360,7 +365,7 @@ def _bind(lib):
 
     gauss_at = gauss.ctypes.data  # c_point_forces.gauss below keeps the array alive
 
-    def c_point_forces(law, x, v, n, area, radius, R_meridian, sin_phi0, axis):
+    def c_point_forces(law, x, v, n, area, radius, R_meridian, sin_phi0, axis, tunnel=None, body_xi=None):
         p = _law_numbers(law)
         moving = [np.ascontiguousarray(a, dtype=float) for a in (x, v, n)]
         ax = None if axis is None else np.ascontiguousarray(axis, dtype=float)
@@ -371,7 +376,9 @@ def _bind(lib):
         count = lib.point_forces(k, *[a.ctypes.data for a in moving],
                                  *[constant(a, keep) for a in (area, radius, R_meridian, sin_phi0)],
                                  None if ax is None else ax.ctypes.data, p.ctypes.data, gauss_at, len(xg), at,
-                                 at + 24 * k, at + 32 * k)
+                                 at + 24 * k, at + 32 * k,
+                                 None if tunnel is None else constant(body_xi, keep),
+                                 None if tunnel is None else tunnel.buf.ctypes.data)
         assert count == len(p), "target_kernel.c and _law_numbers disagree on the parameters"
         return out[: 3 * k].reshape(k, 3), out[3 * k: 4 * k], out[4 * k:]
 

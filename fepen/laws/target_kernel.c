@@ -1,5 +1,6 @@
 /* The target law (docs/theory.md §8) on surface points, its one home: immersion, tunnel stress, wake,
- * separation, free surface, onset, energy crater, sliding friction, at one point (law_at_point), and on k
+ * separation, free surface, onset, energy crater, sliding friction, and the tunnel's wall (tunnel_kernel.c), at
+ * one point (law_at_point), and on k
  * points (point_forces, which fepen.laws.target.load_on_points calls through fepen.native before its
  * linear-crater scaling). tests/unit/laws/test_target_kernel.py checks it against an independent numpy
  * oracle of the equations and against their limits. Built once per machine, called by ctypes. */
@@ -14,6 +15,14 @@ enum { P_DENSITY, P_Y, P_E, P_T, P_LAM, P_SIGMA_S, P_B, P_THICKNESS /* < 0: none
        P_SURFACE_RANGE /* the free face's reach in plastic-zone widths */, P_COUNT };
 
 #define SIN_TOL 1e-9
+
+#include "tunnel_kernel.c"
+
+/* A point in the tunnel (tunnel_kernel.c): its penetration of the wall (m), the outward unit vector, and the
+ * outward speed over which the wall's quasi-static stress develops (m/s) */
+typedef struct {
+    double delta, er[3], ramp;
+} WallHit;
 
 static double clip01(double x) { return x < 0.0 ? 0.0 : (x > 1.0 ? 1.0 : x); }
 
@@ -55,18 +64,26 @@ static LawConstants law_constants(const double *p) {
  * stress *sig only when it is loaded and returns 1; returns 0 (f, *sig untouched) when it is not. */
 static inline int law_at_point(const double *p, const LawConstants *c, const double *xi, const double *vi,
                                const double *ni, double area, double ell, double radius, double Rm, double sphi0,
-                               const double *axis, const double *gauss, int32_t ng, double *fi, double *sig) {
+                               const double *axis, const WallHit *wall, const double *gauss, int32_t ng, double *fi,
+                               double *sig) {
     double y = xi[1];
     double frac = clip01(0.5 - (y + p[P_TOP]) / ell);
     if (p[P_LOWER] >= 0.0) frac *= clip01(0.5 + (y + p[P_LOWER]) / ell);
+    if (wall) frac *= clip01(1.0 + wall->delta / ell); /* in the tunnel: the part of the patch at its wall */
     if (!(frac > 0.0)) return 0;
     double vn = vi[0] * ni[0] + vi[1] * ni[1] + vi[2] * ni[2];
     double speed = sqrt(vi[0] * vi[0] + vi[1] * vi[1] + vi[2] * vi[2]);
-    double sin_phi = speed > 0.0 ? vn / fmax(speed, 1e-300) : 0.0;
-    int loaded = sin_phi > SIN_TOL;
-    /* the wake: moving backward, a point meets the open tunnel, not concrete */
-    if (axis) loaded = loaded && (vi[0] * axis[0] + vi[1] * axis[1] + vi[2] * axis[2] > 0.0);
-    if (p[P_SEPARATION] != 0.0) loaded = loaded && sin_phi > c->sin_min;
+    double sin_phi = speed > 0.0 ? vn / fmax(speed, 1e-300) : 0.0, u = 0.0;
+    int loaded;
+    if (wall) { /* in the tunnel (§8.7): loaded while it faces the wall and pushes it outward */
+        u = vi[0] * wall->er[0] + vi[1] * wall->er[1] + vi[2] * wall->er[2];
+        loaded = u > 0.0 && ni[0] * wall->er[0] + ni[1] * wall->er[1] + ni[2] * wall->er[2] > 0.0;
+    } else {
+        loaded = sin_phi > SIN_TOL;
+        /* the wake: moving backward, a point meets the open tunnel, not concrete */
+        if (axis) loaded = loaded && (vi[0] * axis[0] + vi[1] * axis[1] + vi[2] * axis[2] > 0.0);
+        if (p[P_SEPARATION] != 0.0) loaded = loaded && sin_phi > c->sin_min;
+    }
     if (!loaded || !(vn > 0.0)) return 0;
     /* L_e: the shortest distance to the block's front face, or its rear face when it has one */
     double depth = fmax(-y, 0.0), Le = c->thk >= 0.0 ? fmin(depth, fmax(c->thk - depth, 0.0)) : depth;
@@ -76,7 +93,8 @@ static inline int law_at_point(const double *p, const LawConstants *c, const dou
         if (ca == p[P_C_OVER_A]) s = c->whole;
         else s = p[P_GIVEN_SIGMA_S] != 0.0 ? p[P_SIGMA_S] * cavity_stress(p, ca) / c->ref : cavity_stress(p, ca);
     }
-    if (p[P_ONSET] > 0.0) s *= fmin(sin_phi / c->sin_onset, 1.0);
+    if (wall) s *= fmin(u / wall->ramp, 1.0); /* the wall's stress develops over the first `ramp` of outward speed */
+    else if (p[P_ONSET] > 0.0) s *= fmin(sin_phi / c->sin_onset, 1.0);
     double sg = (s + p[P_B] * p[P_DENSITY] * vn * vn) * frac;
     if (p[P_CRATER] == 2.0 && -y < p[P_K] * p[P_D]) { /* the splash-streamline energy balance (§8.3) */
         double rho = fmax(radius, 1e-12), l = (p[P_C_OVER_A] - 1.0) * rho, integral = 0.0;
@@ -108,23 +126,46 @@ static inline int law_at_point(const double *p, const LawConstants *c, const dou
     return 1;
 }
 
-/* k points; x, v, n (k, 3); area, radius, Rm, sphi0 (k); axis (3) or NULL; gauss: ng nodes then ng weights.
+/* The point's wall, when it is in the tunnel T (NULL: no tunnel): the WallHit, or NULL */
+static inline const WallHit *wall_of(const double *T, const double *xi_point, double xi, WallHit *hit) {
+    if (!T) return 0;
+    int32_t kn, sec;
+    double rho;
+    if (!tunnel_locate(T, xi_point, xi, &hit->delta, hit->er, &kn, &sec, &rho)) return 0;
+    hit->ramp = T[T_RAMP];
+    return hit;
+}
+
+/* k points; x, v, n (k, 3); area, radius, Rm, sphi0 (k); axis (3) or NULL; gauss: ng nodes then ng weights;
+ * body_xi (k): each point's distance behind the tip in the body frame, and T: the tunnel (tunnel_kernel.c; NULL:
+ * none, body_xi unread). A call with T[T_COMMIT] set (a step's first stage) first records a station, then
+ * pushes the wall out to the points it loads, and clears the flag.
  * Out: f (k, 3) and sig (k) (zero where not loaded), sums: force (3), loaded count, loaded area.
  * Returns P_COUNT. */
 int32_t point_forces(int32_t k, const double *x, const double *v, const double *n, const double *area,
                      const double *radius, const double *Rm, const double *sphi0, const double *axis,
-                     const double *p, const double *gauss, int32_t ng, double *f, double *sig, double *sums) {
+                     const double *p, const double *gauss, int32_t ng, double *f, double *sig, double *sums,
+                     const double *body_xi, double *T) {
     const LawConstants c = law_constants(p);
+    const int commit = T && T[T_COMMIT] != 0.0;
+    if (commit) tunnel_record(T);
     for (int j = 0; j < 5; ++j) sums[j] = 0.0;
     for (int32_t i = 0; i < k; ++i) {
         double *fi = f + 3 * i;
         fi[0] = fi[1] = fi[2] = 0.0;
         sig[i] = 0.0;
+        WallHit hit;
+        const WallHit *wall = wall_of(T, x + 3 * i, T ? body_xi[i] : 0.0, &hit);
         if (law_at_point(p, &c, x + 3 * i, v + 3 * i, n + 3 * i, area[i], sqrt(area[i]), radius[i], Rm[i], sphi0[i],
-                         axis, gauss, ng, fi, sig + i) && sig[i] > 0.0) {
+                         axis, wall, gauss, ng, fi, sig + i) && sig[i] > 0.0) {
             sums[3] += 1.0;
             sums[4] += area[i];
         }
+    }
+    if (commit) {
+        for (int32_t i = 0; i < k; ++i)
+            if (sig[i] > 0.0) tunnel_expand(T, x + 3 * i, body_xi[i]);
+        T[T_COMMIT] = 0.0;
     }
     for (int32_t i = 0; i < k; ++i) {
         sums[0] += f[3 * i];

@@ -28,6 +28,7 @@ from mpi4py import MPI
 
 from fepen.errors import InputError, SimulationError
 from fepen.laws import target as tg
+from fepen.laws import tunnel
 from fepen.runs import events
 
 __all__ = ["summaries", "reason", "kernel", "SHOT_NUMBERS", "RESULTS", "OUTCOMES"]
@@ -35,7 +36,8 @@ __all__ = ["summaries", "reason", "kernel", "SHOT_NUMBERS", "RESULTS", "OUTCOMES
 #: the per-shot numbers the kernel reads, in its order (rigid_batch.c's S_ enum)
 SHOT_NUMBERS = ("mass", "dt", "hard_end", "thickness", "until_stopped", "history_interval", "crater",
                 "crater_kd", "crater_c", "ke0", "stop_energy", "tip_x", "tip_y", "tip_z", "tail_x", "tail_y",
-                "tail_z", *[f"I_inv_{i}{j}" for i in range(3) for j in range(3)])
+                "tail_z", *[f"I_inv_{i}{j}" for i in range(3) for j in range(3)], "tunnel", "tunnel_spacing",
+                "shoulder_xi", "shoulder_radius", "wall_ramp_speed", "shoulder_x", "shoulder_y", "shoulder_z")
 #: the per-shot results it writes (its R_ enum)
 RESULTS = ("t", "steps", "outcome", "work", "entered", "max_nose_mm", "max_error", "rows", "status")
 #: outcome codes of the kernel (events_kernel.c's penetration_rule)
@@ -123,7 +125,22 @@ def _shot_numbers(run) -> list[float]:
     return [body.mass, run.dt, run.shot.hard_end, -1.0 if law.thickness is None else law.thickness,
             float(run.rules.until_stopped), run.history.clock.interval, float(crater is not None),
             crater.kd if crater is not None else 0.0, crater.c if crater is not None else 0.0, run.ke0,
-            events.STOP_ENERGY, *run.tip_arm, *(run.tail_ref - body.centre0), *body.I_body_inv.ravel()]
+            events.STOP_ENERGY, *run.tip_arm, *(run.tail_ref - body.centre0), *body.I_body_inv.ravel(),
+            *_tunnel_numbers(run.tunnel), *(run.shoulder_arm if run.tunnel is not None else np.zeros(3))]
+
+
+def _tunnel_numbers(t) -> list[float]:
+    if t is None:
+        return [0.0] * 5
+    b = t.buf
+    return [1.0, b[tunnel.T_SPACING], b[tunnel.T_XI_SH], b[tunnel.T_A0], b[tunnel.T_RAMP]]
+
+
+def _tunnel_room(runs) -> int:
+    """Stations a batch's tunnels need at most: the shoulder's path within the hard end, at most twice the
+    striking speed times it (speed only falls; the turning adds the arm's sweep), over the spacing."""
+    need = [2.0 * r.v0 * r.shot.hard_end / r.tunnel.buf[tunnel.T_SPACING] + 2.0 for r in runs if r.tunnel is not None]
+    return int(min(tunnel.CAPACITY, max(need))) if need else 0
 
 
 def _integrate(runs: list) -> list:
@@ -139,9 +156,14 @@ def _integrate(runs: list) -> list:
     laws = np.ascontiguousarray([tg._law_numbers(r.law) for r in runs], dtype=float)
     y = np.ascontiguousarray([r.state.as_array() for r in runs], dtype=float)
     res = np.zeros((n, len(RESULTS)))
+    cap = _tunnel_room(runs)
+    tlen = tunnel.HEADER + cap * (tunnel.STATION + tunnel.SECTORS)
+    tunnels = np.zeros((n, tlen)) if cap else None
+    xi = np.ascontiguousarray(g["X"][:, 1], dtype=float)
     t0 = time.perf_counter()
     check = lib.rigid_batch(n, k, *[a.ctypes.data for a in const], gauss.ctypes.data, len(gauss) // 2, points, moment,
-                            sp.ctypes.data, laws.ctypes.data, laws.shape[1], y.ctypes.data, res.ctypes.data)
+                            sp.ctypes.data, laws.ctypes.data, laws.shape[1], y.ctypes.data, res.ctypes.data,
+                            xi.ctypes.data, cap, tunnel.SECTORS, None if tunnels is None else tunnels.ctypes.data)
     loop_s = (time.perf_counter() - t0) / n
     if check < 0:
         raise MemoryError("rigid_batch: no memory for its scratch arrays (or a law of another length)")
@@ -155,6 +177,15 @@ def _integrate(runs: list) -> list:
             out.append(None)
             continue
         run.state = RigidState.from_array(yi)
+        if run.tunnel is not None:  # the shot's tunnel as it ended (its room: the batch's, all it needed)
+            ti = tunnels[len(out)]
+            if ti[tunnel.T_M] >= cap:  # full: the single path, whose room is larger, runs the shot
+                out.append(None)
+                continue
+            m = int(ti[tunnel.T_M])
+            run.tunnel.buf[:tunnel.HEADER + m * (tunnel.STATION + tunnel.SECTORS)] = ti[:tunnel.HEADER + m * (
+                tunnel.STATION + tunnel.SECTORS)]
+            run.tunnel.buf[tunnel.T_CAP] = tunnel.CAPACITY
         run.t, run.step_count, run.w_ext = float(ri[_R["t"]]), int(ri[_R["steps"]]), float(ri[_R["work"]])
         run.rules.entered = bool(ri[_R["entered"]])
         try:

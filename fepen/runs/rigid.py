@@ -26,6 +26,7 @@ from fepen.laws.rigid_body import (
     matrix_to_quat,
     tet_mass_properties,
 )
+from fepen.laws.tunnel import Tunnel
 from fepen.runs import budget, setup, shot
 from fepen.runs import probes as run_probes
 from fepen.runs.run import Removal, Run, Snapshot
@@ -162,6 +163,10 @@ class RigidRun(Run):
                 self.wear = Wear(sh.wear, g, y_c, r_c)
             else:
                 self.wear = Wear(sh.wear)
+        self.tunnel = None
+        if sh.tunnel_ramp is not None:
+            self.tunnel = Tunnel.of_points(g["X"], g["radius"], sh.tunnel_ramp)
+            self.shoulder_arm = np.array([0.0, self.tunnel.xi_sh, 0.0]) - self.body.centre0
         self.t, self.step_count = 0.0, 0
         self.prev = self.state
         self.F = self.body.derivative(self.state, self.force_fn)[1]  # the force of a row: at its step's start
@@ -174,8 +179,12 @@ class RigidRun(Run):
         g = self.pts
         R = self.body.frame[0]  # s's rotation (RigidBody.derivative)
         tip = s.c + R @ self.tip_arm
+        xi = None
+        if self.tunnel is not None:  # where the shoulder is now (the tunnel's open end)
+            self.tunnel.at(s.c + R @ self.shoulder_arm, -R[:, 1])
+            xi = np.ascontiguousarray(g["X"][:, 1])
         load = tg.load_on_points(self.law, x, v, n, g["area0"], g["radius"], g["R_meridian"], g["sin_phi0"],
-                                 -R[:, 1], self.crater, -tip[1])
+                                 -R[:, 1], self.crater, -tip[1], tunnel=self.tunnel, body_xi=xi)
         self.loaded, self.area = load.loaded, load.area
         if self.wear is not None:
             self.wear.stage(load.force, n, v)
@@ -188,6 +197,8 @@ class RigidRun(Run):
     def step(self) -> None:
         """One RK4 step (the force kept for the history is the step's start's), then the wear."""
         self.prev = s = self.state
+        if self.tunnel is not None:
+            self.tunnel.commit = True  # the first stage records the tunnel at the step's start
         s, self.F, _, work = self.body.rk4_step(s, self.dt, self.force_fn)
         self.w_ext += work
         if self.wear is not None:

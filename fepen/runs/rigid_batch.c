@@ -21,27 +21,39 @@
 #include "../laws/target_kernel.c"
 
 
-/* The law (target_kernel.c's law_at_point) on k points with one shortcut that changes no bit: ell = sqrt(area)
- * given. f is written only at the points it loads (their indices into idx, in order), and only their forces are
- * summed (the others are zero). Returns how many. */
+/* The law (target_kernel.c's law_at_point, with point_forces's tunnel: a step's first stage records a station
+ * and pushes the wall out) on k points with one shortcut that changes no bit: ell = sqrt(area) given. f is
+ * written only at the points it loads (their indices into idx, in order; their stresses into sg), and only their
+ * forces are summed (the others are zero). Returns how many. */
 __attribute__((noinline)) static int32_t law_points(int32_t k, const double *x, const double *v, const double *n,
                                                     const double *area, const double *ell, const double *radius,
                                                     const double *Rm, const double *sphi0, const double *axis,
                                                     const double *p, const double *gauss, int32_t ng, double *f,
-                                                    int32_t *idx, double *sums) {
+                                                    int32_t *idx, double *sums, const double *body_xi, double *T,
+                                                    double *sgs) {
     const LawConstants c = law_constants(p);
+    const int commit = T && T[T_COMMIT] != 0.0;
+    if (commit) tunnel_record(T);
     int32_t m = 0;
     for (int j = 0; j < 5; ++j) sums[j] = 0.0;
     for (int32_t i = 0; i < k; ++i) {
         double sg = 0.0;
+        WallHit hit;
+        const WallHit *wall = wall_of(T, x + 3 * i, T ? body_xi[i] : 0.0, &hit);
         if (!law_at_point(p, &c, x + 3 * i, v + 3 * i, n + 3 * i, area[i], ell[i], radius[i], Rm[i], sphi0[i], axis,
-                          gauss, ng, f + 3 * i, &sg))
+                          wall, gauss, ng, f + 3 * i, &sg))
             continue;
         if (sg > 0.0) {
             sums[3] += 1.0;
             sums[4] += area[i];
         }
+        sgs[m] = sg;
         idx[m++] = i;
+    }
+    if (commit) {
+        for (int32_t j = 0; j < m; ++j)
+            if (sgs[j] > 0.0) tunnel_expand(T, x + 3 * idx[j], body_xi[idx[j]]);
+        T[T_COMMIT] = 0.0;
     }
     for (int32_t j = 0; j < m; ++j) {
         const double *fi = f + 3 * idx[j];
@@ -77,7 +89,8 @@ static void moment_points(moment_fn moment, int32_t k, int32_t m, const int32_t 
 enum { S_MASS, S_DT, S_HARD_END, S_THICKNESS /* < 0: none */, S_UNTIL_STOPPED, S_HISTORY /* <= 0: none */,
        S_CRATER /* 1: the linear crater */, S_CRATER_KD, S_CRATER_C, S_KE0, S_STOP_ENERGY,
        S_TIP /* 3: the tip about the centre */, S_TAIL = S_TIP + 3, S_IINV = S_TAIL + 3 /* 9 */,
-       S_COUNT = S_IINV + 9 };
+       S_TUNNEL = S_IINV + 9 /* 1: the tunnel (tunnel_kernel.c) */, S_SPACING, S_XI_SH, S_A0, S_RAMP,
+       S_SHOULDER /* 3: the shoulder's centre about the body's centre */, S_COUNT = S_SHOULDER + 3 };
 /* per-shot results */
 enum { R_T, R_STEPS, R_OUTCOME /* 0 ended, 1 perforated, 2 ricochet, 3 embedded */, R_WORK, R_ENTERED,
        R_MAX_NOSE /* mm */, R_MAX_ERROR, R_ROWS, R_STATUS /* 0 ok, 1 a non-finite state */, R_COUNT };
@@ -90,6 +103,9 @@ typedef struct {
     double at[13], R[9], w[3]; /* the state whose points x, v, n, arm hold (at[3] = 2: none), its R and omega */
     double *x, *v, *n, *arm, *f; /* scratch (f zero outside the points a law call loads) */
     int32_t *idx;
+    const double *xi; /* each point's distance behind the tip, body frame */
+    double *T, *tunnel, *sg; /* the shot's tunnel (NULL: none), its buffer, the loaded points' stresses */
+    int32_t cap, sectors;
 } Body;
 
 /* numpy's dot of two 3- or 4-vectors: from 0, left to right */
@@ -151,8 +167,16 @@ static void derivative(Body *b, const double *sp, const double *law, const doubl
     matvec(R, sp + S_TIP, tip);
     for (int j = 0; j < 3; ++j) tip[j] = y[j] + tip[j];
     for (int j = 0; j < 3; ++j) axis[j] = -R[3 * j + 1];
+    if (b->T) { /* RigidRun.force_fn: the shoulder and the axis now, for the tunnel */
+        double sh[3];
+        matvec(R, sp + S_SHOULDER, sh);
+        for (int j = 0; j < 3; ++j) {
+            b->T[T_CS + j] = y[j] + sh[j];
+            b->T[T_TS + j] = axis[j];
+        }
+    }
     int32_t m = law_points(b->k, b->x, b->v, b->n, b->area, b->ell, b->radius, b->Rm, b->sphi0, axis, law,
-                           b->gauss, b->ng, b->f, b->idx, sums);
+                           b->gauss, b->ng, b->f, b->idx, sums, b->xi, b->T, b->sg);
     if (sp[S_CRATER] != 0.0) { /* ForrestalCrater.scale(-tip[1], -(total . axis)) */
         double depth = -tip[1], axial = -dot3(sums, axis), scale = 1.0;
         if (!(depth >= sp[S_CRATER_KD] || axial <= 0.0)) scale = fmax(depth, 0.0) * sp[S_CRATER_C] / axial;
@@ -186,6 +210,7 @@ static double rk4(Body *b, const double *sp, const double *law, double *y, doubl
             for (int j = 0; j < 13; ++j) s[j] = y[j] + cdt * k[i - 1][j];
         } else {
             memcpy(s, y, sizeof s);
+            if (b->T) b->T[T_COMMIT] = 1.0; /* RigidRun.step: the step's first stage records the tunnel */
         }
         derivative(b, sp, law, s, k[i], FM, &P, &loaded, &area);
         if (i == 0) memcpy(F0, FM, 3 * sizeof(double));
@@ -229,6 +254,13 @@ static int finite13(const double *y) {
 /* One shot from y (13) at t = 0 to its end or stop; y becomes the final state. */
 static void one_shot(Body *b, const double *sp, const double *law, double *y, double *res) {
     b->at[3] = 2.0; /* no unit quaternion: nothing kept from the last shot (another inertia) */
+    b->T = NULL;
+    if (sp[S_TUNNEL] != 0.0 && b->tunnel) { /* fepen.laws.tunnel.Tunnel's header, empty */
+        double *T = b->T = b->tunnel;
+        for (int j = 0; j < T_HEADER; ++j) T[j] = 0.0;
+        T[T_CAP] = b->cap; T[T_S] = b->sectors; T[T_SPACING] = sp[S_SPACING]; T[T_XI_SH] = sp[S_XI_SH];
+        T[T_A0] = sp[S_A0]; T[T_RAMP] = sp[S_RAMP];
+    }
     double t = 0.0, work = 0.0, next = 0.0, prev[13], R[9], w[3];
     double max_nose = -INFINITY, max_error = -INFINITY, rows = 0.0;
     int64_t steps = 0;
@@ -300,11 +332,11 @@ static void one_shot(Body *b, const double *sp, const double *law, double *y, do
 int32_t rigid_batch(int32_t n, int32_t k, const double *r0, const double *N0, const double *area, const double *ell,
                     const double *radius, const double *Rm, const double *sphi0, const double *gauss, int32_t ng,
                     void *points, void *moment, const double *sp, const double *laws, int32_t nlaw, double *y,
-                    double *res) {
+                    double *res, const double *xi, int32_t cap, int32_t sectors, double *tunnels) {
     Body b = {k, ng, r0, N0, area, ell, radius, Rm, sphi0, gauss, (points_fn)points, (moment_fn)moment, {0}, {0},
-              {0}, NULL, NULL, NULL, NULL, NULL, NULL};
+              {0}, NULL, NULL, NULL, NULL, NULL, NULL, xi, NULL, NULL, NULL, cap, sectors};
     size_t kk = (size_t)(k > 0 ? k : 1);
-    double *scratch = calloc(15 * kk, sizeof(double));
+    double *scratch = calloc(16 * kk, sizeof(double));
     int32_t *idx = malloc(sizeof(int32_t) * kk);
     if (!scratch || !idx || nlaw != P_COUNT) {
         free(scratch);
@@ -312,8 +344,12 @@ int32_t rigid_batch(int32_t n, int32_t k, const double *r0, const double *N0, co
         return -1;
     }
     b.x = scratch; b.v = b.x + 3 * k; b.n = b.v + 3 * k; b.arm = b.n + 3 * k; b.f = b.arm + 3 * k; b.idx = idx;
-    for (int32_t s = 0; s < n; ++s)
+    b.sg = b.f + 3 * k;
+    const size_t tlen = (size_t)(T_HEADER + (int64_t)cap * (T_STATION + sectors));
+    for (int32_t s = 0; s < n; ++s) {
+        b.tunnel = tunnels ? tunnels + (size_t)s * tlen : NULL; /* each shot's own: its final tunnel stays */
         one_shot(&b, sp + (size_t)s * S_COUNT, laws + (size_t)s * nlaw, y + (size_t)s * 13, res + (size_t)s * R_COUNT);
+    }
     free(scratch);
     free(idx);
     return S_COUNT * 10000 + R_COUNT * 100 + P_COUNT;
@@ -325,8 +361,11 @@ void batch_law(int32_t k, const double *x, const double *v, const double *n, con
                const double *radius, const double *Rm, const double *sphi0, const double *axis, const double *p,
                const double *gauss, int32_t ng, double *f, double *sums) {
     int32_t *idx = malloc(sizeof(int32_t) * (size_t)(k > 0 ? k : 1));
-    if (!idx) return;
-    for (int32_t i = 0; i < 3 * k; ++i) f[i] = 0.0;
-    law_points(k, x, v, n, area, ell, radius, Rm, sphi0, axis, p, gauss, ng, f, idx, sums);
+    double *sg = malloc(sizeof(double) * (size_t)(k > 0 ? k : 1));
+    if (idx && sg) {
+        for (int32_t i = 0; i < 3 * k; ++i) f[i] = 0.0;
+        law_points(k, x, v, n, area, ell, radius, Rm, sphi0, axis, p, gauss, ng, f, idx, sums, NULL, NULL, sg);
+    }
     free(idx);
+    free(sg);
 }

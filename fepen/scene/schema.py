@@ -275,6 +275,10 @@ SCHEMA: dict[str, Key] = {
     "target.crush_strain": number(ABSENT, "", 0.0, 1.0, lo_open=True,
                                   doc="epsilon of the energy crater's strength energy; absent: 1 - density / "
                                       "lock_density; the default 'concrete' gives 0.376 (calibrated)"),
+    "target.wall_ramp_speed": number(5.0, "m/s", 0.01, 1000.0,
+                                     doc="effects.tunnel: the quasi-static stress of the tunnel's wall develops over "
+                                         "this outward speed of the point pressing it (a smooth load at vanishing "
+                                         "speed; docs/theory.md §8.7)"),
     "target.free_surface_range": number(1.0, "", 0.0, 20.0, lo_open=True,
                                         doc="reach of the free face on sigma_s, in plastic-zone widths "
                                             "(effects.free_surface; docs/theory.md §8.4); the default "
@@ -310,6 +314,9 @@ SCHEMA: dict[str, Key] = {
                                  "docs/theory.md §8.3)"),
     "effects.separation": flag(True, doc="flow separation: surface points meeting their motion at less than "
                                          "target.separation_angle_deg carry no load (docs/theory.md §8.4)"),
+    "effects.tunnel": flag(True, doc="the tunnel the nose opens is kept: the body behind the nose is loaded only "
+                                     "where it presses into the tunnel's wall (tail slap), whatever the "
+                                     "separation angle; targets of one material (docs/theory.md §8.7)"),
     "effects.free_surface": flag(True, doc="the target's faces cut the cavity expansion's plastic zone: sigma_s "
                                            "falls toward the strength near a face (target.free_surface_range)"),
     "effects.friction": flag(False, doc="Coulomb friction of the target: shear target.friction sigma_n against "

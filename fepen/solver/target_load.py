@@ -11,6 +11,7 @@ from __future__ import annotations
 from time import perf_counter
 
 import numpy as np
+from mpi4py import MPI
 
 from fepen.geometry.frames import unit_axis
 from fepen.laws import target as tg
@@ -30,10 +31,23 @@ class TargetLoad:
         law: the TargetLaw.
         tip, tail: (owner, local) node handles of the nose tip and tail centre (probes.node_at).
         crater: a ForrestalCrater for the linear crater, else None.
+        tunnel_ramp: target.wall_ramp_speed (m/s) to keep the tunnel the projectile opens (fepen.laws.tunnel),
+            or None. Its shoulder is found on the reference surface of all ranks; each step records a station and
+            pushes the wall out where the points press it, the wall's radii taken as their largest over the
+            ranks, so the tunnel is the same on any partition.
     """
 
-    def __init__(self, solver, surf: Surface, law: tg.TargetLaw, tip, tail, crater=None):
+    def __init__(self, solver, surf: Surface, law: tg.TargetLaw, tip, tail, crater=None, tunnel_ramp=None):
         self.surf, self.law, self.tip, self.tail, self.crater = surf, law, tip, tail, crater
+        self.tunnel = None
+        if tunnel_ramp is not None:
+            from fepen.laws.tunnel import Tunnel
+
+            comm = solver.comm
+            a0 = comm.allreduce(float(np.max(surf.radius, initial=0.0)), op=MPI.MAX)
+            wide = surf.radius >= (1.0 - 1e-3) * a0
+            xi_sh = comm.allreduce(float(np.min(surf.X[wide, 1], initial=np.inf)), op=MPI.MIN)
+            self.tunnel = Tunnel(xi_sh, a0, tunnel_ramp)
         self.force = np.zeros(3)
         self.contact_nodes = 0
         self.area = 0.0
@@ -72,8 +86,17 @@ class TargetLoad:
 
         x, v, area, n = self.surf.kinematics(x_all, solver.Vel)
         s = self.surf
+        xi = None
+        if self.tunnel is not None:  # the shoulder on the deformed axis, tip to tail
+            self.tunnel.at(tip - self.tunnel.xi_sh * axis, axis)
+            self.tunnel.commit = True
+            xi = np.ascontiguousarray(s.X[:, 1])
         load = tg.load_on_points(self.law, x, v, n, area, s.radius, s.R_meridian, s.sin_phi0, axis, self.crater,
-                                 -tip[1], reduce)
+                                 -tip[1], reduce, tunnel=self.tunnel, body_xi=xi)
+        if self.tunnel is not None and comm.size > 1:  # every rank's pushes of the wall
+            t1 = perf_counter()
+            comm.Allreduce(MPI.IN_PLACE, self.tunnel.recorded(), op=MPI.MAX)
+            comm_s += perf_counter() - t1
         if self.wear is not None:
             self.wear.add(load.force, n, v, dt)
         t1 = perf_counter()
@@ -86,9 +109,14 @@ class TargetLoad:
 
     def state(self) -> dict[str, np.ndarray]:
         """The load's last totals (for checkpoints; the same on every rank)."""
-        return {"force": np.asarray(self.force, dtype=float), "totals": np.array([self.contact_nodes, self.area])}
+        out = {"force": np.asarray(self.force, dtype=float), "totals": np.array([self.contact_nodes, self.area])}
+        if self.tunnel is not None:
+            out["tunnel"] = self.tunnel.state()
+        return out
 
     def restore(self, state: dict) -> None:
         """Put back what state() returned."""
         self.force = np.array(state["force"][:3])
         self.contact_nodes, self.area = int(state["totals"][0]), float(state["totals"][1])
+        if self.tunnel is not None and "tunnel" in state:
+            self.tunnel.restore(np.asarray(state["tunnel"]))

@@ -1,0 +1,175 @@
+/* The tunnel the projectile opens (docs/theory.md §8.7), its one home: target_kernel.c includes this file, so
+ * the single rigid path, the batched rigid shots and the deformable load all record it and locate their points
+ * in it with this text.
+ *
+ * The tunnel is a chain of stations along the path of the projectile's widest section (the "shoulder": the
+ * section where the nose first reaches the full calibre): each station a centre c, a unit direction t along the
+ * path, its arc length s and, in S angular sectors about t, the radius a the cavity has been opened to there
+ * (the shoulder's radius a0 when recorded, pushed outward where the body later expands the wall). A station is
+ * recorded once the shoulder is below the face and has advanced `spacing` along the path since the last one;
+ * the shoulder itself, where it is now, is the tunnel's open end.
+ *
+ * A surface point at body-axial distance xi behind the tip (xi_sh: the shoulder's) lies, when the body follows its
+ * tunnel, at arc length s_now - (xi - xi_sh); one projection onto the interpolated axis corrects that for a body
+ * turned in its tunnel. Its distance rho from the axis against the wall's radius a there gives delta = rho - a
+ * (> 0: pushed into the wall) and the outward unit vector er. Points ahead of the shoulder are not in the tunnel
+ * (the nose, which opens it, follows the law of the open face).
+ *
+ * The state is one flat array of doubles (fepen.laws.tunnel.Tunnel owns it in Python; rigid_batch.c one per
+ * shot): a header of T_HEADER numbers, then the stations, each T_STATION + S numbers. */
+#ifndef FEPEN_TUNNEL_KERNEL
+#define FEPEN_TUNNEL_KERNEL
+#include <math.h>
+#include <stdint.h>
+
+enum { T_M /* stations recorded */, T_CAP /* room for stations */, T_S /* sectors */, T_SPACING /* m */,
+       T_XI_SH /* the shoulder's distance behind the tip, body frame (m) */, T_A0 /* its radius (m) */,
+       T_RAMP /* the wall's stress develops over this outward speed (m/s) */,
+       T_COMMIT /* 1: this call records the station and the wall's expansion (a step's first stage) */,
+       T_CS /* the shoulder's centre now (3) */, T_TS = T_CS + 3 /* the axis now, tail to nose (3) */,
+       T_FACE = T_TS + 3 /* the face's y: the shoulder is in once below it */, T_HEADER = 16 };
+enum { T_C /* centre (3) */, T_T = 3 /* direction (3) */, T_ARC = 6 /* arc length */, T_STATION = 8 /* then a[S] */ };
+
+static inline double *tunnel_station(double *T, int32_t k) {
+    return T + T_HEADER + (int64_t)k * (T_STATION + (int32_t)T[T_S]);
+}
+
+static inline double tdot(const double *a, const double *b) { return a[0] * b[0] + a[1] * b[1] + a[2] * b[2]; }
+
+/* Where a station-to-be lies: the centre, direction and arc length of the interpolated axis at arc length s, the
+ * two stations around it (ib == m: the shoulder now, the open end) and the weight of the second. */
+typedef struct {
+    double c[3], t[3], w;
+    int32_t ia, ib;
+} TunnelAt;
+
+/* the shoulder now as a station: its centre, its direction from the last station, its arc length */
+static void tunnel_open_end(const double *T, double *c, double *t, double *s) {
+    const int32_t m = (int32_t)T[T_M];
+    const double *last = tunnel_station((double *)T, m - 1);
+    double d[3] = {T[T_CS] - last[T_C], T[T_CS + 1] - last[T_C + 1], T[T_CS + 2] - last[T_C + 2]};
+    double along = tdot(d, last + T_T), len = sqrt(tdot(d, d));
+    for (int j = 0; j < 3; ++j) {
+        c[j] = T[T_CS + j];
+        t[j] = len > 1e-12 ? d[j] / len : last[T_T + j];
+    }
+    *s = last[T_ARC] + along;
+}
+
+static void tunnel_at(const double *T, double s, const double *c_end, const double *t_end, double s_end,
+                      TunnelAt *at) {
+    const int32_t m = (int32_t)T[T_M];
+    int32_t lo = 0, hi = m; /* stations 0..m-1 recorded, m the open end */
+    if (s >= tunnel_station((double *)T, m - 1)[T_ARC]) {
+        lo = m - 1;
+    } else {
+        while (hi - lo > 1) { /* the last recorded station at or before s */
+            int32_t mid = (lo + hi) / 2;
+            if (tunnel_station((double *)T, mid)[T_ARC] <= s) lo = mid;
+            else hi = mid;
+        }
+    }
+    const double *a = tunnel_station((double *)T, lo);
+    const double *b_c = lo + 1 < m ? tunnel_station((double *)T, lo + 1) + T_C : c_end;
+    const double *b_t = lo + 1 < m ? tunnel_station((double *)T, lo + 1) + T_T : t_end;
+    double sb = lo + 1 < m ? tunnel_station((double *)T, lo + 1)[T_ARC] : s_end;
+    double span = sb - a[T_ARC], w = span > 1e-15 ? (s - a[T_ARC]) / span : 1.0;
+    w = w < 0.0 ? 0.0 : (w > 1.0 ? 1.0 : w);
+    double n2 = 0.0;
+    for (int j = 0; j < 3; ++j) {
+        at->c[j] = a[T_C + j] + w * (b_c[j] - a[T_C + j]);
+        at->t[j] = a[T_T + j] + w * (b_t[j] - a[T_T + j]);
+        n2 += at->t[j] * at->t[j];
+    }
+    double nt = sqrt(n2);
+    for (int j = 0; j < 3; ++j) at->t[j] /= nt;
+    at->ia = lo;
+    at->ib = lo + 1;
+    at->w = w;
+}
+
+/* A point p at body-axial distance xi in the tunnel: returns 1 with its penetration of the wall delta (m), the
+ * outward unit vector er, its nearest recorded station kn (-1: the open end) and sector sec and its distance
+ * rho from the axis; 0 when it is not in the tunnel (ahead of the shoulder, no station yet, or on the axis). */
+static int tunnel_locate(const double *T, const double *p, double xi, double *delta, double *er, int32_t *kn,
+                         int32_t *sec, double *rho) {
+    const int32_t m = (int32_t)T[T_M], S = (int32_t)T[T_S];
+    if (m < 1) return 0;
+    double c_end[3], t_end[3], s_end;
+    tunnel_open_end(T, c_end, t_end, &s_end);
+    double s = s_end - (xi - T[T_XI_SH]);
+    if (s > s_end) return 0; /* ahead of the shoulder: the nose */
+    const double s0 = tunnel_station((double *)T, 0)[T_ARC];
+    if (s < s0) s = s0;
+    TunnelAt at;
+    tunnel_at(T, s, c_end, t_end, s_end, &at);
+    double d[3] = {p[0] - at.c[0], p[1] - at.c[1], p[2] - at.c[2]};
+    s += tdot(d, at.t); /* one projection onto the axis: a body turned in its tunnel */
+    if (s > s_end) s = s_end;
+    if (s < s0) s = s0;
+    tunnel_at(T, s, c_end, t_end, s_end, &at);
+    for (int j = 0; j < 3; ++j) d[j] = p[j] - at.c[j];
+    double along = tdot(d, at.t), r[3];
+    for (int j = 0; j < 3; ++j) r[j] = d[j] - along * at.t[j];
+    double rr = sqrt(tdot(r, r));
+    if (!(rr > 1e-12)) return 0;
+    for (int j = 0; j < 3; ++j) er[j] = r[j] / rr;
+    /* the sector: the angle of r about t from e1, the world z axis's part across t (x when t is along z) */
+    double e1[3] = {-at.t[2] * at.t[0], -at.t[2] * at.t[1], 1.0 - at.t[2] * at.t[2]};
+    double n1 = sqrt(tdot(e1, e1));
+    if (n1 < 1e-6) {
+        e1[0] = 1.0 - at.t[0] * at.t[0]; e1[1] = -at.t[0] * at.t[1]; e1[2] = -at.t[0] * at.t[2];
+        n1 = sqrt(tdot(e1, e1));
+    }
+    for (int j = 0; j < 3; ++j) e1[j] /= n1;
+    double e2[3] = {at.t[1] * e1[2] - at.t[2] * e1[1], at.t[2] * e1[0] - at.t[0] * e1[2],
+                    at.t[0] * e1[1] - at.t[1] * e1[0]};
+    double theta = atan2(tdot(r, e2), tdot(r, e1));
+    int32_t q = (int32_t)floor((theta + M_PI) / (2.0 * M_PI) * S);
+    q = q < 0 ? 0 : (q >= S ? S - 1 : q);
+    double a_lo = tunnel_station((double *)T, at.ia)[T_STATION + q];
+    double a_hi = at.ib < m ? tunnel_station((double *)T, at.ib)[T_STATION + q] : T[T_A0];
+    *delta = rr - (a_lo + at.w * (a_hi - a_lo));
+    *rho = rr;
+    *sec = q;
+    *kn = at.w < 0.5 ? at.ia : (at.ib < m ? at.ib : -1);
+    return 1;
+}
+
+/* A step's first stage: a new station at the shoulder once it is below the face and has advanced `spacing` along
+ * the path since the last (none once the room is full: the tunnel then ends there). */
+static void tunnel_record(double *T) {
+    const int32_t m = (int32_t)T[T_M], S = (int32_t)T[T_S];
+    if (!(T[T_CS + 1] < T[T_FACE]) || m >= (int32_t)T[T_CAP]) return;
+    double *st = tunnel_station(T, m);
+    if (m == 0) {
+        for (int j = 0; j < 3; ++j) {
+            st[T_C + j] = T[T_CS + j];
+            st[T_T + j] = T[T_TS + j];
+        }
+        st[T_ARC] = 0.0;
+    } else {
+        double c[3], t[3], s;
+        tunnel_open_end(T, c, t, &s);
+        if (!(s - tunnel_station(T, m - 1)[T_ARC] >= T[T_SPACING])) return;
+        for (int j = 0; j < 3; ++j) {
+            st[T_C + j] = c[j];
+            st[T_T + j] = t[j];
+        }
+        st[T_ARC] = s;
+    }
+    st[T_ARC + 1] = 0.0;
+    for (int32_t q = 0; q < S; ++q) st[T_STATION + q] = T[T_A0];
+    T[T_M] = m + 1;
+}
+
+/* A step's first stage, after the law: the wall pushed out to every point the wall loads (the plastic cavity
+ * keeps the radius it was opened to), at the point's nearest recorded station and sector. */
+static void tunnel_expand(double *T, const double *p, double xi) {
+    double delta, er[3], rho;
+    int32_t kn, sec;
+    if (!tunnel_locate(T, p, xi, &delta, er, &kn, &sec, &rho) || kn < 0) return;
+    double *a = tunnel_station(T, kn) + T_STATION + sec;
+    if (rho > *a) *a = rho;
+}
+#endif
