@@ -191,6 +191,8 @@ class TargetLaw:
             touching layers (fepen.laws.layers): it loads only points between them, while the free faces of
             the crater, the free-surface rule and the perforation stay those of the block (0, thickness).
             bottom None: thickness.
+        onset_speed: σ_s develops over the first onset_speed (m/s) of a point's speed into the target (its normal
+            speed; at the tunnel's wall its outward speed): a smooth load at vanishing speed (§8.7); 0: at once.
     """
 
     density: float
@@ -219,6 +221,7 @@ class TargetLaw:
     top: float = 0.0
     bottom: float | None = None
     surface_range: float = 1.0
+    onset_speed: float = 0.0
 
     @property
     def lower(self) -> float | None:
@@ -338,7 +341,7 @@ def _law_numbers(law: TargetLaw) -> np.ndarray:
                      law.phi_min, float(law.free_surface), float(law.friction), law.mu,
                      law.mu if law.mu_dynamic is None else law.mu_dynamic, law.mu_decay, law.lock_density,
                      law.crush_strain, law.c_over_a, float(law.given_sigma_s), law.onset, law.top,
-                     -1.0 if law.lower is None else law.lower, law.surface_range])
+                     -1.0 if law.lower is None else law.lower, law.surface_range, law.onset_speed])
 
 
 def _bind(lib):

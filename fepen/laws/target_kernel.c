@@ -12,16 +12,17 @@ enum { P_DENSITY, P_Y, P_E, P_T, P_LAM, P_SIGMA_S, P_B, P_THICKNESS /* < 0: none
        P_K, P_D, P_SEPARATION, P_PHI_MIN, P_FREE_SURFACE, P_FRICTION, P_MU, P_MU_DYNAMIC, P_MU_DECAY,
        P_LOCK_DENSITY, P_CRUSH_STRAIN, P_C_OVER_A, P_GIVEN_SIGMA_S, P_ONSET,
        P_TOP /* the material's own faces in a block of layers */, P_LOWER /* < 0: none */,
-       P_SURFACE_RANGE /* the free face's reach in plastic-zone widths */, P_COUNT };
+       P_SURFACE_RANGE /* the free face's reach in plastic-zone widths */,
+       P_ONSET_SPEED /* sigma_s develops over the first onset_speed of a point's normal speed (m/s); 0: at once */,
+       P_COUNT };
 
 #define SIN_TOL 1e-9
 
 #include "tunnel_kernel.c"
 
-/* A point in the tunnel (tunnel_kernel.c): its penetration of the wall (m), the outward unit vector, and the
- * outward speed over which the wall's quasi-static stress develops (m/s) */
+/* A point in the tunnel (tunnel_kernel.c): its penetration of the wall (m) and the outward unit vector */
 typedef struct {
-    double delta, er[3], ramp;
+    double delta, er[3];
 } WallHit;
 
 static double clip01(double x) { return x < 0.0 ? 0.0 : (x > 1.0 ? 1.0 : x); }
@@ -93,8 +94,11 @@ static inline int law_at_point(const double *p, const LawConstants *c, const dou
         if (ca == p[P_C_OVER_A]) s = c->whole;
         else s = p[P_GIVEN_SIGMA_S] != 0.0 ? p[P_SIGMA_S] * cavity_stress(p, ca) / c->ref : cavity_stress(p, ca);
     }
-    if (wall) s *= fmin(u / wall->ramp, 1.0); /* the wall's stress develops over the first `ramp` of outward speed */
-    else if (p[P_ONSET] > 0.0) s *= fmin(sin_phi / c->sin_onset, 1.0);
+    if (!wall && p[P_ONSET] > 0.0) s *= fmin(sin_phi / c->sin_onset, 1.0);
+    /* at vanishing speed (§8.7): sigma_s develops over the first onset_speed of the point's speed into the target
+     * (its normal speed; at the tunnel's wall its outward speed), so a body coming to rest is not loaded by the
+     * whole rate-independent stress on every point that happens to face its last motion */
+    if (p[P_ONSET_SPEED] > 0.0) s *= fmin((wall ? u : vn) / p[P_ONSET_SPEED], 1.0);
     double sg = (s + p[P_B] * p[P_DENSITY] * vn * vn) * frac;
     if (p[P_CRATER] == 2.0 && -y < p[P_K] * p[P_D]) { /* the splash-streamline energy balance (§8.3) */
         double rho = fmax(radius, 1e-12), l = (p[P_C_OVER_A] - 1.0) * rho, integral = 0.0;
@@ -132,7 +136,6 @@ static inline const WallHit *wall_of(const double *T, const double *xi_point, do
     int32_t kn, sec;
     double rho;
     if (!tunnel_locate(T, xi_point, xi, &hit->delta, hit->er, &kn, &sec, &rho)) return 0;
-    hit->ramp = T[T_RAMP];
     return hit;
 }
 

@@ -5,10 +5,10 @@ The tunnel is recorded along the path of the body's widest section (the shoulder
 ``spacing`` along the path, each with the radius the cavity has been opened to in ``SECTORS`` angular sectors;
 the wall is pushed out where the body later presses into it. Any surface point behind the shoulder is in the
 tunnel: the target loads it only where it presses into that wall, with the cavity-expansion stress of its own
-normal velocity (the quasi-static part developing over the first ``ramp`` m/s of outward speed), whatever the
-separation angle. The nose, ahead of the shoulder, opens the tunnel under the law of the open face.
+normal velocity, whatever the separation angle (its quasi-static part developing over the law's onset_speed
+of outward speed). The nose, ahead of the shoulder, opens the tunnel under the law of the open face.
 
-    t = Tunnel.of_points(X, radius, ramp=...)     from a body's load points (body frame: tip at y = 0, axis +y)
+    t = Tunnel.of_points(X, radius)                from a body's load points (body frame: tip at y = 0, axis +y)
     t.at(shoulder, axis)                           before each force evaluation: where the shoulder is now
     t.commit = True                                before a step's first stage: record and expand there
     t.stations()                                   what has been recorded (for outputs)
@@ -28,7 +28,7 @@ SECTORS = 16
 CAPACITY = 4096
 #: tunnel_kernel.c's layout: the header's length, its fields, a station's fixed part
 HEADER, STATION = 16, 8
-T_M, T_CAP, T_S, T_SPACING, T_XI_SH, T_A0, T_RAMP, T_COMMIT, T_CS, T_TS, T_FACE = 0, 1, 2, 3, 4, 5, 6, 7, 8, 11, 14
+T_M, T_CAP, T_S, T_SPACING, T_XI_SH, T_A0, T_COMMIT, T_CS, T_TS, T_FACE = 0, 1, 2, 3, 4, 5, 7, 8, 11, 14
 
 
 def shoulder_of(X: np.ndarray, radius: np.ndarray) -> tuple[float, float]:
@@ -45,13 +45,11 @@ class Tunnel:
 
     Args:
         xi_sh: the shoulder's distance behind the tip, body frame (m). a0: its radius (m).
-        ramp: the outward speed over which the wall's quasi-static stress develops (m/s).
         spacing: the path between stations (m; default a0 / 2).
     """
 
     xi_sh: float
     a0: float
-    ramp: float
     spacing: float | None = None
 
     def __post_init__(self):
@@ -59,13 +57,13 @@ class Tunnel:
         b = self.buf
         b[T_CAP], b[T_S] = CAPACITY, SECTORS
         b[T_SPACING] = self.spacing if self.spacing is not None else 0.5 * self.a0
-        b[T_XI_SH], b[T_A0], b[T_RAMP] = self.xi_sh, self.a0, self.ramp
+        b[T_XI_SH], b[T_A0] = self.xi_sh, self.a0
 
     @classmethod
-    def of_points(cls, X: np.ndarray, radius: np.ndarray, ramp: float) -> Tunnel:
+    def of_points(cls, X: np.ndarray, radius: np.ndarray) -> Tunnel:
         """The tunnel of a body with load points X (body frame) at distances ``radius`` from its axis."""
         xi_sh, a0 = shoulder_of(X, radius)
-        return cls(xi_sh, a0, ramp)
+        return cls(xi_sh, a0)
 
     def at(self, shoulder: np.ndarray, axis: np.ndarray) -> None:
         """Where the shoulder's centre is now and the axis (tail to nose), before the law is called."""

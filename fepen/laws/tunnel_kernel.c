@@ -24,7 +24,7 @@
 
 enum { T_M /* stations recorded */, T_CAP /* room for stations */, T_S /* sectors */, T_SPACING /* m */,
        T_XI_SH /* the shoulder's distance behind the tip, body frame (m) */, T_A0 /* its radius (m) */,
-       T_RAMP /* the wall's stress develops over this outward speed (m/s) */,
+       T_RESERVED,
        T_COMMIT /* 1: this call records the station and the wall's expansion (a step's first stage) */,
        T_CS /* the shoulder's centre now (3) */, T_TS = T_CS + 3 /* the axis now, tail to nose (3) */,
        T_FACE = T_TS + 3 /* the face's y: the shoulder is in once below it */, T_HEADER = 16 };

@@ -37,7 +37,7 @@ __all__ = ["summaries", "reason", "kernel", "SHOT_NUMBERS", "RESULTS", "OUTCOMES
 SHOT_NUMBERS = ("mass", "dt", "hard_end", "thickness", "until_stopped", "history_interval", "crater",
                 "crater_kd", "crater_c", "ke0", "stop_energy", "tip_x", "tip_y", "tip_z", "tail_x", "tail_y",
                 "tail_z", *[f"I_inv_{i}{j}" for i in range(3) for j in range(3)], "tunnel", "tunnel_spacing",
-                "shoulder_xi", "shoulder_radius", "wall_ramp_speed", "shoulder_x", "shoulder_y", "shoulder_z")
+                "shoulder_xi", "shoulder_radius", "reserved", "shoulder_x", "shoulder_y", "shoulder_z")
 #: the per-shot results it writes (its R_ enum)
 RESULTS = ("t", "steps", "outcome", "work", "entered", "max_nose_mm", "max_error", "rows", "status")
 #: outcome codes of the kernel (events_kernel.c's penetration_rule)
@@ -133,7 +133,7 @@ def _tunnel_numbers(t) -> list[float]:
     if t is None:
         return [0.0] * 5
     b = t.buf
-    return [1.0, b[tunnel.T_SPACING], b[tunnel.T_XI_SH], b[tunnel.T_A0], b[tunnel.T_RAMP]]
+    return [1.0, b[tunnel.T_SPACING], b[tunnel.T_XI_SH], b[tunnel.T_A0], 0.0]
 
 
 def _tunnel_room(runs) -> int:

@@ -164,8 +164,8 @@ class RigidRun(Run):
             else:
                 self.wear = Wear(sh.wear)
         self.tunnel = None
-        if sh.tunnel_ramp is not None:
-            self.tunnel = Tunnel.of_points(g["X"], g["radius"], sh.tunnel_ramp)
+        if sh.tunnel:
+            self.tunnel = Tunnel.of_points(g["X"], g["radius"])
             self.shoulder_arm = np.array([0.0, self.tunnel.xi_sh, 0.0]) - self.body.centre0
         self.t, self.step_count = 0.0, 0
         self.prev = self.state

@@ -89,7 +89,7 @@ static void moment_points(moment_fn moment, int32_t k, int32_t m, const int32_t 
 enum { S_MASS, S_DT, S_HARD_END, S_THICKNESS /* < 0: none */, S_UNTIL_STOPPED, S_HISTORY /* <= 0: none */,
        S_CRATER /* 1: the linear crater */, S_CRATER_KD, S_CRATER_C, S_KE0, S_STOP_ENERGY,
        S_TIP /* 3: the tip about the centre */, S_TAIL = S_TIP + 3, S_IINV = S_TAIL + 3 /* 9 */,
-       S_TUNNEL = S_IINV + 9 /* 1: the tunnel (tunnel_kernel.c) */, S_SPACING, S_XI_SH, S_A0, S_RAMP,
+       S_TUNNEL = S_IINV + 9 /* 1: the tunnel (tunnel_kernel.c) */, S_SPACING, S_XI_SH, S_A0, S_RESERVED,
        S_SHOULDER /* 3: the shoulder's centre about the body's centre */, S_COUNT = S_SHOULDER + 3 };
 /* per-shot results */
 enum { R_T, R_STEPS, R_OUTCOME /* 0 ended, 1 perforated, 2 ricochet, 3 embedded */, R_WORK, R_ENTERED,
@@ -259,7 +259,7 @@ static void one_shot(Body *b, const double *sp, const double *law, double *y, do
         double *T = b->T = b->tunnel;
         for (int j = 0; j < T_HEADER; ++j) T[j] = 0.0;
         T[T_CAP] = b->cap; T[T_S] = b->sectors; T[T_SPACING] = sp[S_SPACING]; T[T_XI_SH] = sp[S_XI_SH];
-        T[T_A0] = sp[S_A0]; T[T_RAMP] = sp[S_RAMP];
+        T[T_A0] = sp[S_A0];
     }
     double t = 0.0, work = 0.0, next = 0.0, prev[13], R[9], w[3];
     double max_nose = -INFINITY, max_error = -INFINITY, rows = 0.0;

@@ -126,7 +126,7 @@ def material_law(scene, c: dict, thickness: float | None) -> tg.TargetLaw:
         free_surface=e.free_surface, friction=e.friction, mu=t.friction,
         mu_dynamic=scene.get("target.friction_dynamic"), mu_decay=t.friction_decay,
         lock_density=lock, crush_strain=crush, c_over_a=ca, given_sigma_s=given_flag,
-        onset=math.radians(t.onset_angle_deg),
+        onset=math.radians(t.onset_angle_deg), onset_speed=t.onset_speed,
         surface_range=get("free_surface_range") or SCHEMA["target.free_surface_range"].default)
 
 

@@ -78,8 +78,8 @@ class Shot:
         safety_factor, stable_step: the explicit step's safety factor and estimate ("eigenvalue", "altitude").
         charge_friction: the shell-charge friction coefficient.
         rigid_step: run.rigid_step or None.
-        tunnel_ramp: with effects.tunnel in a target of one material, target.wall_ramp_speed (m/s): the run keeps
-            the tunnel the projectile opens (fepen.laws.tunnel); else None.
+        tunnel: effects.tunnel in a target of one material: the run keeps the tunnel the projectile opens
+            (fepen.laws.tunnel).
         nominal_diameter: projectile.diameter (m), which the rigid step has always been sized on (a drawn profile's
             or a CAD body's own calibre may differ from it).
         experiment: the Table 1 shot's name (impact.shot) or None.
@@ -116,7 +116,7 @@ class Shot:
     body_key: tuple = field(repr=False, default=())
     scene_toml: str = field(repr=False, default="")
     probes: tuple = ()
-    tunnel_ramp: float | None = None
+    tunnel: bool = False
     envelope: dict = field(repr=False, default_factory=dict)
     inputs: dict = field(repr=False, default_factory=dict)
 
@@ -212,8 +212,7 @@ def resolve(scene, toml: bool = True) -> Shot:
         nominal_diameter=scene.projectile.diameter,
         experiment=scene.get("impact.shot"), scene=scene.as_dict(), body_key=setup.body_key(scene),
         scene_toml=to_toml(scene) if toml else "", probes=probes, envelope=setup.envelope_facts(scene, built),
-        tunnel_ramp=(scene.target.wall_ramp_speed if scene.effects.tunnel and law is not None
-                     and not getattr(law, "layered", False) else None),
+        tunnel=bool(scene.effects.tunnel and law is not None and not getattr(law, "layered", False)),
         inputs=inputs_record(scene) if toml else {})
 
 

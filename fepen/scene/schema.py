@@ -275,10 +275,10 @@ SCHEMA: dict[str, Key] = {
     "target.crush_strain": number(ABSENT, "", 0.0, 1.0, lo_open=True,
                                   doc="epsilon of the energy crater's strength energy; absent: 1 - density / "
                                       "lock_density; the default 'concrete' gives 0.376 (calibrated)"),
-    "target.wall_ramp_speed": number(5.0, "m/s", 0.01, 1000.0,
-                                     doc="effects.tunnel: the quasi-static stress of the tunnel's wall develops over "
-                                         "this outward speed of the point pressing it (a smooth load at vanishing "
-                                         "speed; docs/theory.md §8.7)"),
+    "target.onset_speed": number(10.0, "m/s", 0.0, 1000.0,
+                                 doc="sigma_s develops over this much of a surface point's speed into the target "
+                                     "(its normal speed; at the tunnel's wall its outward speed): a smooth load as "
+                                     "the body comes to rest; 0: at once (docs/theory.md §8.7)"),
     "target.free_surface_range": number(1.0, "", 0.0, 20.0, lo_open=True,
                                         doc="reach of the free face on sigma_s, in plastic-zone widths "
                                             "(effects.free_surface; docs/theory.md §8.4); the default "

@@ -31,23 +31,22 @@ class TargetLoad:
         law: the TargetLaw.
         tip, tail: (owner, local) node handles of the nose tip and tail centre (probes.node_at).
         crater: a ForrestalCrater for the linear crater, else None.
-        tunnel_ramp: target.wall_ramp_speed (m/s) to keep the tunnel the projectile opens (fepen.laws.tunnel),
-            or None. Its shoulder is found on the reference surface of all ranks; each step records a station and
+        tunnel: keep the tunnel the projectile opens (fepen.laws.tunnel). Its shoulder is found on the reference surface of all ranks; each step records a station and
             pushes the wall out where the points press it, the wall's radii taken as their largest over the
             ranks, so the tunnel is the same on any partition.
     """
 
-    def __init__(self, solver, surf: Surface, law: tg.TargetLaw, tip, tail, crater=None, tunnel_ramp=None):
+    def __init__(self, solver, surf: Surface, law: tg.TargetLaw, tip, tail, crater=None, tunnel: bool = False):
         self.surf, self.law, self.tip, self.tail, self.crater = surf, law, tip, tail, crater
         self.tunnel = None
-        if tunnel_ramp is not None:
+        if tunnel:
             from fepen.laws.tunnel import Tunnel
 
             comm = solver.comm
             a0 = comm.allreduce(float(np.max(surf.radius, initial=0.0)), op=MPI.MAX)
             wide = surf.radius >= (1.0 - 1e-3) * a0
             xi_sh = comm.allreduce(float(np.min(surf.X[wide, 1], initial=np.inf)), op=MPI.MIN)
-            self.tunnel = Tunnel(xi_sh, a0, tunnel_ramp)
+            self.tunnel = Tunnel(xi_sh, a0)
         self.force = np.zeros(3)
         self.contact_nodes = 0
         self.area = 0.0
