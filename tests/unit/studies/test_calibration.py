@@ -52,14 +52,29 @@ def test_calibrate_picks_the_node_that_made_the_data():
     assert ranked[0][1] == nodes[1] and ranked[0][0] <= ranked[1][0]
 
 
-def test_table1_error_is_the_mean_of_nose_and_tail_errors():
-    """Table 1's shot error: positions equal to the test's give 0; the nose 10 % of |H| off along x and the
-    tail exact give 5 %."""
+def test_table1_error_is_the_mean_of_nose_tail_and_axis_errors():
+    """Table 1's shot error: positions equal to the test's give 0; the nose and the tail moved together by 10 %
+    of |H| along x (the axis unchanged) give (10 % |H|/|H| + 10 % |H|/|T| + 0)/3; the tail alone turned about
+    the nose by 5 degrees adds 5 x AXIS_WEIGHT_PER_DEG / 3 to the tail's own error."""
+    import math
+
     from fepen.data import SHOTS
 
     rows = depth.table1_set()
     exact = np.array([[s.Hx_mm, s.Hy_mm, s.Tx_mm, s.Ty_mm] for s in SHOTS.values()]) / 1e3
     assert np.allclose(cal.group_errors("table1", rows, exact), 0.0)
+    H = np.hypot(exact[:, 0], exact[:, 1])
+    T = np.hypot(exact[:, 2], exact[:, 3])
     off = exact.copy()
-    off[:, 0] += 0.1 * np.hypot(exact[:, 0], exact[:, 1])
-    assert np.allclose(cal.group_errors("table1", rows, off), 0.05)
+    off[:, 0] += 0.1 * H
+    off[:, 2] += 0.1 * H
+    assert np.allclose(cal.group_errors("table1", rows, off), (0.1 + 0.1 * H / T) / 3.0)
+    # the tail turned about the nose by 5 degrees (toward larger Hx - Tx)
+    turned = exact.copy()
+    d = exact[:, 2:] - exact[:, :2]
+    c, s = math.cos(math.radians(5.0)), math.sin(math.radians(5.0))
+    turned[:, 2] = exact[:, 0] + c * d[:, 0] - s * d[:, 1]
+    turned[:, 3] = exact[:, 1] + s * d[:, 0] + c * d[:, 1]
+    tail = np.linalg.norm(turned[:, 2:] - exact[:, 2:], axis=1) / T
+    got = cal.group_errors("table1", rows, turned)
+    assert np.allclose(got, (tail + 5.0 * cal.AXIS_WEIGHT_PER_DEG) / 3.0)
