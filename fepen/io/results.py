@@ -49,6 +49,10 @@ RESULTANT_COLUMNS = ["contact_fx_N", "contact_fy_N", "contact_force_N"]
 #: appended with effects.wear or effects.erosion (either fidelity): the mass, the interface heat, the eroded
 #: cells and the kinetic energy the removed material carried away, so far
 REMOVAL_COLUMNS = ["mass_kg", "wear_heat_J", "eroded_cells", "removed_kinetic_J"]
+#: appended in a concrete target (both fidelities; fepen.laws.tunnel.zones): the size of the target's resultant
+#: force on the nose (ahead of the shoulder, the widest section), the shank and the tail (the last calibre) (N),
+#: and the points it loads in each
+LOAD_COLUMNS = ["nose_force_N", "shank_force_N", "tail_force_N", "nose_points", "shank_points", "tail_points"]
 #: appended with a charge in frictional contact (fepen.solver.shell_charge): friction dissipation, the largest gap,
 #: interpenetration and slip over the wall's node pairs, the fractions of pairs open and sliding
 INTERFACE_COLUMNS = ["friction_J", "interface_gap_max_mm", "interface_penetration_max_mm", "interface_slip_max_mm",
@@ -140,10 +144,26 @@ def comparison(name: str | None, summary: dict) -> dict | None:
     H_exp, T_exp = np.array([s.Hx_mm, s.Hy_mm]), np.array([s.Tx_mm, s.Ty_mm])
     H = np.array([summary["Hx_mm"], summary["Hy_mm"]])
     T = np.array([summary["Tx_mm"], summary["Ty_mm"]])
+    axis = float(final_axis_deg(s.Hx_mm, s.Hy_mm, s.Tx_mm, s.Ty_mm))
     return {"shot": name, "Hx_mm": s.Hx_mm, "Hy_mm": s.Hy_mm, "Tx_mm": s.Tx_mm, "Ty_mm": s.Ty_mm,
+            "final_axis_angle_deg": axis, "axis_error_deg": float(summary["final_axis_angle_deg"] - axis),
+            "nose_offset_mm": nose_offset_mm(s.Hx_mm, s.Hy_mm, s.obliquity_deg),
             "nose_error": float(np.linalg.norm(H - H_exp) / np.linalg.norm(H_exp)),
             "tail_error": float(np.linalg.norm(T - T_exp) / np.linalg.norm(T_exp)),
             "Hy_error": float(summary["Hy_mm"] / s.Hy_mm - 1), "Ty_error": float(summary["Ty_mm"] / s.Ty_mm - 1)}
+
+
+def final_axis_deg(Hx_mm, Hy_mm, Tx_mm, Ty_mm):
+    """The projectile's axis at the end (deg from the face's normal, toward +x): atan2(Hx − Tx, Hy − Ty) of the
+    nose and tail positions in the reported frame (x along the face, y depth); numbers or arrays."""
+    return np.degrees(np.arctan2(np.subtract(Hx_mm, Tx_mm), np.subtract(Hy_mm, Ty_mm)))
+
+
+def nose_offset_mm(Hx_mm: float, Hy_mm: float, obliquity_deg: float) -> float:
+    """How far the nose ended from the line of fire (mm): its distance from the line through the impact point at
+    the obliquity from the face's normal, in the plane of the shot."""
+    ob = math.radians(obliquity_deg)
+    return float(abs(Hx_mm * math.cos(ob) - Hy_mm * math.sin(ob)))
 
 
 def summary(scene: dict, experiment: str | None, rows, outcome: str, extra: dict) -> dict:
@@ -159,6 +179,10 @@ def summary(scene: dict, experiment: str | None, rows, outcome: str, extra: dict
            "depth_mm": max(r[COL["nose_y_mm"]] for r in rows), "length_mm": last[COL["length_mm"]],
            "residual_speed_m_s": last[COL["speed_m_s"]], "outcome": outcome,
            "energy_error": max(r[COL["energy_error"]] for r in rows), "max_peeq": last[COL["max_peeq"]]}
+    out["final_axis_angle_deg"] = float(final_axis_deg(last[COL["nose_x_mm"]], last[COL["nose_y_mm"]],
+                                                       last[COL["tail_x_mm"]], last[COL["tail_y_mm"]]))
+    out["nose_offset_mm"] = nose_offset_mm(last[COL["nose_x_mm"]], last[COL["nose_y_mm"]],
+                                           scene.get("impact", {}).get("obliquity_deg", 0.0))
     out.update(extra)
     out["experiment"] = comparison(experiment, out)
     out["scene"] = scene

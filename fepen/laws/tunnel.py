@@ -20,7 +20,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
-__all__ = ["Tunnel", "SECTORS", "CAPACITY", "HEADER", "STATION", "shoulder_of"]
+__all__ = ["Tunnel", "SECTORS", "CAPACITY", "HEADER", "STATION", "shoulder_of", "zones", "ZONES", "split"]
 
 #: angular sectors of a station's radius
 SECTORS = 16
@@ -37,6 +37,32 @@ def shoulder_of(X: np.ndarray, radius: np.ndarray) -> tuple[float, float]:
     a0 = float(np.max(radius))
     wide = radius >= (1.0 - 1e-3) * a0
     return float(np.min(X[wide, 1])), a0
+
+
+#: the body's zones, by their distance behind the tip: the nose (ahead of the shoulder), the shank, the tail (the
+#: last calibre)
+ZONES = ("nose", "shank", "tail")
+
+
+def zones(xi: np.ndarray, xi_sh: float, length: float, calibre: float) -> np.ndarray:
+    """Each point's zone (0 nose, 1 shank, 2 tail) from its distance xi behind the tip (m): the nose ahead of the
+    shoulder xi_sh, the tail the last calibre of the body's length, the shank between."""
+    out = np.ones(len(xi), dtype=np.int64)
+    out[xi < xi_sh] = 0
+    out[xi > length - calibre] = 2
+    out[xi < xi_sh] = 0  # a body shorter than its nose and a calibre: the nose first
+    return out
+
+
+def split(force: np.ndarray, zone: np.ndarray) -> np.ndarray:
+    """The target's force summed by zone, (3 zones, 3) (N), and the loaded points by zone (3,), as one (3, 4)
+    array: [:, :3] the forces, [:, 3] the counts (a point is loaded when its force is not zero)."""
+    out = np.zeros((3, 4))
+    loaded = np.any(force != 0.0, axis=1)
+    for j in range(3):
+        out[:, j] = np.bincount(zone, weights=force[:, j], minlength=3)
+    out[:, 3] = np.bincount(zone, weights=loaded.astype(float), minlength=3)
+    return out
 
 
 @dataclass

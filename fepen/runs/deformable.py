@@ -77,7 +77,11 @@ class DeformableRun(Run):
         charge = results.CHARGE_COLUMNS + results.BODY_COLUMNS + results.RESULTANT_COLUMNS
         return (results.HISTORY_COLUMNS + (charge if self.pm.charge else [])
                 + (results.INTERFACE_COLUMNS if self.contact is not None else [])
-                + (results.REMOVAL_COLUMNS if self.removing else []))
+                + (results.REMOVAL_COLUMNS if self.removing else [])
+                + (results.LOAD_COLUMNS if self.splitting else []))
+
+    def load_split(self) -> list[float]:
+        return self.load.split(self.comm)
 
     # ---- the step and the rules ---------------------------------------------------------------------------
     def step(self) -> None:

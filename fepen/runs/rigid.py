@@ -19,6 +19,7 @@ from fepen.geometry import revolution, tags
 from fepen.io import results
 from fepen.laws import energy, wear
 from fepen.laws import target as tg
+from fepen.laws import tunnel as tunnel_zones
 from fepen.laws.rigid_body import (
     RigidBody,
     RigidState,
@@ -164,6 +165,8 @@ class RigidRun(Run):
             else:
                 self.wear = Wear(sh.wear)
         self.tunnel = None
+        xi_sh, a0 = tunnel_zones.shoulder_of(g["X"], g["radius"])
+        self.zone = tunnel_zones.zones(g["X"][:, 1], xi_sh, self.shape.length, 2.0 * a0)
         if sh.tunnel:
             self.tunnel = Tunnel.of_points(g["X"], g["radius"])
             self.shoulder_arm = np.array([0.0, self.tunnel.xi_sh, 0.0]) - self.body.centre0
@@ -174,17 +177,27 @@ class RigidRun(Run):
             self.probes = run_probes.RigidProbes(sh.probes)
 
     # ------------------------------------------------------------------------------------------------
-    def force_fn(self, s: RigidState, x, v, n):
-        """Target forces on the load points (zero outside the target)."""
+    def _load(self, s: RigidState, R, x, v, n):
+        """The target's PointLoad on the load points at state s (rotation R)."""
         g = self.pts
-        R = self.body.frame[0]  # s's rotation (RigidBody.derivative)
         tip = s.c + R @ self.tip_arm
         xi = None
         if self.tunnel is not None:  # where the shoulder is now (the tunnel's open end)
             self.tunnel.at(s.c + R @ self.shoulder_arm, -R[:, 1])
             xi = np.ascontiguousarray(g["X"][:, 1])
-        load = tg.load_on_points(self.law, x, v, n, g["area0"], g["radius"], g["R_meridian"], g["sin_phi0"],
+        return tg.load_on_points(self.law, x, v, n, g["area0"], g["radius"], g["R_meridian"], g["sin_phi0"],
                                  -R[:, 1], self.crater, -tip[1], tunnel=self.tunnel, body_xi=xi)
+
+    def load_split(self) -> list[float]:
+        """LOAD_COLUMNS at the present state (the target's forces evaluated there; nothing recorded)."""
+        s = self.state
+        x, v, n, _ = self.body.points(s)
+        split = tunnel_zones.split(self._load(s, self.body.at(s)[1], x, v, n).force, self.zone)
+        return [*np.linalg.norm(split[:, :3], axis=1).tolist(), *split[:, 3].tolist()]
+
+    def force_fn(self, s: RigidState, x, v, n):
+        """Target forces on the load points (zero outside the target)."""
+        load = self._load(s, self.body.frame[0], x, v, n)  # s's rotation (RigidBody.derivative)
         self.loaded, self.area = load.loaded, load.area
         if self.wear is not None:
             self.wear.stage(load.force, n, v)

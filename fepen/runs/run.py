@@ -143,7 +143,17 @@ class Run:
     @property
     def columns(self) -> list[str]:
         """history.csv's columns."""
-        return results.HISTORY_COLUMNS + (results.REMOVAL_COLUMNS if self.removing else [])
+        return (results.HISTORY_COLUMNS + (results.REMOVAL_COLUMNS if self.removing else [])
+                + (results.LOAD_COLUMNS if self.splitting else []))
+
+    @property
+    def splitting(self) -> bool:
+        """Whether the history has the load's split by zone (a concrete target)."""
+        return self.shot.law is not None
+
+    def load_split(self) -> list[float]:
+        """The body's LOAD_COLUMNS at the history row's state (collective)."""
+        raise NotImplementedError
 
     @property
     def wall_s(self) -> float:
@@ -217,6 +227,8 @@ class Run:
         if self.removing:
             r = s.removal or self.removal()
             row += [s.mass, r.heat_J, r.eroded_cells, r.kinetic_J]
+        if self.splitting:
+            row += self.load_split()
         results.finite_row(row, self.step_count, self.t)
         self.rows.append(row)
         if self.probes is not None:

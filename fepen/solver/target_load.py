@@ -31,21 +31,25 @@ class TargetLoad:
         law: the TargetLaw.
         tip, tail: (owner, local) node handles of the nose tip and tail centre (probes.node_at).
         crater: a ForrestalCrater for the linear crater, else None.
-        tunnel: keep the tunnel the projectile opens (fepen.laws.tunnel). Its shoulder is found on the reference surface of all ranks; each step records a station and
-            pushes the wall out where the points press it, the wall's radii taken as their largest over the
-            ranks, so the tunnel is the same on any partition.
+        tunnel: keep the tunnel the projectile opens (fepen.laws.tunnel). Its shoulder is found on the
+            reference surface of all ranks; each step records a station and pushes the wall out where the points
+            press it, the wall's radii taken as their largest over the ranks, so the tunnel is the same on any
+            partition.
     """
 
     def __init__(self, solver, surf: Surface, law: tg.TargetLaw, tip, tail, crater=None, tunnel: bool = False):
         self.surf, self.law, self.tip, self.tail, self.crater = surf, law, tip, tail, crater
         self.tunnel = None
+        comm = solver.comm
+        a0 = comm.allreduce(float(np.max(surf.radius, initial=0.0)), op=MPI.MAX)
+        wide = surf.radius >= (1.0 - 1e-3) * a0
+        xi_sh = comm.allreduce(float(np.min(surf.X[wide, 1], initial=np.inf)), op=MPI.MIN)
+        length = comm.allreduce(float(np.max(surf.X[:, 1], initial=-np.inf)), op=MPI.MAX)
+        self.xi_sh, self.length, self.calibre = xi_sh, length, 2.0 * a0
+        self.last_force = np.zeros((0, 3))  # the points' forces of the last step (this rank's)
         if tunnel:
             from fepen.laws.tunnel import Tunnel
 
-            comm = solver.comm
-            a0 = comm.allreduce(float(np.max(surf.radius, initial=0.0)), op=MPI.MAX)
-            wide = surf.radius >= (1.0 - 1e-3) * a0
-            xi_sh = comm.allreduce(float(np.min(surf.X[wide, 1], initial=np.inf)), op=MPI.MIN)
             self.tunnel = Tunnel(xi_sh, a0)
         self.force = np.zeros(3)
         self.contact_nodes = 0
@@ -104,7 +108,24 @@ class TargetLoad:
         n_own = solver.n_owned
         solver.fext[:n_own] += self._nodes[:n_own]
         self.force, self.contact_nodes, self.area = load.total, load.loaded, load.area
+        self.last_force = load.force
         solver.clock.times.target_comm += comm_s
+
+    def split(self, comm) -> list[float]:
+        """The last step's load by zone (fepen.laws.tunnel.zones: nose, shank, tail): the size of each zone's
+        resultant (N), then its loaded points, summed exactly over the ranks (collective; the same on any
+        partition)."""
+        from fepen.laws import tunnel
+
+        f = self.last_force
+        zone = tunnel.zones(self.surf.X[:, 1], self.xi_sh, self.length, self.calibre)
+        hit = np.flatnonzero(np.any(f != 0.0, axis=1)) if len(f) == len(zone) else np.zeros(0, dtype=np.int64)
+        terms = np.zeros((len(hit), 12))
+        for j in range(3):
+            terms[np.arange(len(hit)), 4 * zone[hit] + j] = f[hit, j]
+        terms[np.arange(len(hit)), 4 * zone[hit] + 3] = 1.0
+        sums = assembly.exact_sum(terms, comm).reshape(3, 4)
+        return [*np.linalg.norm(sums[:, :3], axis=1).tolist(), *sums[:, 3].tolist()]
 
     def state(self) -> dict[str, np.ndarray]:
         """The load's last totals (for checkpoints; the same on every rank)."""

@@ -36,6 +36,7 @@ from pathlib import Path
 
 import numpy as np
 
+from fepen.io import results
 from fepen.laws import target as tg
 from fepen.studies import depth
 from fepen.studies.study import Round, Study, register, set_option
@@ -166,11 +167,6 @@ def predicted(rows, table: np.ndarray, a: float, D0: float, b: float = EXPONENT)
 AXIS_WEIGHT_PER_DEG = 0.01
 
 
-def final_axis_deg(Hx, Hy, Tx, Ty) -> np.ndarray:
-    """The final axis's angle from the face's normal (deg): atan2(Hx − Tx, Hy − Ty) of the nose and tail."""
-    return np.degrees(np.arctan2(np.asarray(Hx) - np.asarray(Tx), np.asarray(Hy) - np.asarray(Ty)))
-
-
 def group_errors(name: str, rows, pred: np.ndarray) -> np.ndarray:
     """Each shot's error (step 4): Table 1's mean of its nose error, tail error and final-axis error (the axis
     AXIS_WEIGHT_PER_DEG per degree), a depth set's |ln(P_pred/P_meas)|."""
@@ -183,7 +179,7 @@ def group_errors(name: str, rows, pred: np.ndarray) -> np.ndarray:
         P = np.abs(pred)
         nose = np.linalg.norm(P[:, :2] - H, axis=1) / np.linalg.norm(H, axis=1)
         tail = np.linalg.norm(P[:, 2:] - T, axis=1) / np.linalg.norm(T, axis=1)
-        axis = np.abs(final_axis_deg(*P.T) - final_axis_deg(H[:, 0], H[:, 1], T[:, 0], T[:, 1]))
+        axis = np.abs(results.final_axis_deg(*P.T) - results.final_axis_deg(H[:, 0], H[:, 1], T[:, 0], T[:, 1]))
         return (nose + tail + AXIS_WEIGHT_PER_DEG * axis) / 3.0
     return np.abs(np.log(pred[:, 1] / np.array([r.depth for r in rows])))
 
