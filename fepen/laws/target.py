@@ -79,11 +79,6 @@ def strength_S(fc_pa: float, diameter: float, coefficient: float, exponent: floa
     return coefficient * (fc_pa / 1e6) ** -exponent / math.sqrt(1.0 + diameter / size)  # D/inf = 0
 
 
-#: the "scaled-S" constants refitted by the same procedure with friction on (the paper's Coulomb μ = 0.1 on
-#: the whole surface; docs/validation-depth.md): the empirical σ_s must not count the interface twice
-SCALED_S_FRICTION = (62.59, 0.544, 0.06558)
-SCALED_S_FRICTION_MU = 0.1
-
 #: strength models of σ_s = S f_c: (coefficient, exponent, size (m)). "forrestal-S" is Frew et al.'s (1998)
 #: fit to Sandia data; "scaled-S" is fepen's, calibrated once (docs/validation-depth.md)
 S_MODELS = {"forrestal-S": (82.6, 0.544, math.inf), "scaled-S": (SCALED_S_COEFFICIENT, SCALED_S_EXPONENT,

@@ -104,8 +104,6 @@ def material_law(scene, c: dict, thickness: float | None) -> tg.TargetLaw:
             a, b, size = tg.S_MODELS[model]
             if model == "scaled-S" and e.wear:  # refitted with the calibrated wear on (docs/wear.md §2)
                 a, b, size = tg.SCALED_S_WEAR
-            elif model == "scaled-S" and e.friction:  # refitted with friction on (theory.md §8.1)
-                a, b, size = tg.SCALED_S_FRICTION
             a = get("S_coefficient") or a
             b = get("S_exponent") if get("S_exponent") is not None else b
             size = get("S_size") or size
@@ -263,18 +261,19 @@ def thin_target_note(scene, built: Built) -> str | None:
     return None
 
 
-def friction_note(scene) -> str | None:
-    """A line when friction is on with the calibrated strength but not with the friction law its constants
-    were refitted for (Coulomb target.friction = 0.1)."""
+def check_friction(scene) -> None:
+    """Refuse effects.friction with the calibrated scaled-S strength and no constants of the user's own
+    (InputError on effects.friction): its σ_s was fitted to depths that contain the interface's resistance, so
+    friction on top counts it twice, and the friction refit predated the separation angle, the free face and
+    the tunnel (it drove C3 37 % too deep); docs/theory.md §8.1."""
     t = scene.target
-    if not scene.effects.friction or t.strength_model != "scaled-S" or scene.get("target.S_coefficient"):
-        return None
-    mu_d = scene.get("target.friction_dynamic")
-    if t.friction == tg.SCALED_S_FRICTION_MU and (t.friction_decay == 0.0 or mu_d in (None, t.friction)):
-        return None
-    return (f"target: the scaled-S constants were refitted for Coulomb friction {tg.SCALED_S_FRICTION_MU:g}, "
-            "not for this friction law; refit them with `python -m fepen.studies.calibration DATA --set ...` "
-            "and give target.S_coefficient and target.S_size (docs/validation-depth.md)")
+    if scene.effects.friction and t.strength_model == "scaled-S" and not scene.get("target.S_coefficient") \
+            and scene.get("target.quasi_static_stress") is None:
+        raise InputError("effects.friction", "true needs a strength fitted with friction on: give target.S_coefficient "
+                                             "and target.S_size (refit: fepen study calibration --set "
+                                             "effects.friction=true), target.quasi_static_stress, or another "
+                                             "target.strength_model (the scaled-S constants have friction's share "
+                                             "in sigma_s; docs/theory.md 8.1)")
 
 
 def announce(scene, comm, built: Built | None = None) -> Built:
@@ -284,7 +283,7 @@ def announce(scene, comm, built: Built | None = None) -> Built:
     if comm.rank == 0:
         import logging
 
-        for note in (built.note, friction_note(scene), thin_target_note(scene, built), envelope_note(scene, built)):
+        for note in (built.note, thin_target_note(scene, built), envelope_note(scene, built)):
             if note:
                 logging.getLogger("fepen").warning(note)
     return built
@@ -321,6 +320,8 @@ def check_supported(scene, built: Built | None = None) -> Built:
         dolfinx_api.check_version()  # a mesh is made: only on the dolfinx releases fepen supports
     if scene.effects.fidelity != "rigid" or not built.shape.exact:  # a volume mesh is made
         check_mesh_cost(scene, MPI.COMM_WORLD, built)
+    if scene.target.kind == "concrete":
+        check_friction(scene)
     if scene.effects.fidelity == "rigid" and scene.target.kind != "concrete":
         raise InputError("effects.fidelity", "'rigid' runs against target.kind = 'concrete'; a rigid "
                                              "projectile on a rigid wall has nothing to compute")

@@ -236,12 +236,11 @@ SCHEMA: dict[str, Key] = {
     "target.S_coefficient": positive(ABSENT, "", 1.0e4,
                                      doc="a of S = a (f_c/MPa)^-b / sqrt(1 + D/S_size), sigma_s = S f_c "
                                          "(strength_model 'scaled-S' or 'forrestal-S'); absent: the model's "
-                                         "(scaled-S 132.1, with effects.wear 124.6, with effects.friction "
-                                         "62.59; forrestal-S 82.6)"),
+                                         "(scaled-S 132.1, with effects.wear 124.6; forrestal-S 82.6)"),
     "target.S_exponent": number(ABSENT, "", 0.0, 2.0, doc="b of S (above); absent: the strength model's 0.544"),
     "target.S_size": positive(ABSENT, "m", 1.0e6,
                               doc="D0 of S (above), Bazant's size effect in the projectile diameter D; absent: "
-                                  "the model's (scaled-S 0.05631, with wear 0.06291, with friction 0.06558; "
+                                  "the model's (scaled-S 0.05631, with wear 0.06291; "
                                   "forrestal-S none)"),
     "target.quasi_static_stress": positive(ABSENT, "Pa", 1.0e11,
                                            doc="overrides the strength model's sigma_s; absent: computed"),
@@ -320,8 +319,9 @@ SCHEMA: dict[str, Key] = {
     "effects.free_surface": flag(True, doc="the target's faces cut the cavity expansion's plastic zone: sigma_s "
                                            "falls toward the strength near a face (target.free_surface_range)"),
     "effects.friction": flag(False, doc="Coulomb friction of the target: shear target.friction sigma_n against "
-                                        "the sliding velocity (scaled-S then takes its constants refitted with "
-                                        "friction; docs/theory.md §8.1, §8.4); off: frictionless"),
+                                        "the sliding velocity (with scaled-S only given target.S_coefficient and "
+                                        "S_size fitted with friction: its own constants hold the interface's "
+                                        "share; docs/theory.md §8.1, §8.4); off: frictionless"),
     "effects.wear": flag(False, doc="nose wear: the interface heat melts mass off the surface (rigid fidelity: "
                                     "the mass loss; deformable: the surface recedes; docs/theory.md §14)"),
     "effects.erosion": flag(False, doc="element erosion of the meshed projectile: cells past projectile.erosion.* "

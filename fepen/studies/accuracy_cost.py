@@ -42,8 +42,6 @@ def configurations(quick: bool = False) -> list[dict]:
         ("plastic+thermal+rate", BASE_OFF),
         ("+separation", ["effects.separation=true", "effects.free_surface=false", "effects.friction=false"]),
         ("+free surface", ["effects.separation=false", "effects.free_surface=true", "effects.friction=false"]),
-        ("+friction", ["effects.separation=false", "effects.free_surface=false", "effects.friction=true"]),
-        ("default+friction", ["effects.friction=true"]),
     ]
     for name, sets in ladder:
         runs.append({"name": name, "group": "fidelity", "h": h, "sets": [f"mesh.size={h}", *sets]})

@@ -229,23 +229,23 @@ def test_scene_builds_the_law():
         1 - 2300 / 2710)  # absent: 1 - rho0/Q1
 
 
-def test_friction_on_takes_the_constants_refitted_with_friction():
-    """σ_s must not count the interface twice: with friction on, scaled-S uses its friction refit, and a
-    friction law it was not refitted for is named in a note (no note for the refitted one)."""
+def test_friction_with_the_calibrated_strength_is_refused_and_with_a_users_strength_taken():
+    """σ_s must not count the interface twice: scaled-S's constants hold friction's share, so effects.friction
+    with them is refused naming the key before anything runs; with the user's own a (and D0), a given σ_s or
+    another strength model it runs, and σ_s is the user's."""
+    from fepen.errors import InputError
+
     D = 0.0236
+    with pytest.raises(InputError) as err:
+        setup.check_friction(scene.load(None, ["effects.friction=true"]))
+    assert err.value.key == "effects.friction" and "target.S_coefficient" in err.value.message
+    for ok in (["target.S_coefficient=80", "target.S_size=0.06"], ["target.quasi_static_stress=1e8"],
+               ['target.strength_model="forrestal-S"'], []):
+        setup.check_friction(scene.load(None, ["effects.friction=true", *ok] if ok else []))
     off = setup.target_law(scene.load(None, []))
-    on = setup.target_law(scene.load(None, ["effects.friction=true"]))
-    fc = 31.875e6  # the paper's C40 as a cylinder strength
-    assert off.sigma_s == pytest.approx(tg.strength_S(fc, D, *tg.S_MODELS["scaled-S"]) * fc, rel=1e-12)
-    assert on.sigma_s == pytest.approx(tg.strength_S(fc, D, *tg.SCALED_S_FRICTION) * fc, rel=1e-12)
-    assert on.sigma_s < off.sigma_s  # friction carries part of the resistance
-    assert setup.friction_note(scene.load(None, ["effects.friction=true"])) is None
-    assert setup.friction_note(scene.load(None, [])) is None
-    note = setup.friction_note(scene.load(None, ["effects.friction=true", "target.friction=0.3"]))
-    assert "target.S_coefficient" in note and "refit" in note
     given = setup.target_law(scene.load(None, ["effects.friction=true", "target.S_coefficient=80"]))
-    assert given.sigma_s == pytest.approx(80 / tg.SCALED_S_COEFFICIENT * off.sigma_s * math.sqrt(
-        (1 + D / tg.SCALED_S_SIZE) / (1 + D / tg.SCALED_S_FRICTION[2])), rel=1e-12)
+    assert given.sigma_s == pytest.approx(80 / tg.SCALED_S_COEFFICIENT * off.sigma_s, rel=1e-12)
+    assert given.friction and not off.friction
 
 
 def test_immersion_is_the_submerged_fraction_of_a_patch():
