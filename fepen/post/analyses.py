@@ -2,8 +2,10 @@
 
 - Hazard map: the largest equivalent plastic strain of the surface cells (cells with a face on the outer
   surface) in axial bins along the projectile, from the nose, and the largest von Mises stress those cells
-  reached at any history row (``hazard.csv``, ``hazard.png``): where a shot yields, and how close to
-  yielding an elastic one came.
+  reached at any history row; the same over every cell of the bin, inside included (``hazard.csv``,
+  ``hazard.png``): where a shot yields, and how close to yielding an elastic one came.
+- First yield: the history row at which the first cell's plastic strain left zero, and where that cell is
+  (summary.json ``first_yield``).
 - Strain gauges: four surface cells — top (+x), bottom (−x), two sides (±z) in the body frame, where x is
   the plane of incidence — at 1/3 L and 1/2 L from the nose; their axial logarithmic strain
   ln |F a0| (a0 the reference axis) over time (``strains.csv``). Bending shows as top/bottom ≫ sides.
@@ -71,10 +73,14 @@ class Gauges:
         self.rows = []
         #: the largest von Mises stress of each owned cell at the history rows so far (Pa)
         self.peak_von_mises = np.zeros(solver.n_cells)
+        #: the history-row time at which each owned cell first had plastic strain (s; inf: not yet)
+        self.first_yield_t = np.full(solver.n_cells, np.inf)
+        self.centres = centres[: solver.n_cells]
 
     def state(self) -> dict[str, np.ndarray]:
         """The rows so far and the cells' peak von Mises stress (for checkpoints)."""
-        return {"rows": np.array(self.rows, dtype=float), "peak_von_mises_Pa": self.peak_von_mises.copy()}
+        return {"rows": np.array(self.rows, dtype=float), "peak_von_mises_Pa": self.peak_von_mises.copy(),
+                "first_yield_s": self.first_yield_t.copy()}
 
     def restore(self, state: dict) -> None:
         """Put back what state() returned (a checkpoint without the peaks keeps zeros)."""
@@ -82,6 +88,9 @@ class Gauges:
         peak = state.get("peak_von_mises_Pa")
         if peak is not None and len(peak) == len(self.peak_von_mises):
             self.peak_von_mises = np.array(peak, dtype=float)
+        first = state.get("first_yield_s")
+        if first is not None and len(first) == len(self.first_yield_t):
+            self.first_yield_t = np.array(first, dtype=float)
 
     def axial_strains(self) -> list[float]:
         """Axial logarithmic strain ln|F a0| of the gauge cells (a0 = reference axis), every rank."""
@@ -102,23 +111,58 @@ class Gauges:
         vm = diagnostics.von_mises(self.solver)
         live = self.solver.mat >= 0  # an eroded cell's stress is gone, its peak kept
         np.maximum(self.peak_von_mises, np.where(live, vm, 0.0), out=self.peak_von_mises)
+        n = len(self.first_yield_t)
+        newly = (self.solver.eps_p[:n] > 0.0) & np.isinf(self.first_yield_t)
+        self.first_yield_t[newly] = self.solver.t
+
+    def first_yield(self) -> dict | None:
+        """Where and when the projectile first yielded (collective, the same on every rank): the earliest
+        history row at which a cell had plastic strain, and that cell (ties: the one nearest the nose, then
+        the lowest rank). None if no cell yielded.
+
+        Returns:
+            {"t_s", "axial_from_nose_mm", "radius_mm", "angle_deg" (about the axis from +x, the plane of
+            incidence's windward side, toward +z), "surface" (the cell has a face on the outer surface)}.
+        """
+        t = self.first_yield_t
+        if len(t) and np.isfinite(t.min()):
+            k = int(np.lexsort((self.centres[:, 1], t))[0])
+            mine = (float(t[k]), float(self.centres[k, 1]), self.comm.rank)
+        else:
+            k, mine = -1, (np.inf, np.inf, self.comm.rank)
+        best = self.comm.allreduce(mine, op=MPI.MIN)
+        if not np.isfinite(best[0]):
+            return None
+        info = None
+        if best[2] == self.comm.rank:
+            c = self.centres[k]
+            info = {"t_s": best[0], "axial_from_nose_mm": float(c[1]) * 1e3,
+                    "radius_mm": float(np.hypot(c[0], c[2])) * 1e3,
+                    "angle_deg": float(np.degrees(np.arctan2(c[2], c[0]))),
+                    "surface": bool(np.isin(k, self.surface))}
+        return self.comm.bcast(info, root=best[2])
 
     def hazard(self, bin_mm: float = 2.0):
         """(axial bin centres from the nose (mm), largest surface-cell PEEQ per bin, largest surface-cell von
-        Mises stress per bin over the history rows (Pa)) on rank 0, else None (collective)."""
+        Mises stress per bin over the history rows (Pa), the same two over every cell of the bin) on rank 0,
+        else None (collective)."""
         s = self.solver
-        parts = self.comm.gather((self.surface_y, s.eps_p[self.surface], self.peak_von_mises[self.surface]), root=0)
+        n = s.n_cells
+        parts = self.comm.gather((self.surface_y, s.eps_p[self.surface], self.peak_von_mises[self.surface],
+                                  self.centres[:, 1], s.eps_p[:n], self.peak_von_mises), root=0)
         if self.comm.rank:
             return None
-        y = np.concatenate([p[0] for p in parts]) * 1e3
-        e = np.concatenate([p[1] for p in parts])
-        vm = np.concatenate([p[2] for p in parts])
-        edges = np.arange(0.0, y.max() + bin_mm, bin_mm)
-        idx = np.clip(np.digitize(y, edges) - 1, 0, len(edges) - 2)
-        peak, peak_vm = np.zeros(len(edges) - 1), np.zeros(len(edges) - 1)
-        np.maximum.at(peak, idx, e)
-        np.maximum.at(peak_vm, idx, vm)
-        return 0.5 * (edges[1:] + edges[:-1]), peak, peak_vm
+        y_all = np.concatenate([p[3] for p in parts]) * 1e3
+        edges = np.arange(0.0, y_all.max() + bin_mm, bin_mm)
+        out = [0.5 * (edges[1:] + edges[:-1])]
+        for y_k, vals in ((0, (1, 2)), (3, (4, 5))):
+            y = np.concatenate([p[y_k] for p in parts]) * 1e3
+            idx = np.clip(np.digitize(y, edges) - 1, 0, len(edges) - 2)
+            for j in vals:
+                peak = np.zeros(len(edges) - 1)
+                np.maximum.at(peak, idx, np.concatenate([p[j] for p in parts]))
+                out.append(peak)
+        return tuple(out)
 
     def write(self, out: Path) -> None:
         """strains.csv, hazard.csv and hazard.png (collective; rank 0 writes)."""
@@ -128,7 +172,8 @@ class Gauges:
         out = Path(out)
         save_table(out / "strains.csv", np.array(self.rows), ",".join(self.columns), "%.9g")
         save_table(out / "hazard.csv", np.column_stack(haz),
-                   "axial_from_nose_mm,max_surface_peeq,peak_surface_von_mises_Pa", "%.6g")
+                   "axial_from_nose_mm,max_surface_peeq,peak_surface_von_mises_Pa,max_peeq,peak_von_mises_Pa",
+                   "%.6g")
         hazard_figure(out, haz, np.array(self.rows), self.columns)
 
 
@@ -164,7 +209,7 @@ def hazard_figure(out: Path, haz, rows: np.ndarray, columns: list[str]) -> Path:
     """
     from fepen.post.figures import new_figure, run_info, run_title, save_figure
 
-    y, peeq, vm = (np.asarray(a, float) for a in haz)
+    y, peeq, vm = (np.asarray(a, float) for a in haz[:3])
     info = run_info(out)
     A = info["yield_Pa"]
     plastic = bool(np.any(peeq > 0.0))

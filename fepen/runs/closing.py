@@ -21,10 +21,12 @@ class Closing:
         self.peaks: dict | None = None
         self.charge: dict | None = None
         self.profile: dict | None = None
+        self.first_yield: dict | None = None
 
     def write(self, run) -> None:
         """Write the closing analyses of ``run`` (a fepen.runs.deformable.DeformableRun; collective)."""
         run.gauges.write(run.out)
+        self.first_yield = run.gauges.first_yield()
         if run.sections is not None:
             run.sections.write(run.out)
         self.peaks = accelerations(run)
@@ -49,7 +51,8 @@ class Closing:
 
     def summary(self) -> dict:
         """The summary keys of the closing analyses (None where they were not written)."""
-        return {"peak_accelerations": self.peaks, "charge": self.charge, "nose_profile": self.profile}
+        return {"peak_accelerations": self.peaks, "charge": self.charge, "nose_profile": self.profile,
+                "first_yield": self.first_yield}
 
 
 def accelerations(run) -> dict:

@@ -29,6 +29,8 @@ def test_stiff_projectile_reproduces_the_rigid_one(tmp_path):
     # the paper's analyses: hazard map along the axis and the eight strain gauges
     haz = np.loadtxt(tmp_path / "elastic" / "hazard.csv", delimiter=",", skiprows=1)
     assert haz[:, 0].max() > 140.0 and np.all(haz[:, 1] == 0.0)  # elastic: no plastic strain anywhere
+    assert np.all(haz[:, 3] == 0.0) and s["first_yield"] is None
+    assert np.all(haz[:, 4] >= haz[:, 2]) and haz[:, 4].max() > 0.0  # every cell's peak bounds the surface's
     gauges = np.loadtxt(tmp_path / "elastic" / "strains.csv", delimiter=",", skiprows=1)
     assert gauges.shape[1] == 9 and gauges.shape[0] > 10
     # at normal incidence the projectile is compressed axially, about equally on all four sides
@@ -59,6 +61,11 @@ def test_penetration_is_the_same_on_any_rank_count():
     cols = [1, 2, 3, 4, 5]  # nose x, y, tail x, y, speed
     assert np.max(np.abs(world[:, cols] - alone[:, cols])) <= 1e-10 * np.abs(alone[:, cols]).max()
     assert alone[-1, 2] > 5.0  # 5 mm deep after 40 us
+    fw, fa = sw.gauges.first_yield(), sa.gauges.first_yield()  # the nose yields at once, at the same place
+    assert fa is not None and fa["t_s"] < 4e-5 and fa["axial_from_nose_mm"] < 30.0
+    assert fw["t_s"] == fa["t_s"] and fw["surface"] == fa["surface"]
+    for k in ("axial_from_nose_mm", "radius_mm"):
+        assert fw[k] == pytest.approx(fa[k], abs=1e-9)
 
 
 def test_fields_hold_every_field_at_every_output_time(tmp_path):
