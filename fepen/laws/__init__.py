@@ -1,7 +1,8 @@
 """Laws on plain arrays: materials, the target (and layered targets), the shell-charge contact, rigid-body
-mechanics, nose wear, element erosion, the energy balance.
+mechanics, nose wear, element erosion, the energy balance, the tunnel the projectile opens.
 
 No dolfinx, no MPI, no scene: parameters are plain numbers (docs/theory.md §3-§5, §13).
 """
 
-__all__ = ["materials", "uniaxial", "target", "layers", "contact", "rigid_body", "wear", "erosion", "energy"]
+__all__ = ["materials", "uniaxial", "target", "layers", "contact", "rigid_body", "wear", "erosion", "energy",
+           "tunnel"]

@@ -235,7 +235,6 @@ def test_friction_with_the_calibrated_strength_is_refused_and_with_a_users_stren
     another strength model it runs, and σ_s is the user's."""
     from fepen.errors import InputError
 
-    D = 0.0236
     with pytest.raises(InputError) as err:
         setup.check_friction(scene.load(None, ["effects.friction=true"]))
     assert err.value.key == "effects.friction" and "target.S_coefficient" in err.value.message

@@ -107,7 +107,7 @@ CASES = [
     ["effects.crater=linear"],
     ["target.thickness=0.2", "impact.velocity=900"],  # perforated
     ["impact.obliquity_deg=75", "impact.velocity=400"],  # ricochet
-    ["effects.friction=true"],
+    ["effects.friction=true", "target.S_coefficient=80", "target.S_size=0.06"],  # friction: a strength of its own
     ["run.end_time=0.0004"],  # ends at its end time
     ["effects.separation=false", "effects.free_surface=false", "effects.crater=none"],
 ]
