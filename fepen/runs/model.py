@@ -87,7 +87,8 @@ def build(sh, comm: MPI.Comm = MPI.COMM_WORLD) -> Model:
     surf = None
     if sh.law is not None:
         surf = surface.outer_surface(s.V, pm.facet_tags, pm.shape)
-        load = target_load.TargetLoad(s, surf, sh.law, tip, tail, sh.crater(s.total_mass), sh.tunnel)
+        load = target_load.TargetLoad(s, surf, sh.law, tip, tail, sh.crater(s.total_mass), sh.tunnel,
+                                      sh.load_points)
     else:
         load = rigid_wall.RigidWall(s)
     s.external = load

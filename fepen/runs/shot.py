@@ -12,6 +12,7 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
+from fepen.errors import InputError
 from fepen.geometry.mass_rule import Built
 from fepen.laws import target as tg
 from fepen.laws import wear
@@ -80,6 +81,7 @@ class Shot:
         rigid_step: run.rigid_step or None.
         tunnel: effects.tunnel in a target of one material: the run keeps the tunnel the projectile opens
             (fepen.laws.tunnel).
+        load_points: target.load_points, where a deformable run evaluates the target law: "facets" or "nodes".
         nominal_diameter: projectile.diameter (m), which the rigid step has always been sized on (a drawn profile's
             or a CAD body's own calibre may differ from it).
         experiment: the Table 1 shot's name (impact.shot) or None.
@@ -117,6 +119,7 @@ class Shot:
     scene_toml: str = field(repr=False, default="")
     probes: tuple = ()
     tunnel: bool = False
+    load_points: str = "facets"
     envelope: dict = field(repr=False, default_factory=dict)
     inputs: dict = field(repr=False, default_factory=dict)
 
@@ -213,7 +216,20 @@ def resolve(scene, toml: bool = True) -> Shot:
         experiment=scene.get("impact.shot"), scene=scene.as_dict(), body_key=setup.body_key(scene),
         scene_toml=to_toml(scene) if toml else "", probes=probes, envelope=setup.envelope_facts(scene, built),
         tunnel=bool(scene.effects.tunnel and law is not None and not getattr(law, "layered", False)),
+        load_points=_load_points(scene),
         inputs=inputs_record(scene) if toml else {})
+
+
+def _load_points(scene) -> str:
+    """target.load_points, refused with effects that rework the facets as the run goes (erosion exposes new
+    ones, the deformable wear recedes them by their own forces)."""
+    points = scene.target.load_points
+    if points == "nodes" and scene.effects.fidelity != "rigid":
+        for key in ("erosion", "wear"):
+            if getattr(scene.effects, key):
+                raise InputError("target.load_points", f"'nodes' does not run with effects.{key} = true (it "
+                                                       "reworks the surface's facets as the run goes): 'facets'")
+    return points
 
 
 def inputs_record(scene) -> dict:

@@ -274,6 +274,11 @@ SCHEMA: dict[str, Key] = {
     "target.crush_strain": number(ABSENT, "", 0.0, 1.0, lo_open=True,
                                   doc="epsilon of the energy crater's strength energy; absent: 1 - density / "
                                       "lock_density; the default 'concrete' gives 0.376 (calibrated)"),
+    "target.load_points": choice("facets", "facets", "nodes",
+                                 doc="where a deformable run evaluates the target law: 'facets', one point per "
+                                     "outer facet on the exact surface, its force shared by the facet's nodes; "
+                                     "'nodes', one per surface node (the paper's), a third of its facets' area; "
+                                     "the rigid fidelity has its rings (docs/theory.md §8.5)"),
     "target.onset_speed": number(10.0, "m/s", 0.0, 1000.0,
                                  doc="sigma_s develops over this much of a surface point's speed into the target "
                                      "(its normal speed; at the tunnel's wall its outward speed): a smooth load as "

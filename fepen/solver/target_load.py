@@ -35,10 +35,18 @@ class TargetLoad:
             reference surface of all ranks; each step records a station and pushes the wall out where the points
             press it, the wall's radii taken as their largest over the ranks, so the tunnel is the same on any
             partition.
+        points: "facets", one load point per outer facet, its force shared by the facet's three nodes; or
+            "nodes", one per owned surface node (fepen.solver.node_points), its force the node's.
     """
 
-    def __init__(self, solver, surf: Surface, law: tg.TargetLaw, tip, tail, crater=None, tunnel: bool = False):
+    def __init__(self, solver, surf: Surface, law: tg.TargetLaw, tip, tail, crater=None, tunnel: bool = False,
+                 points: str = "facets"):
         self.surf, self.law, self.tip, self.tail, self.crater = surf, law, tip, tail, crater
+        self.nodal = None
+        if points == "nodes":
+            from fepen.solver.node_points import NodePoints
+
+            self.nodal = NodePoints(solver, surf)
         self.tunnel = None
         comm = solver.comm
         a0 = comm.allreduce(float(np.max(surf.radius, initial=0.0)), op=MPI.MAX)
@@ -87,8 +95,8 @@ class TargetLoad:
             comm_s += perf_counter() - t1
             return out
 
-        x, v, area, n = self.surf.kinematics(x_all, solver.Vel)
-        s = self.surf
+        s = self.surf if self.nodal is None else self.nodal
+        x, v, area, n = s.kinematics(x_all, solver.Vel)
         xi = None
         if self.tunnel is not None:  # the shoulder on the deformed axis, tip to tail
             self.tunnel.at(tip - self.tunnel.xi_sh * axis, axis)
@@ -103,7 +111,10 @@ class TargetLoad:
         if self.wear is not None:
             self.wear.add(load.force, n, v, dt)
         t1 = perf_counter()
-        self._facet_sum(solver)(load.force / 3.0, self._nodes)  # a third to each corner
+        if self.nodal is None:
+            self._facet_sum(solver)(load.force / 3.0, self._nodes)  # a third to each corner
+        else:
+            self.nodal.to_nodes(load.force, self._nodes)  # each point's force is its node's
         comm_s += perf_counter() - t1
         n_own = solver.n_owned
         solver.fext[:n_own] += self._nodes[:n_own]
@@ -118,7 +129,8 @@ class TargetLoad:
         from fepen.laws import tunnel
 
         f = self.last_force
-        zone = tunnel.zones(self.surf.X[:, 1], self.xi_sh, self.length, self.calibre)
+        X = (self.surf if self.nodal is None else self.nodal).X
+        zone = tunnel.zones(X[:, 1], self.xi_sh, self.length, self.calibre)
         hit = np.flatnonzero(np.any(f != 0.0, axis=1)) if len(f) == len(zone) else np.zeros(0, dtype=np.int64)
         terms = np.zeros((len(hit), 12))
         for j in range(3):
