@@ -153,6 +153,22 @@ def time_scales(mass: float, v0: float, diameter: float, law) -> tuple[float, fl
     return mass * v0 / force, float(np.sqrt(mass * getattr(law, "k", 2.37) * diameter / force))
 
 
+#: the tunnel's wall acts on a body pressing into it as a damper while its outward speed is below the onset
+#: speed (docs/theory.md §8.7): σ_s over the first onset_speed, on up to the body's projected side D L, a time
+#: constant τ = m onset / (σ_s D L). The classical RK4 step is stable below 2.8 τ; measured on the shots that ran
+#: away (26.9 mm, 2.5 x Forrestal's S), at about 3 τ. A rigid run takes onset_speed >= σ_s D L Δt / (ONSET_STEPS m)
+ONSET_STEPS = 2.5
+
+
+def stable_onset(law, mass: float, step: float, diameter: float, length: float):
+    """The law with the onset speed the rigid step can integrate (a copy; the law itself if it already is):
+    max(law.onset_speed, σ_s D L Δt / (ONSET_STEPS m)) (ONSET_STEPS)."""
+    from dataclasses import replace
+
+    need = law.sigma_s * diameter * length * step / (ONSET_STEPS * mass)
+    return law if law.onset_speed >= need else replace(law, onset_speed=need)
+
+
 def default_step(mass: float, v0: float, diameter: float, law) -> float:
     """The rigid fidelity's RK4 step without run.rigid_step: min(STEP_FRACTION D / v0, max(t_stop, t_crater) /
     STOP_STEPS) (time_scales). Above about 140 m/s t_stop is the larger (the step of every earlier fepen); below,

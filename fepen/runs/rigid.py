@@ -148,6 +148,8 @@ class RigidRun(Run):
         self.state = RigidState(R @ c0, matrix_to_quat(R), v.copy(), np.zeros(3))
         self.crater = sh.crater(self.mass)
         self.dt = sh.rigid_step or budget.default_step(self.mass, self.v0, sh.nominal_diameter, self.law)
+        if sh.tunnel and isinstance(self.law, tg.TargetLaw):  # the tunnel's wall, a damper the step integrates
+            self.law = budget.stable_onset(self.law, self.mass, self.dt, self.shape.diameter, self.shape.length)
         self.tip_ref = np.zeros(3)
         self.tail_ref = np.array([0.0, self.shape.length, 0.0])
         self.tip_arm = self.tip_ref - self.body.centre0  # the tip about the centre, body frame
