@@ -25,7 +25,8 @@ from fepen.studies.study import Round, Study, register
 __all__ = ["Validate", "validate", "table", "FIELDS"]
 
 FIELDS = ["shot", "v0_m_s", "obliquity_deg", "attack_deg", "Hx_mm", "Hy_mm", "Tx_mm", "Ty_mm", "Hx_exp_mm",
-          "Hy_exp_mm", "Tx_exp_mm", "Ty_exp_mm", "nose_error", "tail_error", "outcome", "wall_s"]
+          "Hy_exp_mm", "Tx_exp_mm", "Ty_exp_mm", "nose_error", "tail_error", "axis_deg", "axis_exp_deg",
+          "axis_error_deg", "nose_offset_mm", "nose_offset_exp_mm", "outcome", "wall_s"]
 
 
 @dataclass
@@ -74,6 +75,10 @@ class Validate(Study):
                          "Hx_mm": s["Hx_mm"], "Hy_mm": s["Hy_mm"], "Tx_mm": s["Tx_mm"], "Ty_mm": s["Ty_mm"],
                          "Hx_exp_mm": e.Hx_mm, "Hy_exp_mm": e.Hy_mm, "Tx_exp_mm": e.Tx_mm, "Ty_exp_mm": e.Ty_mm,
                          "nose_error": s["experiment"]["nose_error"], "tail_error": s["experiment"]["tail_error"],
+                         "axis_deg": s["final_axis_angle_deg"],
+                         "axis_exp_deg": s["experiment"]["final_axis_angle_deg"],
+                         "axis_error_deg": s["experiment"]["axis_error_deg"], "nose_offset_mm": s["nose_offset_mm"],
+                         "nose_offset_exp_mm": s["experiment"]["nose_offset_mm"],
                          "outcome": s["outcome"], "wall_s": s["wall_s"]})
         return {"rows": rows}
 
@@ -123,17 +128,25 @@ def table(rows, sc) -> str:
              f" (phi_min {sc.target.separation_angle_deg:g} deg); free surface: {sc.effects.free_surface}; "
              f"friction: {sc.effects.friction}; mesh {sc.mesh.size * 1e3:g} mm.", "",
              "| shot | v0 (m/s) | α (°) | ϑ (°) | Hx sim / test (mm) | Hy sim / test (mm) | Tx sim / test (mm) | "
-             "Ty sim / test (mm) | nose error | tail error | outcome |",
-             "|---|---|---|---|---|---|---|---|---|---|---|"]
+             "Ty sim / test (mm) | nose error | tail error | final axis sim / test (°) | nose offset sim / test (mm) | "
+             "outcome |",
+             "|---|---|---|---|---|---|---|---|---|---|---|---|---|"]
     for r in rows:
         lines.append(
             f"| {r['shot']} | {r['v0_m_s']:g} | {r['obliquity_deg']:g} | {r['attack_deg']:g} | "
             f"{r['Hx_mm']:.1f} / {r['Hx_exp_mm']:g} | {r['Hy_mm']:.1f} / {r['Hy_exp_mm']:g} | "
             f"{r['Tx_mm']:.1f} / {r['Tx_exp_mm']:g} | {r['Ty_mm']:.1f} / {r['Ty_exp_mm']:g} | "
-            f"{100 * r['nose_error']:.1f} % | {100 * r['tail_error']:.1f} % | {r['outcome']} |")
+            f"{100 * r['nose_error']:.1f} % | {100 * r['tail_error']:.1f} % | "
+            f"{r['axis_deg']:.1f} / {r['axis_exp_deg']:.1f} | "
+            f"{r['nose_offset_mm']:.0f} / {r['nose_offset_exp_mm']:.0f} | "
+            f"{r['outcome']} |")
     ne = np.array([r["nose_error"] for r in rows])
     te = np.array([r["tail_error"] for r in rows])
+    ae = np.abs([r["axis_error_deg"] for r in rows])
     lines += ["", f"Mean nose error {100 * ne.mean():.1f} %, largest {100 * ne.max():.1f} %; mean tail error "
                   f"{100 * te.mean():.1f} %, largest {100 * te.max():.1f} %. Errors: |H_sim − H_test| / |H_test| "
-                  "with H = (Hx, Hy), likewise T.", ""]
+                  "with H = (Hx, Hy), likewise T.",
+              "", f"Final axis atan2(Hx − Tx, Hy − Ty): mean error {ae.mean():.1f}°, largest {ae.max():.1f}°; "
+                  "nose offset from the line of fire "
+                  "(the nose's distance from the line through the impact point along the striking velocity).", ""]
     return "\n".join(lines)

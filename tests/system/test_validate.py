@@ -21,6 +21,17 @@ def test_validate_rigid_writes_table_1(fepen_cli, tmp_path):
     for f in ("validation.md", "validation.png", "C3/summary.json", "C3/history.csv", "C3/history.png"):
         assert (tmp_path / f).is_file()
     assert "| C7 |" in (tmp_path / "validation.md").read_text()
+    import math  # the attitude: the final axis from the row's own nose and tail, the test's from Table 1's
+
+    for k, v in rows.items():
+        f = {c: float(v[c]) for c in ("Hx_mm", "Hy_mm", "Tx_mm", "Ty_mm", "Hx_exp_mm", "Hy_exp_mm", "Tx_exp_mm",
+                                       "Ty_exp_mm", "axis_deg", "axis_exp_deg", "axis_error_deg")}
+        assert f["axis_deg"] == pytest.approx(math.degrees(math.atan2(f["Hx_mm"] - f["Tx_mm"], f["Hy_mm"] - f["Ty_mm"])),
+                                              abs=1e-3), k
+        assert f["axis_exp_deg"] == pytest.approx(math.degrees(math.atan2(f["Hx_exp_mm"] - f["Tx_exp_mm"],
+                                                                          f["Hy_exp_mm"] - f["Ty_exp_mm"])), abs=1e-3)
+        assert f["axis_error_deg"] == pytest.approx(f["axis_deg"] - f["axis_exp_deg"], abs=1e-3)
+    assert float(rows["C7"]["axis_exp_deg"]) == pytest.approx(41.5, abs=0.05)
 
 
 def test_validate_refuses_impact_overrides(fepen_cli, tmp_path):
