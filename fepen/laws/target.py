@@ -19,7 +19,7 @@ SCALED_S_COEFFICIENT = 134.8
 SCALED_S_EXPONENT = 0.544
 SCALED_S_SIZE = 0.05412
 #: the same fit with the calibrated nose wear on (effects.wear; docs/wear.md §2: fepen.studies.wear_calibration)
-SCALED_S_WEAR = (124.6, SCALED_S_EXPONENT, 0.06291)
+SCALED_S_WEAR = (125.2, SCALED_S_EXPONENT, 0.06293)
 
 
 # ---------------------------------------------------------------------------------------------------------
