@@ -2,4 +2,4 @@
 changes its reference body, target load, contact."""
 
 __all__ = ["kernels", "ckernel", "assembly", "state", "explicit", "probes", "diagnostics", "reference", "failures",
-           "surface", "target_load", "rigid_wall", "shell_charge", "erosion", "recession"]
+           "surface", "node_points", "target_load", "rigid_wall", "shell_charge", "erosion", "recession"]

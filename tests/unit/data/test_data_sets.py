@@ -54,6 +54,6 @@ def test_every_named_steel_and_target_says_where_its_numbers_come_from():
 
 def test_the_prediction_errors_say_what_made_them():
     text = (resources.files("fepen.data") / "prediction_errors.csv").read_text().splitlines()
-    assert text[0].startswith("# fepen") and "python -m fepen.studies.prediction_errors" in text[0]
+    assert text[0].startswith("# fepen") and "prediction-errors" in text[0]  # fepen study prediction-errors
     rows = list(csv.DictReader(line for line in text if not line.startswith("#")))
     assert len(rows) > 50
