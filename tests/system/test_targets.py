@@ -46,7 +46,7 @@ def test_mesh_facets_give_the_closed_form_nose_force(name):
 
 METAL = ["target.material='6061-T6511'", "projectile.diameter=0.0071", "projectile.length=0.071",
          "projectile.cavity_diameter=0", "projectile.material.name='aisi-4340'", "effects.free_surface=false",
-         "target.onset_angle_deg=0", *NORMAL]
+         "target.onset_angle_deg=0", "target.onset_speed=0", "effects.tunnel=false", *NORMAL]
 
 
 def forrestal_warren_depth(sc) -> float:
@@ -95,7 +95,7 @@ def test_a_gap_changes_nothing_but_the_time():
 def test_a_thin_slabs_residual_speed_against_its_closed_form(h):
     """No crater, no free surface: v_r² = (v0² + σ_s/(N* ρ)) exp(−2 π a² N* ρ h / m) − σ_s/(N* ρ)."""
     sets = ["effects.crater=none", "effects.free_surface=false", "target.onset_angle_deg=0", "impact.velocity=800",
-            "target.separation_angle_deg=0"]  # the closed form loads the whole nose
+            "target.separation_angle_deg=0", "target.onset_speed=0", "effects.tunnel=false"]  # the closed form
     sc = scene.Scene(f"[target]\nthickness = {h}\n", NORMAL + sets)
     s = RigidRun(sc, None, MPI.COMM_SELF).run()
     law, shape = setup.target_law(sc), setup.projectile_shape(sc)
