@@ -188,6 +188,8 @@ class TargetLaw:
             bottom None: thickness.
         onset_speed: σ_s develops over the first onset_speed (m/s) of a point's speed into the target (its normal
             speed; at the tunnel's wall its outward speed): a smooth load at vanishing speed (§8.7); 0: at once.
+        face_onset_speed: the same on the open face (m/s); None: onset_speed. A shot sets it to
+            min(onset_speed, ONSET_FRACTION x its striking speed) (at_striking_speed).
     """
 
     density: float
@@ -217,12 +219,30 @@ class TargetLaw:
     bottom: float | None = None
     surface_range: float = 1.0
     onset_speed: float = 0.0
+    face_onset_speed: float | None = None
 
     @property
     def lower(self) -> float | None:
         """Depth of the material's rear face below the face y = 0 (m): ``bottom`` (a layer inside a block of
         touching layers), else ``thickness``; None: semi-infinite."""
         return self.thickness if self.bottom is None else self.bottom
+
+
+#: on the open face σ_s develops over at most this fraction of the striking speed (§8.7): a shot that strikes
+#: slower than onset_speed / ONSET_FRACTION is not a damper from its first microsecond (a 0.1 m/s shot would
+#: creep 2 mm into concrete where the rate-independent law stops it in tens of µm)
+ONSET_FRACTION = 0.5
+
+
+def at_striking_speed(law, speed: float):
+    """The law (a TargetLaw or fepen.laws.layers.Layered) for a shot striking at ``speed`` (m/s): its open
+    face's onset speed min(onset_speed, ONSET_FRACTION speed); the tunnel wall's stays onset_speed."""
+    from dataclasses import replace
+
+    if getattr(law, "layered", False):
+        return replace(law, layers=tuple(replace(layer, law=at_striking_speed(layer.law, speed))
+                                         for layer in law.layers))
+    return replace(law, face_onset_speed=min(law.onset_speed, ONSET_FRACTION * float(speed)))
 
 
 @functools.lru_cache(maxsize=8)
@@ -336,7 +356,8 @@ def _law_numbers(law: TargetLaw) -> np.ndarray:
                      law.phi_min, float(law.free_surface), float(law.friction), law.mu,
                      law.mu if law.mu_dynamic is None else law.mu_dynamic, law.mu_decay, law.lock_density,
                      law.crush_strain, law.c_over_a, float(law.given_sigma_s), law.onset, law.top,
-                     -1.0 if law.lower is None else law.lower, law.surface_range, law.onset_speed])
+                     -1.0 if law.lower is None else law.lower, law.surface_range, law.onset_speed,
+                     law.onset_speed if law.face_onset_speed is None else law.face_onset_speed])
 
 
 def _bind(lib):

@@ -14,6 +14,7 @@ enum { P_DENSITY, P_Y, P_E, P_T, P_LAM, P_SIGMA_S, P_B, P_THICKNESS /* < 0: none
        P_TOP /* the material's own faces in a block of layers */, P_LOWER /* < 0: none */,
        P_SURFACE_RANGE /* the free face's reach in plastic-zone widths */,
        P_ONSET_SPEED /* sigma_s develops over the first onset_speed of a point's normal speed (m/s); 0: at once */,
+       P_FACE_ONSET /* the same on the open face (m/s): min(onset_speed, ONSET_FRACTION x striking speed) */,
        P_COUNT };
 
 #define SIN_TOL 1e-9
@@ -98,7 +99,8 @@ static inline int law_at_point(const double *p, const LawConstants *c, const dou
     /* at vanishing speed (§8.7): sigma_s develops over the first onset_speed of the point's speed into the target
      * (its normal speed; at the tunnel's wall its outward speed), so a body coming to rest is not loaded by the
      * whole rate-independent stress on every point that happens to face its last motion */
-    if (p[P_ONSET_SPEED] > 0.0) s *= fmin((wall ? u : vn) / p[P_ONSET_SPEED], 1.0);
+    const double onset_speed = wall ? p[P_ONSET_SPEED] : p[P_FACE_ONSET];
+    if (onset_speed > 0.0) s *= fmin((wall ? u : vn) / onset_speed, 1.0);
     double sg = (s + p[P_B] * p[P_DENSITY] * vn * vn) * frac;
     if (p[P_CRATER] == 2.0 && -y < p[P_K] * p[P_D]) { /* the splash-streamline energy balance (§8.3) */
         double rho = fmax(radius, 1e-12), l = (p[P_C_OVER_A] - 1.0) * rho, integral = 0.0;
