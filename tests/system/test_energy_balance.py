@@ -44,8 +44,8 @@ def test_energy_ratio_of_a_coarse_plastic_run():
     """The plastic C5 shot (Table 1's fast oblique one) at 5 mm cells to its stop: the ratio within 1 ± 0.05 at
     every row. Not C3: inside its tunnel C3 turns less and stays elastic on this mesh (max_peeq 0)."""
     out = tempfile.mkdtemp(prefix="fepen-balance-")
-    sim = DeformableRun(scene.load(None, ['impact.shot="C5"', "mesh.size=0.005", "run.fields=false", "run.checkpoint_interval=0"]), out,
-                        MPI.COMM_SELF)
+    sets = ['impact.shot="C5"', "mesh.size=0.005", "run.fields=false", "run.checkpoint_interval=0"]
+    sim = DeformableRun(scene.load(None, sets), out, MPI.COMM_SELF)
     summary = sim.run()
     rows = np.array(sim.rows)
     assert summary["outcome"] == "embedded" and summary["max_peeq"] > 0.0
