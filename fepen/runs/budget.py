@@ -162,11 +162,15 @@ ONSET_STEPS = 2.5
 
 def stable_onset(law, mass: float, step: float, diameter: float, length: float):
     """The law with the onset speed the rigid step can integrate (a copy; the law itself if it already is):
-    max(law.onset_speed, σ_s D L Δt / (ONSET_STEPS m)) (ONSET_STEPS)."""
+    max(law.onset_speed, σ_s D L Δt / (ONSET_STEPS m)) (ONSET_STEPS), the open face's with it unless the
+    striking speed has set that one lower (fepen.laws.target.at_striking_speed)."""
     from dataclasses import replace
 
     need = law.sigma_s * diameter * length * step / (ONSET_STEPS * mass)
-    return law if law.onset_speed >= need else replace(law, onset_speed=need)
+    if law.onset_speed >= need:
+        return law
+    face = law.face_onset_speed  # the open face's follows, unless a slow shot has made it smaller (§8.7)
+    return replace(law, onset_speed=need, face_onset_speed=None if face is None or face >= law.onset_speed else face)
 
 
 def default_step(mass: float, v0: float, diameter: float, law) -> float:
