@@ -55,6 +55,7 @@ class TargetLoad:
         length = comm.allreduce(float(np.max(surf.X[:, 1], initial=-np.inf)), op=MPI.MAX)
         self.xi_sh, self.length, self.calibre = xi_sh, length, 2.0 * a0
         self.last_force = np.zeros((0, 3))  # the points' forces of the last step (this rank's)
+        self.last_X = np.zeros((0, 3))  # and those points' reference positions
         if tunnel:
             from fepen.laws.tunnel import Tunnel
 
@@ -120,6 +121,7 @@ class TargetLoad:
         solver.fext[:n_own] += self._nodes[:n_own]
         self.force, self.contact_nodes, self.area = load.total, load.loaded, load.area
         self.last_force = load.force
+        self.last_X = (self.surf if self.nodal is None else self.nodal).X  # its points (an erosion may rebuild the surface before the row)
         solver.clock.times.target_comm += comm_s
 
     def split(self, comm) -> list[float]:
@@ -129,8 +131,7 @@ class TargetLoad:
         from fepen.laws import tunnel
 
         f = self.last_force
-        X = (self.surf if self.nodal is None else self.nodal).X
-        zone = tunnel.zones(X[:, 1], self.xi_sh, self.length, self.calibre)
+        zone = tunnel.zones(self.last_X[:, 1], self.xi_sh, self.length, self.calibre)
         hit = np.flatnonzero(np.any(f != 0.0, axis=1)) if len(f) == len(zone) else np.zeros(0, dtype=np.int64)
         terms = np.zeros((len(hit), 12))
         for j in range(3):
