@@ -5,9 +5,11 @@ after the current stack's unit and MPI lanes; it needs both environments (make s
 
 The two stacks do not run the same floating-point operations (numpy 2's SIMD exp and sin against libm's,
 ffcx 0.11's generated kernel, another LLVM under numba), so their figures agree to round-off grown through a
-run, not to the bit: every summary figure within 1e-6 of itself (the 6 significant digits fepen prints) and
-every history column within 1e-6 of its own scale; on this machine the largest are 3e-8 (C2's max_peeq, a just-
-yielded strain of 1.5e-5) and 1e-11 for the rigid shots (tools/compare_stacks.py prints them all)."""
+run, not to the bit: the rigid shots' every summary figure within 1e-6 of itself (the 6 significant digits fepen
+prints; the tip's recession, the residual speed and the energy error, differences of large figures, on their
+scale: compare_stacks.SCALE) and every history column within 1e-6 of its own scale (on this machine 1e-11); the
+deformable shots' depths to the printed digit, their other figures within TOLERANCE (the tunnel's wall makes a
+nearly normal shot's small lateral figures carry a flipped contact: C2 4e-5, 2.8e-4)."""
 
 import json
 import subprocess
@@ -27,6 +29,12 @@ pytestmark = pytest.mark.skipif(bool(MISSING), reason=f"both stacks needed (make
                                                       f"missing {MISSING}")
 #: the printed digits' resolution: fepen prints 6 significant digits
 RTOL = 1e-6
+#: the deformable shots since the tunnel's wall (issue 45), (summary, history): a point at the wall is loaded or
+#: not, and the wall is pushed out to it, so round-off can flip one point's contact and the lateral figures of a
+#: nearly normal shot, small themselves, carry it. Measured at 4 mm (tools/compare_stacks.py): C2 (0.58 deg)
+#: final axis 4e-5 of itself, force_x_N 2.8e-4 of its scale, C8 1.2e-5 and 1.5e-5; C3-C7 below 7e-7; the depths
+#: the same to the printed digit on every shot
+TOLERANCE = {"rigid": (RTOL, RTOL), "plastic-4mm": (1e-4, 1e-3)}
 
 
 @pytest.fixture(scope="module")
@@ -39,10 +47,13 @@ def pairs(tmp_path_factory):
 def test_table1_gives_the_same_figures_on_both_stacks(pairs, case):
     rows = cs.compare(*pairs[case])
     assert [r["shot"] for r in rows] == [f"C{k}" for k in range(1, 9)]
+    summary_tol, history_tol = TOLERANCE[case]
     for r in rows:
         assert r["outcome"][0] == r["outcome"][1] and not r["missing"], r
-        assert r["summary_rel"] < RTOL, f"{r['shot']} {case}: {r['summary_key']} differs by {r['summary_rel']:.2g}"
-        assert r["rows"][0] == r["rows"][1] and r["history_rel"] < RTOL, \
+        assert cs.rel(r["depth_a"], r["depth_b"]) < RTOL, r
+        assert r["summary_rel"] < summary_tol, \
+            f"{r['shot']} {case}: {r['summary_key']} differs by {r['summary_rel']:.2g}"
+        assert r["rows"][0] == r["rows"][1] and r["history_rel"] < history_tol, \
             f"{r['shot']} {case}: history.csv {r['history_col']} differs by {r['history_rel']:.2g}"
 
 
