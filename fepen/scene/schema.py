@@ -282,8 +282,8 @@ SCHEMA: dict[str, Key] = {
     "target.onset_speed": number(10.0, "m/s", 0.0, 1000.0,
                                  doc="sigma_s develops over this much of a surface point's speed into the target "
                                      "(its normal speed; at the tunnel's wall its outward speed): a smooth load as "
-                                     "the body comes to rest (on the open face at most half the striking speed); 0: at once "
-                                     "(docs/theory.md §8.7)"),
+                                     "the body comes to rest (on the open face at most half the striking speed); "
+                                     "0: at once (docs/theory.md §8.7)"),
     "target.free_surface_range": number(1.0, "", 0.0, 20.0, lo_open=True,
                                         doc="reach of the free face on sigma_s, in plastic-zone widths "
                                             "(effects.free_surface; docs/theory.md §8.4); the default "

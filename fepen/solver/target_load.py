@@ -121,7 +121,8 @@ class TargetLoad:
         solver.fext[:n_own] += self._nodes[:n_own]
         self.force, self.contact_nodes, self.area = load.total, load.loaded, load.area
         self.last_force = load.force
-        self.last_X = (self.surf if self.nodal is None else self.nodal).X  # its points (an erosion may rebuild the surface before the row)
+        # the points it acted on: an erosion may rebuild the surface before the history row splits it
+        self.last_X = (self.surf if self.nodal is None else self.nodal).X
         solver.clock.times.target_comm += comm_s
 
     def split(self, comm) -> list[float]:
