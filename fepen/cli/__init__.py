@@ -172,10 +172,23 @@ def _verdict_line(err: BaseException) -> tuple[int, str]:
 
 
 def _quiet() -> None:
+    """The console speaks only for fepen: the "fepen" logger's records as ``fepen: ...`` lines on stderr; every
+    other package's records (ffcx's compiler lines, matplotlib's font cache and warnings, Python's warnings) go
+    to fepen.log only (rundir.ChatterToLog), never to the console."""
     import logging
 
+    from fepen.io import rundir
+
     logging.getLogger("dolfinx").setLevel(logging.WARNING)
-    logging.basicConfig(format="fepen: %(message)s", level=logging.INFO)
+    own = logging.getLogger("fepen")
+    own.setLevel(logging.INFO)
+    own.propagate = False  # not through the root logger's handlers
+    if not any(getattr(h, "fepen_console", False) for h in own.handlers):
+        console = logging.StreamHandler(sys.stderr)
+        console.setFormatter(logging.Formatter("fepen: %(message)s"))
+        console.fepen_console = True
+        own.addHandler(console)
+    rundir.chatter_to_log()
 
 
 def _error(line: str) -> None:

@@ -137,9 +137,33 @@ class _Tee(logging.Handler):
             _append(_log_path, [line])
 
 
+class ChatterToLog(logging.Handler):
+    """Other packages' log records (and Python's warnings) into fepen.log, named by their logger, never to the
+    console: ``ffcx: ...``, ``py.warnings: ...`` (rank 0's; the other ranks' are dropped)."""
+
+    def emit(self, record) -> None:
+        from mpi4py import MPI
+
+        if MPI.COMM_WORLD.rank == 0:
+            log_line(f"{record.name}: {' '.join(record.getMessage().split())[:2000]}")
+
+
+def chatter_to_log() -> None:
+    """Route the root logger (every package but fepen) to fepen.log only, at INFO (once per process); Python's
+    warnings are captured into it too."""
+    root = logging.getLogger()
+    if not any(isinstance(h, ChatterToLog) for h in root.handlers):
+        root.addHandler(ChatterToLog())
+    root.setLevel(logging.INFO)
+    logging.captureWarnings(True)
+    logging.getLogger("py.warnings").propagate = True
+
+
 def tee_logging(rank: int) -> None:
-    """Send the "fepen" and "py.warnings" loggers' records to fepen.log too (once per process)."""
-    for name in ("fepen", "py.warnings"):
+    """Send the "fepen" and "py.warnings" loggers' records to fepen.log too (once per process; Python's warnings
+    not again when the command line routes every other package there: chatter_to_log)."""
+    chatter = any(isinstance(h, ChatterToLog) for h in logging.getLogger().handlers)
+    for name in ("fepen",) if chatter else ("fepen", "py.warnings"):
         logger = logging.getLogger(name)
         if not any(isinstance(h, _Tee) for h in logger.handlers):
             logger.addHandler(_Tee(rank))

@@ -184,7 +184,11 @@ class Progress:
     def __init__(self, end: float, t: float):
         from tqdm import tqdm
 
-        self.bar = tqdm(total=round(end * 1e6), initial=round(t * 1e6), unit="µs", desc="fepen", leave=False)
+        from fepen.geometry.mesh import bar_disabled
+
+        # on a terminal only (a Slurm .err file or a pipe gets none; FEPEN_PROGRESS=1 asks for it anyway)
+        self.bar = tqdm(total=round(end * 1e6), initial=round(t * 1e6), unit="µs", desc="fepen", leave=False,
+                        disable=bar_disabled())
 
     def due(self, run) -> bool:
         return run.step_count % self.EVERY == 0

@@ -283,7 +283,7 @@ def announce(scene, comm, built: Built | None = None) -> Built:
     if comm.rank == 0:
         import logging
 
-        for note in (built.note, thin_target_note(scene, built), envelope_note(scene, built)):
+        for note in (built.note, thin_target_note(scene, built), *envelope_note(scene, built).split("\n")):
             if note:
                 logging.getLogger("fepen").warning(note)
     return built
@@ -415,7 +415,7 @@ def envelope_note(scene, built: Built | None = None) -> str:
     from fepen.stats import envelope
 
     v = envelope.verdict(envelope_facts(scene, built))
-    return "" if v["inside"] else envelope.line(v)
+    return "" if v["inside"] else "\n".join([*envelope.unit_slips(v), envelope.line(v)])
 
 
 def envelope_facts(scene, built: Built | None = None) -> dict:

@@ -539,12 +539,37 @@ def unknown_key(name: str) -> InputError:
     Returns:
         The InputError (to raise, or to quote).
     """
-    tail = name.split(".")[-1]
+    parts = name.split(".")
+    if parts[0] in ("grid", "monte_carlo", "table"):  # a sweep's spec given where a scene is read
+        return InputError(display_name(name), f"[{parts[0]}] is a sweep's table, not a scene key: run the file "
+                                              "with fepen sweep FILE")
+    for k in range(len(parts) - 1, 0, -1):  # a key's value given as a table: {…} for [[…]], or a.b.c = 1
+        head = ".".join(parts[:k])
+        if head in SCHEMA:
+            return InputError(head, f"got a table ({display_name(name)}), expected {SCHEMA[head].allowed()}"
+                                    + (f" ([[{head}]] in TOML)" if "list" in SCHEMA[head].allowed() else ""))
+    tail = parts[-1]
     same_leaf = [k for k in SCHEMA if k.split(".")[-1] == tail]  # a key in the wrong table, first
     close = difflib.get_close_matches(name, same_leaf, n=1, cutoff=0.0) or difflib.get_close_matches(
         name, SCHEMA.keys(), n=1, cutoff=0.5)
     hint = f" (did you mean '{close[0]}'?)" if close else f" (sections: {', '.join(SECTIONS)})"
     return InputError(display_name(name), "unknown key" + hint)
+
+
+def _check_sets(source, sets) -> None:
+    """``--set KEY VALUE`` (a space for the '='): the value became the scene file's name. Said as that, naming
+    the key, before the file is looked for."""
+    for item in sets:
+        if isinstance(item, str) and "=" not in item:
+            hint = ""
+            if isinstance(source, (str, Path)) and "\n" not in str(source):
+                try:
+                    missing = not Path(source).is_file()
+                except (OSError, ValueError):
+                    missing = True
+                if missing:
+                    hint = f" (did you mean --set {display_name(item)}={display_name(str(source), 60)}?)"
+            raise InputError("--set", f"expected KEY=VALUE, got {shown(item)}{hint}")
 
 
 def parse_set(item: str) -> tuple[str, Any]:
@@ -734,6 +759,8 @@ class Scene(Section):
     """
 
     def __init__(self, source=None, sets=()):
+        if not isinstance(sets, dict):
+            _check_sets(source, sets)
         given = _given(source)
         items = sets.items() if isinstance(sets, dict) else (parse_set(item) for item in sets)
         for key, value in items:

@@ -12,6 +12,7 @@ dimension, its value and how far it lies beyond the range.
 from __future__ import annotations
 
 import functools
+import math
 from dataclasses import dataclass
 
 __all__ = ["Dimension", "DIMENSIONS", "KEYS", "LAWS", "ranges", "verdict", "line", "markdown"]
@@ -136,10 +137,29 @@ def verdict(facts: dict) -> dict:
             by = _beyond(d, value, lo, hi)
             if by is not None:
                 unit = f" {d.unit}" if d.unit else ""
+                end = hi if value > hi else lo
                 outside.append({"dimension": d.name, "key": KEYS[d.column], "value": f"{_fmt(d, value)}{unit}",
-                                "range": f"{_fmt(d, lo)}-{_fmt(d, hi)}{unit}", "by": by})
+                                "range": f"{_fmt(d, lo)}-{_fmt(d, hi)}{unit}", "by": by,
+                                "factor": abs(value / end) if end != 0.0 and value != 0.0 else math.inf})
     checked = f"{r['shots']} shots in {r['sets']} public sets" if r else "no public data"
     return {"inside": not outside, "law": law, "checked_on": checked, "outside": outside}
+
+
+#: a value this many times beyond its checked range (either way) is more likely a unit slip than a design
+UNIT_SLIP = 10.0
+
+
+def unit_slips(v: dict) -> list[str]:
+    """One warning per value UNIT_SLIP times or more beyond its checked range, naming its key: a km/s typed for
+    m/s, mm for m (verdict's "outside")."""
+    out = []
+    for o in v["outside"]:
+        f = o.get("factor")
+        if f is not None and (f >= UNIT_SLIP or f <= 1.0 / UNIT_SLIP):
+            times = f if f >= 1.0 else 1.0 / f
+            out.append(f"{o['key']}: {o['value']} is {times:.3g} times {'above' if f >= 1.0 else 'below'} the "
+                       f"{o['range']} checked: a unit slip? (scene keys are in SI: m, kg, m/s, Pa)")
+    return out
 
 
 def line(v: dict) -> str:

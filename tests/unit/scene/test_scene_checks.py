@@ -13,7 +13,7 @@ ROOT = Path(__file__).resolve().parents[3]
 HEADER = "Checks across keys, before anything is meshed (bad input, exit 2, naming the key):"
 
 #: the functions of resolve.py that refuse what the user gave before any key is known: not checks across keys
-PARSING = {"flatten", "unknown_key", "parse_set", "read_toml", "read_capped", "_given", "resolve"}
+PARSING = {"flatten", "unknown_key", "parse_set", "_check_sets", "read_toml", "read_capped", "_given", "resolve"}
 
 
 def _functions() -> dict[str, ast.FunctionDef]:
