@@ -34,8 +34,19 @@ def run(args) -> int:
             *(("max_peeq",) if summary.get("fidelity") != "rigid" else ()), "energy_error", "steps", "dt_s", "wall_s")
     keys += tuple(k for k in ("mass_loss_kg", "mass_loss_percent") if k in summary)
     say(*(f"{k} = {summary[k]:.6g}" if isinstance(summary[k], float) else f"{k} = {summary[k]}"
-          for k in keys), *prediction_lines(summary), written_line(out))
+          for k in keys), *experiment_lines(summary), *prediction_lines(summary), written_line(out))
     return 0
+
+
+def experiment_lines(summary: dict) -> list[str]:
+    """A Table 1 shot's errors against its test, one line (none for another shot)."""
+    e = summary.get("experiment")
+    if not e:
+        return []
+    return [f"against Table 1 {e['shot']}: nose error {100 * e['nose_error']:.1f} %, tail error "
+            f"{100 * e['tail_error']:.1f} %, final axis {summary['final_axis_angle_deg']:.1f} deg (test "
+            f"{e['final_axis_angle_deg']:.1f}), nose offset {summary['nose_offset_mm']:.0f} mm (test "
+            f"{e['nose_offset_mm']:.0f})"]
 
 
 def prediction_lines(summary: dict) -> list[str]:
