@@ -14,6 +14,10 @@ from pathlib import Path
 
 import pytest
 from conftest import ROOT
+from mpi4py import MPI
+
+from fepen import scene
+from fepen.runs.rigid import RigidRun
 
 nbclient = pytest.importorskip("nbclient", reason="the notebook tests need fepen[test] (nbclient, ipykernel)")
 jupytext = pytest.importorskip("jupytext")
@@ -69,6 +73,12 @@ def test_rigid_study_as_a_notebook(tmp_path):
     # Forrestal's law: depth grows as ln(1 + c v^2), so it rises more slowly than v^2 over 400-900 m/s
     ratio, v2 = map(float, re.search(r"depth ratio ([\d.]+) against a speed-squared ratio ([\d.]+)", text).groups())
     assert 1.5 < ratio < v2
-    # the normal-incidence tests: the rigid C2 within 10 % (docs/validation.md)
-    c2 = float(re.search(r"^C2: .*\(([-+\d.]+)%\)$", text, re.M).group(1))
-    assert abs(c2) < 10.0
+    # what it states: normal incidence (every final axis within 1e-3 deg of the normal), and the tests C2 and C8
+    # predicted as the rigid Table 1 shots predict them (the rigid validate's Hy errors, within 1.5 points:
+    # the grid's interpolation and their 0.4 and 0.58 deg)
+    assert float(re.search(r"the largest final axis angle ([-+\d.e]+) deg", text).group(1)) < 1e-3
+    for name in ("C2", "C8"):
+        said = float(re.search(rf"^{name}: .*\(([-+\d.]+)%\)$", text, re.M).group(1))
+        direct = RigidRun(scene.load(None, ["effects.fidelity=rigid", f'impact.shot="{name}"']), None,
+                          MPI.COMM_SELF).run()
+        assert abs(said - 100.0 * direct["experiment"]["Hy_error"]) < 1.5, (name, said, direct["experiment"])
