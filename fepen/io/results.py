@@ -14,6 +14,7 @@ from fepen.data import shot
 from fepen.errors import OUTCOMES, SimulationError
 from fepen.geometry.frames import unit_axis
 from fepen.io import files
+from fepen.version import SUMMARY_FORMAT
 
 G0 = 9.80665  # m/s^2, for accelerations in g
 
@@ -132,6 +133,7 @@ def stop_summary(scene: dict, rows, outcome: str, reason: str, where: dict, extr
     out.update(extra)
     out["scene"] = scene
     out["versions"] = {"fepen": files.__version__}
+    out["format_version"] = SUMMARY_FORMAT
     return out
 
 
@@ -187,6 +189,7 @@ def summary(scene: dict, experiment: str | None, rows, outcome: str, extra: dict
     out["experiment"] = comparison(experiment, out)
     out["scene"] = scene
     out["versions"] = files.versions()
+    out["format_version"] = SUMMARY_FORMAT
     return out
 
 
