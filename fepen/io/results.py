@@ -29,6 +29,22 @@ HISTORY_COLUMNS = ["t_s", "nose_x_mm", "nose_y_mm", "tail_x_mm", "tail_y_mm", "s
 # energy_ratio (-) = total_energy_J / KE_0: 1 for a perfect balance. Rigid fidelity: kinetic_J + the kinetic
 # energy the worn mass carried off − external_work_J (no internal energy, no interface).
 COL = {k: i for i, k in enumerate(HISTORY_COLUMNS)}
+#: appended to every history (both fidelities), last: the third dimension where x and y are written (z: the
+#: scene's, across the plane of fire; mm, m/s, N), and the attitude. axis_angle_deg: the axis (tail to nose)
+#: from the target's normal, in the plane of fire, positive toward +x (final_axis_deg of the row's nose and
+#: tail; summary.json's final_axis_angle_deg is its last value); yaw_deg: between the axis and the centre of
+#: mass's velocity (3-D, >= 0). The pseudo-vectors, about the centre of mass, in the scene's right-handed frame
+#: (x along the face, y out of the target toward the gun, z = x × y): the angular velocity (rad/s), the target's
+#: moment (N m) and the angular momentum (N m s), whose rate the moment is
+ATTITUDE_COLUMNS = ["nose_z_mm", "tail_z_mm", "vz_m_s", "force_z_N", "centre_x_mm", "centre_y_mm", "centre_z_mm",
+                    "axis_angle_deg", "yaw_deg",
+                    "angular_velocity_x_rad_s", "angular_velocity_y_rad_s", "angular_velocity_z_rad_s",
+                    "moment_x_N_m", "moment_y_N_m", "moment_z_N_m",
+                    "angular_momentum_x_N_m_s", "angular_momentum_y_N_m_s", "angular_momentum_z_N_m_s",
+                    "angular_impulse_x_N_m_s", "angular_impulse_y_N_m_s", "angular_impulse_z_N_m_s"]
+#: (centre_*: the centre of mass, in the history's frame, y depth; the last three: the target's angular impulse
+#: about O, the impact point, since the run began, integrated every step; the angular momentum about O,
+#: H + x_c × M v_c in the scene's frame, has grown by it)
 #: appended with a charge: mass-averaged acceleration of each body along the axis (tail to nose), in g
 #: (negative while the projectile decelerates)
 CHARGE_COLUMNS = ["shell_acc_g", "charge_acc_g"]
@@ -58,6 +74,17 @@ LOAD_COLUMNS = ["nose_force_N", "shank_force_N", "tail_force_N", "nose_points", 
 #: interpenetration and slip over the wall's node pairs, the fractions of pairs open and sliding
 INTERFACE_COLUMNS = ["friction_J", "interface_gap_max_mm", "interface_penetration_max_mm", "interface_slip_max_mm",
                      "interface_free_fraction", "interface_sliding_fraction"]
+
+
+def attitude_row(tip, tail, velocity, force, centre, omega, moment, momentum, impulse) -> list[float]:
+    """ATTITUDE_COLUMNS of one row (world-frame arguments, SI; see ATTITUDE_COLUMNS for the frames)."""
+    axis = unit_axis(tip, tail)
+    speed = float(np.linalg.norm(velocity))
+    yaw = math.degrees(math.acos(min(1.0, max(-1.0, float(axis @ velocity) / speed)))) if speed > 0.0 else 0.0
+    angle = float(final_axis_deg(tip[0], -tip[1], tail[0], -tail[1]))
+    return [tip[2] * 1e3, tail[2] * 1e3, float(velocity[2]), float(force[2]), centre[0] * 1e3, -centre[1] * 1e3,
+            centre[2] * 1e3, angle, yaw,
+            *map(float, omega), *map(float, moment), *map(float, momentum), *map(float, impulse)]
 
 
 def history_row(t, tip, tail, velocity, force, mass, energies: dict, contact: int, dt: float, peeq: float,

@@ -118,6 +118,7 @@ class RigidBody:
         #: (R, ω) of the state last passed to derivative (force functions may use them)
         self.frame: tuple[np.ndarray, np.ndarray] | None = None
         self._last: list | None = None  # [state's bytes, R, ω, points or None] of the last state asked (at)
+        self.angular_impulse_step = np.zeros(3)  # the last step's angular impulse of the load about O (N m s)
 
     def at(self, s: RigidState) -> list:
         """[key, R, ω, points or None] of state s, kept for the last state asked: a step's end state is asked
@@ -207,6 +208,7 @@ class RigidBody:
         """
         y0 = s.as_array()
         work = 0.0
+        angular = np.zeros(3)
         k = []
         state = s
         for i, (c, w) in enumerate(((0.0, 1.0), (0.5, 2.0), (0.5, 2.0), (1.0, 1.0))):
@@ -216,10 +218,12 @@ class RigidBody:
             if i == 0:
                 F0, M0 = F, M
             work += w * self.power(state, F, M, self.frame[1])
+            angular += w * (M + np.cross(state.c, F))  # the moment about O
             k.append(ki)
         y = y0 + dt / 6.0 * (k[0] + 2 * k[1] + 2 * k[2] + k[3])
         new = RigidState.from_array(y)
         new.q /= np.linalg.norm(new.q)
+        self.angular_impulse_step = dt / 6.0 * angular  # the step's angular impulse about O, the same weights
         return new, F0, M0, dt / 6.0 * work
 
     def remove_mass(self, s: RigidState, dm: float) -> tuple[RigidState, float]:

@@ -78,7 +78,7 @@ class DeformableRun(Run):
         return (results.HISTORY_COLUMNS + (charge if self.pm.charge else [])
                 + (results.INTERFACE_COLUMNS if self.contact is not None else [])
                 + (results.REMOVAL_COLUMNS if self.removing else [])
-                + (results.LOAD_COLUMNS if self.splitting else []))
+                + (results.LOAD_COLUMNS if self.splitting else []) + results.ATTITUDE_COLUMNS)
 
     def load_split(self) -> list[float]:
         return self.load.split(self.comm)
@@ -194,9 +194,11 @@ class DeformableRun(Run):
                       i["sliding_fraction"]]
         self.gauges.record()
         rear = -self._y_extent(x)[1] if self.crossings is not None else np.nan
+        xc, w, M, H = diagnostics.rotation(s, x, getattr(self.load, "nodal_force", None))  # a rigid wall: none
         return Snapshot(tip, tail, diagnostics.momentum_velocity(s), self.load.force, s.total_mass, en,
                         self.load.contact_nodes, s.dt, diagnostics.max_peeq(s), self.load.area, rear, extra,
-                        self._removal(e) if self.removing else None)
+                        self._removal(e) if self.removing else None, w, M, H,
+                        self.load.angular_impulse_now(self.comm) if m.law is not None else np.zeros(3), xc)
 
     def removal(self) -> Removal:
         return self._removal(diagnostics.energies(self.solver))

@@ -154,6 +154,7 @@ class RigidRun(Run):
         self.tail_ref = np.array([0.0, self.shape.length, 0.0])
         self.tip_arm = self.tip_ref - self.body.centre0  # the tip about the centre, body frame
         self.w_ext = 0.0
+        self.angular_impulse = np.zeros(3)  # the target's about O since the run began (N m s)
         self.ke0 = self.body.kinetic_energy(self.state)
         self.loaded = 0
         self.area = 0.0
@@ -190,11 +191,19 @@ class RigidRun(Run):
         return tg.load_on_points(self.law, x, v, n, g["area0"], g["radius"], g["R_meridian"], g["sin_phi0"],
                                  -R[:, 1], self.crater, -tip[1], tunnel=self.tunnel, body_xi=xi)
 
+    def _row_load(self, s: RigidState, R, x, v, n):
+        """The target's load at the history row's state s, evaluated once for the row's columns (the split and
+        the moment; nothing recorded)."""
+        key = s.as_array().tobytes()
+        if getattr(self, "_row", None) is None or self._row[0] != key:
+            self._row = (key, self._load(s, R, x, v, n))
+        return self._row[1]
+
     def load_split(self) -> list[float]:
         """LOAD_COLUMNS at the present state (the target's forces evaluated there; nothing recorded)."""
         s = self.state
         x, v, n, _ = self.body.points(s)
-        split = tunnel_zones.split(self._load(s, self.body.at(s)[1], x, v, n).force, self.zone)
+        split = tunnel_zones.split(self._row_load(s, self.body.at(s)[1], x, v, n).force, self.zone)
         return [*np.linalg.norm(split[:, :3], axis=1).tolist(), *split[:, 3].tolist()]
 
     def force_fn(self, s: RigidState, x, v, n):
@@ -216,6 +225,7 @@ class RigidRun(Run):
             self.tunnel.commit = True  # the first stage records the tunnel at the step's start
         s, self.F, _, work = self.body.rk4_step(s, self.dt, self.force_fn)
         self.w_ext += work
+        self.angular_impulse = self.angular_impulse + self.body.angular_impulse_step
         if self.wear is not None:
             s = self.wear.step(self.body, s, self.dt)
             self.tip_ref[1] = self.wear.shortening
@@ -242,6 +252,7 @@ class RigidRun(Run):
             s.q /= np.linalg.norm(s.q)
             self.state = s
             self.t -= (1.0 - lam) * self.dt
+            self.angular_impulse = self.angular_impulse - (1.0 - lam) * self.body.angular_impulse_step
         return outcome
 
     def finish_loop(self) -> None:
@@ -269,7 +280,14 @@ class RigidRun(Run):
                   energy_error=energy.balance_error(ke, self.ke0, self.w_ext, removed_kinetic=removed),
                   total_energy=total, energy_ratio=total / self.ke0)
         rear = -float(body.points(s)[0][:, 1].max())
-        return Snapshot(tip, tail, s.V, self.F, body.mass, en, self.loaded, self.dt, 0.0, self.area, rear)
+        R, w = body.at(s)[1:3]
+        M = np.zeros(3)
+        if self.shot.law is not None:  # the target's moment about the centre at this state
+            x, v, n, arm = body.points(s)
+            M = body.force_moment(arm, self._row_load(s, R, x, v, n).force)[1]
+        return Snapshot(tip, tail, s.V, self.F, body.mass, en, self.loaded, self.dt, 0.0, self.area, rear,
+                        omega=w.copy(), moment=M, momentum=s.L.copy(), impulse=self.angular_impulse,
+                        centre=s.c.copy())
 
     def removal(self) -> Removal:
         w = self.wear

@@ -69,6 +69,14 @@ class Snapshot:
     rear_depth: float
     extra: list = field(default_factory=list)
     removal: Removal | None = None
+    #: about the centre of mass, world frame: angular velocity (rad/s), the target's moment (N m), angular
+    #: momentum (N m s)
+    omega: np.ndarray = field(default_factory=lambda: np.zeros(3))
+    moment: np.ndarray = field(default_factory=lambda: np.zeros(3))
+    momentum: np.ndarray = field(default_factory=lambda: np.zeros(3))
+    #: the target's angular impulse about O since the run began (N m s)
+    impulse: np.ndarray = field(default_factory=lambda: np.zeros(3))
+    centre: np.ndarray = field(default_factory=lambda: np.zeros(3))  # of mass (m, world)
 
 
 class Run:
@@ -145,7 +153,7 @@ class Run:
     def columns(self) -> list[str]:
         """history.csv's columns."""
         return (results.HISTORY_COLUMNS + (results.REMOVAL_COLUMNS if self.removing else [])
-                + (results.LOAD_COLUMNS if self.splitting else []))
+                + (results.LOAD_COLUMNS if self.splitting else []) + results.ATTITUDE_COLUMNS)
 
     @property
     def splitting(self) -> bool:
@@ -230,6 +238,8 @@ class Run:
             row += [s.mass, r.heat_J, r.eroded_cells, r.kinetic_J]
         if self.splitting:
             row += self.load_split()
+        row += results.attitude_row(s.tip, s.tail, s.velocity, s.force, s.centre, s.omega, s.moment, s.momentum,
+                                    s.impulse)
         results.finite_row(row, self.step_count, self.t)
         self.rows.append(row)
         if self.probes is not None:

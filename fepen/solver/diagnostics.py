@@ -170,6 +170,30 @@ def momentum_velocity(solver) -> np.ndarray:
     return assembly.exact_sum(solver.mass[:n, None] * solver.velocity_at_step()[:n], solver.comm) / solver.total_mass
 
 
+def rotation(solver, x: np.ndarray, f_target: np.ndarray | None):
+    """The body's centre of mass x_c (m) and its rotation about it, all ranks (exact sums over the owned nodes:
+    the same on any partition): the angular velocity ω = I⁻¹ H (rad/s), the target's moment Σ r × f (N m)
+    and the angular momentum H = Σ m r × (v − v_c) (N m s), r = x − x_c, world frame; I = Σ m (|r|² 1 − r rᵀ).
+
+    Args:
+        solver: the ExplicitSolver. x: its node positions now (m). f_target: the target's nodal forces of the
+            last step (N; None: no target, zero moment).
+    """
+    n = solver.n_owned
+    m = solver.mass[:n]
+    v = solver.velocity_at_step()[:n]
+    first = assembly.exact_sum(np.concatenate([m[:, None] * x[:n], m[:, None] * v], axis=1), solver.comm)
+    xc, vc = first[:3] / solver.total_mass, first[3:] / solver.total_mass
+    r, u = x[:n] - xc, v - vc
+    f = np.zeros((n, 3)) if f_target is None else f_target[:n]
+    H = m[:, None] * np.cross(r, u)
+    M = np.cross(r, f)
+    rr = m[:, None, None] * (np.einsum("ij,ij->i", r, r)[:, None, None] * np.eye(3) - r[:, :, None] * r[:, None, :])
+    sums = assembly.exact_sum(np.concatenate([H, M, rr.reshape(n, 9)], axis=1), solver.comm)
+    H, M, inertia = sums[:3], sums[3:6], sums[6:].reshape(3, 3)
+    return xc, np.linalg.solve(inertia, H), M, H
+
+
 def body_accelerations(solver, axis: np.ndarray) -> np.ndarray:
     """Mass-averaged acceleration of each material's body along the axis (m/s^2), all ranks:
     Σ_a m_a^(body) a_a · axis / m_body, with m_a^(body) the lumped mass node a takes from that body's

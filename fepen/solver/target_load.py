@@ -55,6 +55,10 @@ class TargetLoad:
         length = comm.allreduce(float(np.max(surf.X[:, 1], initial=-np.inf)), op=MPI.MAX)
         self.xi_sh, self.length, self.calibre = xi_sh, length, 2.0 * a0
         self.last_force = np.zeros((0, 3))  # the points' forces of the last step (this rank's)
+        #: the target's angular impulse about O (N m s): up to the last history row (the same on every rank),
+        #: and this rank's part since then; the moment about O of this rank's points at the last step
+        self.angular_impulse = np.zeros(3)
+        self.angular_since, self.moment_o = np.zeros(3), np.zeros(3)
         self.last_X = np.zeros((0, 3))  # and those points' reference positions
         if tunnel:
             from fepen.laws.tunnel import Tunnel
@@ -105,6 +109,11 @@ class TargetLoad:
             xi = np.ascontiguousarray(s.X[:, 1])
         load = tg.load_on_points(self.law, x, v, n, area, s.radius, s.R_meridian, s.sin_phi0, axis, self.crater,
                                  -tip[1], reduce, tunnel=self.tunnel, body_xi=xi)
+        # the target's moment about O on this rank's points (Σ x × f: a facet's thirds at its corners have its
+        # centroid's moment), integrated by the trapezoid rule, whose weights are the central difference's
+        m_o = np.cross(x, load.force).sum(axis=0) if len(x) else np.zeros(3)
+        self.angular_since += 0.5 * dt * (self.moment_o + m_o)
+        self.moment_o = m_o
         if self.tunnel is not None and comm.size > 1:  # every rank's pushes of the wall
             t1 = perf_counter()
             comm.Allreduce(MPI.IN_PLACE, self.tunnel.recorded(), op=MPI.MAX)
@@ -125,6 +134,18 @@ class TargetLoad:
         self.last_X = (self.surf if self.nodal is None else self.nodal).X
         solver.clock.times.target_comm += comm_s
 
+    def angular_impulse_now(self, comm) -> np.ndarray:
+        """The target's angular impulse about O since the run began (N m s; collective, exact: the same on any
+        partition), folded into angular_impulse."""
+        self.angular_impulse = self.angular_impulse + assembly.exact_sum(self.angular_since[None, :], comm)
+        self.angular_since = np.zeros(3)
+        return self.angular_impulse
+
+    @property
+    def nodal_force(self) -> np.ndarray:
+        """The target's force on each node at the last step (N, this rank's nodes, world frame)."""
+        return self._nodes
+
     def split(self, comm) -> list[float]:
         """The last step's load by zone (fepen.laws.tunnel.zones: nose, shank, tail): the size of each zone's
         resultant (N), then its loaded points, summed exactly over the ranks (collective; the same on any
@@ -143,7 +164,8 @@ class TargetLoad:
 
     def state(self) -> dict[str, np.ndarray]:
         """The load's last totals (for checkpoints; the same on every rank)."""
-        out = {"force": np.asarray(self.force, dtype=float), "totals": np.array([self.contact_nodes, self.area])}
+        out = {"force": np.asarray(self.force, dtype=float), "totals": np.array([self.contact_nodes, self.area]),
+               "angular_impulse": np.asarray(self.angular_impulse, dtype=float)}  # as of the last history row
         if self.tunnel is not None:
             out["tunnel"] = self.tunnel.state()
         return out
@@ -152,5 +174,7 @@ class TargetLoad:
         """Put back what state() returned."""
         self.force = np.array(state["force"][:3])
         self.contact_nodes, self.area = int(state["totals"][0]), float(state["totals"][1])
+        if "angular_impulse" in state:
+            self.angular_impulse = np.array(state["angular_impulse"][:3])
         if self.tunnel is not None and "tunnel" in state:
             self.tunnel.restore(np.asarray(state["tunnel"]))

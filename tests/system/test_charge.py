@@ -53,7 +53,7 @@ def test_tied_charge_accelerations_balance_the_target_force(tied_150us):
     header = (sim.out / "history.csv").read_text().splitlines()[0].split(",")
     k = len(results.HISTORY_COLUMNS)
     assert header[k:] == (results.CHARGE_COLUMNS + results.BODY_COLUMNS + results.RESULTANT_COLUMNS
-                          + results.LOAD_COLUMNS)
+                          + results.LOAD_COLUMNS + results.ATTITUDE_COLUMNS)
 
 
 @pytest.mark.mpi
