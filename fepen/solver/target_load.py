@@ -163,9 +163,10 @@ class TargetLoad:
         return [*np.linalg.norm(sums[:, :3], axis=1).tolist(), *sums[:, 3].tolist()]
 
     def state(self) -> dict[str, np.ndarray]:
-        """The load's last totals (for checkpoints; the same on every rank)."""
+        """The load's last totals and the angular impulse's sums (for checkpoints; this rank's)."""
         out = {"force": np.asarray(self.force, dtype=float), "totals": np.array([self.contact_nodes, self.area]),
-               "angular_impulse": np.asarray(self.angular_impulse, dtype=float)}  # as of the last history row
+               # the angular impulse as of the last history row, this rank's since, and its last moment about O
+               "angular": np.concatenate([self.angular_impulse, self.angular_since, self.moment_o])}
         if self.tunnel is not None:
             out["tunnel"] = self.tunnel.state()
         return out
@@ -174,7 +175,8 @@ class TargetLoad:
         """Put back what state() returned."""
         self.force = np.array(state["force"][:3])
         self.contact_nodes, self.area = int(state["totals"][0]), float(state["totals"][1])
-        if "angular_impulse" in state:
-            self.angular_impulse = np.array(state["angular_impulse"][:3])
+        if "angular" in state:
+            a = np.asarray(state["angular"], dtype=float)
+            self.angular_impulse, self.angular_since, self.moment_o = a[:3].copy(), a[3:6].copy(), a[6:9].copy()
         if self.tunnel is not None and "tunnel" in state:
             self.tunnel.restore(np.asarray(state["tunnel"]))
