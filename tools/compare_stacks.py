@@ -14,6 +14,7 @@ from __future__ import annotations
 
 import argparse
 import math
+import re
 import subprocess
 import sys
 from pathlib import Path
@@ -48,7 +49,8 @@ def numbers(d, prefix: str = "") -> dict[str, float]:
 #: speed (1.5 m/s of C1's 700, the body's ringing when it stops) is a difference of nodal velocities of the
 #: striking speed's size
 SCALE = {"nose_profile.tip_recession_mm": 100.0, "length_change_mm": 100.0, "residual_speed_m_s": 100.0,
-         "energy_error": 1.0}  # and the energy balance's error, a fraction of the striking energy (1e-5 of it)
+         "energy_error": 1.0,  # and the energy balance's error, a fraction of the striking energy (1e-5 of it)
+         "yaw_deg": 1.0, "axis_angle_deg": 1.0}  # and angles of a nearly normal shot, hundredths of a degree
 
 
 def rel(a: float, b: float, scale: float = 0.0) -> float:
@@ -104,18 +106,28 @@ def state_rows(columns: list[str], ra: list[list[float]], rb: list[list[float]])
     return [i for i, (r1, r2) in enumerate(zip(ra, rb)) if any(r1[j] != r2[j] for j in js)]
 
 
+def family(name: str) -> str:
+    """A vector's components share a scale: nose_x_mm, nose_y_mm, nose_z_mm -> nose_*_mm; vx_m_s -> v*_m_s;
+    moment_y_N_m -> moment_*_N_m (a planar shot's out-of-plane moment is round-off on the in-plane one's scale)."""
+    name = re.sub(r"(^|_)[xyz](?=_)", r"\1*", name)
+    return re.sub(r"^v[xyz]_", "v*_", name)
+
+
 def history_difference(columns: list[str], ra: list[list[float]], rb: list[list[float]]) -> tuple[float, str]:
     """The largest difference of two histories' numbers relative to their column's largest magnitude (a column
     that starts at zero, as the work done, is judged on its scale, not on its first rows), and its column; the
     state columns (is_state) left out."""
     worst = (0.0, "")
+    scales: dict[str, float] = {}
+    for j, name in enumerate(columns):
+        vals = [abs(r[j]) for rows in (ra, rb) for r in rows if not math.isnan(r[j])]
+        scales[family(name)] = max(scales.get(family(name), 0.0), max(vals, default=0.0))
     for j, name in enumerate(columns):
         if is_state(name):
             continue
         a = [r[j] for r in ra if not math.isnan(r[j])]
         b = [r[j] for r in rb if not math.isnan(r[j])]
-        scale = max((abs(x) for x in a + b), default=0.0)
-        scale = max(scale, SCALE.get(name, 0.0))
+        scale = max(scales[family(name)], SCALE.get(name, 0.0))
         if len(a) != len(b):
             return math.inf, name
         if scale > 0.0:

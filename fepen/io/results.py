@@ -79,8 +79,8 @@ INTERFACE_COLUMNS = ["friction_J", "interface_gap_max_mm", "interface_penetratio
 def attitude_row(tip, tail, velocity, force, centre, omega, moment, momentum, impulse) -> list[float]:
     """ATTITUDE_COLUMNS of one row (world-frame arguments, SI; see ATTITUDE_COLUMNS for the frames)."""
     axis = unit_axis(tip, tail)
-    speed = float(np.linalg.norm(velocity))
-    yaw = math.degrees(math.acos(min(1.0, max(-1.0, float(axis @ velocity) / speed)))) if speed > 0.0 else 0.0
+    # atan2(|a × v|, a · v): a small yaw to full precision (acos of a cosine near 1 keeps only its square root)
+    yaw = math.degrees(math.atan2(float(np.linalg.norm(np.cross(axis, velocity))), float(axis @ velocity)))
     angle = float(final_axis_deg(tip[0], -tip[1], tail[0], -tail[1]))
     return [tip[2] * 1e3, tail[2] * 1e3, float(velocity[2]), float(force[2]), centre[0] * 1e3, -centre[1] * 1e3,
             centre[2] * 1e3, angle, yaw,

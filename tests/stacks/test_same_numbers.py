@@ -32,9 +32,9 @@ RTOL = 1e-6
 #: the deformable shots since the tunnel's wall (issue 45), (summary, history): a point at the wall is loaded or
 #: not, and the wall is pushed out to it, so round-off can flip one point's contact and the lateral figures of a
 #: nearly normal shot, small themselves, carry it. Measured at 4 mm (tools/compare_stacks.py): C2 (0.58 deg)
-#: final axis 4e-5 of itself, force_x_N 2.8e-4 of its scale, C8 1.2e-5 and 1.5e-5; C3-C7 below 7e-7; the depths
-#: the same to the printed digit on every shot
-TOLERANCE = {"rigid": (RTOL, RTOL), "plastic-4mm": (1e-4, 1e-3)}
+#: final axis 4e-5 of itself, its instantaneous out-of-plane moment moment_x_N_m 1.6e-3 of the moments' scale,
+#: C8 1.2e-5 and 2e-5; C3-C7 below 6e-6; the depths the same to the printed digit on every shot
+TOLERANCE = {"rigid": (RTOL, RTOL), "plastic-4mm": (1e-4, 5e-3)}
 
 
 @pytest.fixture(scope="module")
