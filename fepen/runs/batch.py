@@ -122,7 +122,7 @@ def _single(run):
 
 def _shot_numbers(run) -> list[float]:
     body, crater, law = run.body, run.crater, run.law
-    return [body.mass, run.dt, run.shot.hard_end, -1.0 if law.thickness is None else law.thickness,
+    return [body.mass, run.dt, run.end, -1.0 if law.thickness is None else law.thickness,
             float(run.rules.until_stopped), run.history.clock.interval, float(crater is not None),
             crater.kd if crater is not None else 0.0, crater.c if crater is not None else 0.0, run.ke0,
             events.STOP_ENERGY, *run.tip_arm, *(run.tail_ref - body.centre0), *body.I_body_inv.ravel(),
@@ -139,7 +139,7 @@ def _tunnel_numbers(t) -> list[float]:
 def _tunnel_room(runs) -> int:
     """Stations a batch's tunnels need at most: the shoulder's path within the hard end, at most twice the
     striking speed times it (speed only falls; the turning adds the arm's sweep), over the spacing."""
-    need = [2.0 * r.v0 * r.shot.hard_end / r.tunnel.buf[tunnel.T_SPACING] + 2.0 for r in runs if r.tunnel is not None]
+    need = [2.0 * r.v0 * r.end / r.tunnel.buf[tunnel.T_SPACING] + 2.0 for r in runs if r.tunnel is not None]
     return int(min(tunnel.CAPACITY, max(need))) if need else 0
 
 

@@ -148,6 +148,8 @@ class RigidRun(Run):
         self.state = RigidState(R @ c0, matrix_to_quat(R), v.copy(), np.zeros(3))
         self.crater = sh.crater(self.mass)
         self.dt = sh.rigid_step or budget.default_step(self.mass, self.v0, sh.nominal_diameter, self.law)
+        if sh.end_time is None:  # a shot that never stops (a body slower than its first ring's reach) ends
+            self.end = min(self.end, (budget.MAX_RIGID_STEPS - 0.5) * self.dt)  # in the step budget, "ended"
         if sh.tunnel and isinstance(self.law, tg.TargetLaw):  # the tunnel's wall, a damper the step integrates
             self.law = budget.stable_onset(self.law, self.mass, self.dt, self.shape.diameter, self.shape.length)
         self.tip_ref = np.zeros(3)

@@ -97,6 +97,7 @@ class Run:
     def __init__(self, shot: Shot, out, comm=MPI.COMM_WORLD):
         self.shot, self.comm = shot, comm
         self.wall_t0 = time.perf_counter()
+        self.end = shot.hard_end  # the latest simulated time the loop runs to (s)
         self.wall_before = 0.0  # wall seconds of the runs this one resumes
         self.output_s = 0.0
         self.out = files.prepare(out, comm) if out is not None else None
@@ -209,7 +210,7 @@ class Run:
         caught SIGTERM or SIGINT interrupts after the next outputs). Returns the outcome of a stop rule, or
         None at the end of time."""
         outcome = caught = None
-        while outcome is None and self.t < self.shot.hard_end:
+        while outcome is None and self.t < self.end:
             for o in self.outputs:
                 if o.due(self):
                     o.write(self)
