@@ -157,6 +157,7 @@ class RigidRun(Run):
         self.tip_arm = self.tip_ref - self.body.centre0  # the tip about the centre, body frame
         self.w_ext = 0.0
         self.angular_impulse = np.zeros(3)  # the target's about O since the run began (N m s)
+        self._row = None  # (the state's bytes, the target's load there) of the last history row
         self.ke0 = self.body.kinetic_energy(self.state)
         self.loaded = 0
         self.area = 0.0
@@ -197,7 +198,7 @@ class RigidRun(Run):
         """The target's load at the history row's state s, evaluated once for the row's columns (the split and
         the moment; nothing recorded)."""
         key = s.as_array().tobytes()
-        if getattr(self, "_row", None) is None or self._row[0] != key:
+        if self._row is None or self._row[0] != key:
             self._row = (key, self._load(s, R, x, v, n))
         return self._row[1]
 
