@@ -5,7 +5,12 @@ Node probes (the target's frame, as fields.xdmf: metres, y = 0 the target face, 
 ``_ux_m, _uy_m, _uz_m`` the displacement from the undeformed projectile's point (the placement at t = 0
 included), ``_vx_m_s, ...`` the velocity and ``_ax_m_s2, ...`` the acceleration. Cell probes:
 ``_von_mises_Pa``, ``_axial_stress_Pa`` (along the axis, tail to nose; positive in tension), ``_pressure_Pa``
-(positive in compression), ``_peeq`` and ``_temperature_K``. Values are written with the digits that give
+(positive in compression), ``_peeq`` and ``_temperature_K``. Accelerometer probes (a node probe read as an
+accelerometer fixed in the body, as instrumented penetrators carry): the node's acceleration resolved on the
+body's axes, in g (9.80665 m/s²), ``_axial_g`` along the axis tail to nose (negative while the body slows, as
+every acceleration fepen writes), ``_lateral_g`` across it in the plane of fire (ẑ × axis) and
+``_out_of_plane_g`` (the third, toward +z); raw, then each low-pass filtered like accelerations.csv
+(``_axial_filtered_g``, ...; zero-phase, run.acceleration_filter_hz, over the whole record so far). Values are written with the digits that give
 back the same double (the rank-count invariance is checked on the file itself).
 """
 
@@ -17,13 +22,45 @@ from pathlib import Path
 from mpi4py import MPI
 
 from fepen.io import files
+from fepen.io.results import G0
 
-__all__ = ["NODE_COLUMNS", "CELL_COLUMNS", "columns", "write"]
+__all__ = ["NODE_COLUMNS", "CELL_COLUMNS", "ACCELEROMETER_COLUMNS", "quantities", "columns", "body_axes_g",
+           "write"]
 
 #: a node probe's quantities, in the order of its values
 NODE_COLUMNS = ("ux_m", "uy_m", "uz_m", "vx_m_s", "vy_m_s", "vz_m_s", "ax_m_s2", "ay_m_s2", "az_m_s2")
 #: a cell probe's quantities, in the order of its values
 CELL_COLUMNS = ("von_mises_Pa", "axial_stress_Pa", "pressure_Pa", "peeq", "temperature_K")
+#: an accelerometer probe's raw channels (g, body axes); each is followed in the file by its filtered twin
+ACCELEROMETER_RAW = ("axial_g", "lateral_g", "out_of_plane_g")
+#: an accelerometer probe's columns: the raw channels, then the filtered ones
+ACCELEROMETER_COLUMNS = ACCELEROMETER_RAW + tuple(c.replace("_g", "_filtered_g") for c in ACCELEROMETER_RAW)
+
+
+def quantities(kind: str) -> tuple[str, ...]:
+    """The columns (without the probe's name) of one probe kind ('node', 'cell' or 'accelerometer')."""
+    return {"node": NODE_COLUMNS, "cell": CELL_COLUMNS, "accelerometer": ACCELEROMETER_COLUMNS}[kind]
+
+
+def body_axes_g(acc, axis) -> list[float]:
+    """An acceleration resolved on the body's axes, in g.
+
+    Args:
+        acc: the acceleration (3,), m/s², the target's frame. axis: the body's unit axis, tail to nose.
+
+    Returns:
+        [axial, lateral, out of plane] (g): along the axis; along ẑ × axis (across the axis in the plane of
+        fire, +x for a normal shot); along the rest of ẑ (toward +z). An axis along z (never a shot's) takes
+        x as its plane's normal instead.
+    """
+    import numpy as np
+
+    a, e = np.asarray(acc, dtype=float), np.asarray(axis, dtype=float)
+    z = np.array([0.0, 0.0, 1.0]) if abs(e[2]) < 0.999 else np.array([1.0, 0.0, 0.0])
+    lat = np.cross(z, e)
+    lat /= np.linalg.norm(lat)
+    out = np.cross(e, lat)
+    return [float(a @ e) / G0, float(a @ lat) / G0, float(a @ out) / G0]
 
 
 def columns(probes) -> list[str]:
@@ -37,18 +74,41 @@ def columns(probes) -> list[str]:
     """
     out = ["t_s"]
     for p in probes:
-        out += [f"{p['name']}_{q}" for q in (NODE_COLUMNS if p["kind"] == "node" else CELL_COLUMNS)]
+        out += [f"{p['name']}_{q}" for q in quantities(p["kind"])]
     return out
 
 
-def write(rows, out: Path, header: list[str], comm=MPI.COMM_WORLD) -> None:
+def filtered(rows, header: list[str], cutoff_hz: float) -> list[list[float]]:
+    """The rows with every accelerometer's filtered columns filled from its raw ones (zero-phase low-pass over
+    the whole record, fepen.post.signals.lowpass; the rows as given are left alone).
+
+    Args:
+        rows: the rows, t then the values in the header's order (the filtered columns' values are ignored).
+        header: columns(probes). cutoff_hz: run.acceleration_filter_hz.
+    """
+    import numpy as np
+
+    from fepen.post import signals
+
+    table = np.array(rows, dtype=float).reshape(len(rows), len(header))
+    for j, name in enumerate(header):
+        if name.endswith("_filtered_g"):
+            raw = header.index(name.replace("_filtered_g", "_g"))
+            table[:, j] = signals.lowpass(table[:, 0], table[:, raw], cutoff_hz) if len(rows) else []
+    return table.tolist()
+
+
+def write(rows, out: Path, header: list[str], comm=MPI.COMM_WORLD, cutoff_hz: float = 0.0) -> None:
     """probes.csv (rank 0, atomically; collective: a failed write raises MachineFault on every rank, and the
     file keeps its last complete version).
 
     Args:
         rows: the rows, each t then the values in the header's order.
         out: the results directory. header: columns(probes). comm: the run's communicator.
+        cutoff_hz: the accelerometers' low-pass cut-off (run.acceleration_filter_hz; 0: unfiltered).
     """
+    if any(h.endswith("_filtered_g") for h in header):
+        rows = filtered(rows, header, cutoff_hz)
 
     def write_file():
         buf = io.StringIO()

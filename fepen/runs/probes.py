@@ -76,9 +76,10 @@ class Probes:
         """Append the row of the run's time (collective)."""
         self.rows.append([run.t, *self.values(run)])
 
-    def write(self, out, comm) -> None:
-        """probes.csv of the rows so far (collective)."""
-        probes_io.write(self.rows, out, self.header, comm)
+    def write(self, out, comm, cutoff_hz: float = 0.0) -> None:
+        """probes.csv of the rows so far (collective); cutoff_hz: the accelerometers' low-pass
+        (run.acceleration_filter_hz)."""
+        probes_io.write(self.rows, out, self.header, comm, cutoff_hz)
 
     def state(self) -> dict:
         """The rows (a checkpoint's arrays)."""
@@ -125,16 +126,16 @@ class MeshProbes(Probes):
         s = run.solver
         x = s.positions()
         nodes = cells = np.zeros((0, 0))
+        m = run.model
+        axis = unit_axis(sp.node_value(s, m.tip, x), sp.node_value(s, m.tail, x))
         if self.nodes:
             u = sp.node_values(s, self.nodes, x - s.X0)
             v = sp.node_values(s, self.nodes, s.velocity_at_step())
             a = sp.node_values(s, self.nodes, s.acc)
             nodes = np.concatenate([u, v, a], axis=1)
         if self.cells:
-            m = run.model
-            axis = unit_axis(sp.node_value(s, m.tip, x), sp.node_value(s, m.tail, x))
             cells = sp.cell_values(s, self.cells, axis)
-        return _in_order(self.specs, nodes, cells)
+        return _in_order(self.specs, nodes, cells, axis)
 
 
 class RigidProbes(Probes):
@@ -159,16 +160,22 @@ class RigidProbes(Probes):
         v = s.V + np.cross(w, r)
         alpha = R @ (body.I_body_inv @ (R.T @ (M - np.cross(w, s.L))))
         a = F / body.mass + np.cross(alpha, r) + np.cross(w, np.cross(w, r))
-        return _in_order(self.specs, np.concatenate([u, v, a], axis=1), np.zeros((0, 0)))
+        axis = R @ np.array([0.0, -1.0, 0.0])  # tail to nose: the reference body's nose tip is at y = 0, its tail at +y
+        return _in_order(self.specs, np.concatenate([u, v, a], axis=1), np.zeros((0, 0)), axis)
 
 
-def _in_order(specs, nodes: np.ndarray, cells: np.ndarray) -> list[float]:
-    """The node and cell probes' value rows merged back into the scene's order."""
+def _in_order(specs, nodes: np.ndarray, cells: np.ndarray, axis: np.ndarray) -> list[float]:
+    """The node and cell probes' value rows merged back into the scene's order; an accelerometer's node
+    acceleration resolved on the body's axes (its filtered columns left at 0: probes.csv's writer fills them
+    from the whole record)."""
     out: list[float] = []
     i = j = 0
     for p in specs:
         if p["kind"] == "node":
             out += [float(v) for v in nodes[i]]
+            i += 1
+        elif p["kind"] == "accelerometer":
+            out += probes_io.body_axes_g(nodes[i][6:9], axis) + [0.0, 0.0, 0.0]
             i += 1
         else:
             out += [float(v) for v in cells[j]]

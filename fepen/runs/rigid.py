@@ -178,7 +178,7 @@ class RigidRun(Run):
             self.shoulder_arm = np.array([0.0, self.tunnel.xi_sh, 0.0]) - self.body.centre0
         self.t, self.step_count = 0.0, 0
         self.prev = self.state
-        self.F = self.body.derivative(self.state, self.force_fn)[1]  # the force of a row: at its step's start
+        self.F = self.body.derivative(self.state, self.force_fn)[1]  # the force at the state (no target: zero)
         if sh.probes and history and self.out is not None:
             self.probes = run_probes.RigidProbes(sh.probes)
 
@@ -222,7 +222,7 @@ class RigidRun(Run):
         return self.body.at(s)[1] @ np.array([0.0, -1.0, 0.0])
 
     def step(self) -> None:
-        """One RK4 step (the force kept for the history is the step's start's), then the wear."""
+        """One RK4 step, then the wear (a history row evaluates the target's load at its own state)."""
         self.prev = s = self.state
         if self.tunnel is not None:
             self.tunnel.commit = True  # the first stage records the tunnel at the step's start
@@ -284,11 +284,13 @@ class RigidRun(Run):
                   total_energy=total, energy_ratio=total / self.ke0)
         rear = -float(body.points(s)[0][:, 1].max())
         R, w = body.at(s)[1:3]
-        M = np.zeros(3)
-        if self.shot.law is not None:  # the target's moment about the centre at this state
+        F, M, loaded, area = self.F, np.zeros(3), self.loaded, self.area
+        if self.shot.law is not None:  # the target's force and moment about the centre at the row's state
             x, v, n, arm = body.points(s)
-            M = body.force_moment(arm, self._row_load(s, R, x, v, n).force)[1]
-        return Snapshot(tip, tail, s.V, self.F, body.mass, en, self.loaded, self.dt, 0.0, self.area, rear,
+            load = self._row_load(s, R, x, v, n)
+            F, M = body.force_moment(arm, load.force)
+            loaded, area = load.loaded, load.area
+        return Snapshot(tip, tail, s.V, F, body.mass, en, loaded, self.dt, 0.0, area, rear,
                         omega=w.copy(), moment=M, momentum=s.L.copy(), impulse=self.angular_impulse,
                         centre=s.c.copy())
 

@@ -266,7 +266,7 @@ class Run:
         if self.out is not None:
             results.write_history(self.rows, self.out, self.comm, self.columns)
             if self.probes is not None:
-                self.probes.write(self.out, self.comm)
+                self.probes.write(self.out, self.comm, self.shot.outputs.acceleration_filter_hz)
 
     # ---- the summary --------------------------------------------------------------------------------------
     def removal_summary(self) -> dict:

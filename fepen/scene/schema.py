@@ -34,7 +34,7 @@ def _layers(key: Key, name: str, value) -> list:
 
 def _probes(key: Key, name: str, value) -> list:
     """output.probes' rows: each table's name (unique, letters, digits, '_' or '-'), point ([x, y, z], m) and
-    kind ('node' or 'cell', default 'node'); unknown keys refused.
+    kind ('node', 'cell' or 'accelerometer', default 'node'); unknown keys refused.
 
     Args:
         key: the list key (for its allowed form). name: the key's name. value: what the user gave.
@@ -386,8 +386,12 @@ SCHEMA: dict[str, Key] = {
                                            "rigid motion of the point), in the target's frame (m, m/s, m/s^2, as "
                                            "fields.xdmf); 'cell': the cell holding the point, its von Mises and "
                                            "axial stress, pressure (Pa), PEEQ and temperature (K), meshed "
-                                           "fidelities only. Columns <name>_<quantity>_<unit> (docs/results.md)",
-                         form="a list of tables {name, point = [x, y, z], kind = 'node' or 'cell'}", rows=_probes),
+                                           "fidelities only; 'accelerometer': the nearest node's acceleration "
+                                           "on the body's axes (axial, lateral, out of plane; g), raw and "
+                                           "low-pass filtered (run.acceleration_filter_hz). Columns "
+                                           "<name>_<quantity>_<unit> (docs/results.md)",
+                         form="a list of tables {name, point = [x, y, z], kind = 'node', 'cell' or 'accelerometer'}",
+                         rows=_probes),
 }
 
 #: the tables of the scene (the first part of every key)
@@ -397,7 +401,7 @@ SECTIONS = sorted({name.split(".")[0] for name in SCHEMA})
 PROBE_FIELDS: dict[str, Key] = {
     "name": Key(str, ABSENT, doc="the probe's name, unique: its columns in probes.csv start with it"),
     "point": Key(list, ABSENT, "m", doc="[x, y, z] in the undeformed projectile's frame"),
-    "kind": choice("node", "node", "cell"),
+    "kind": choice("node", "node", "cell", "accelerometer"),
 }
 
 #: the keys of one [[target.layers]] table besides the target constants

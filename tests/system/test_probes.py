@@ -11,6 +11,7 @@ from mpi4py import MPI
 from fepen import scene
 from fepen.errors import InputError
 from fepen.runs.deformable import DeformableRun
+from fepen.io import results
 from fepen.runs.rigid import RigidRun
 
 pytestmark = pytest.mark.xdist_group("probes")
@@ -19,7 +20,8 @@ LENGTH = 0.144
 PROBES = [{"name": "tail", "point": [0.0, LENGTH, 0.0]},
           {"name": "wall", "point": [0.0, 0.07, 0.009], "kind": "cell"},
           {"name": "nose", "point": [0.0, 0.004, 0.0], "kind": "cell"},
-          {"name": "side", "point": [0.0105, 0.1, 0.003]}]
+          {"name": "side", "point": [0.0105, 0.1, 0.003]},
+          {"name": "gauge", "point": [0.0, LENGTH, 0.0], "kind": "accelerometer"}]
 SETS = ["mesh.size=0.005", "run.end_time=3.05e-5", "run.output_interval=1e-5", "run.checkpoint_interval=0",
         "run.fields=false"]
 
@@ -58,6 +60,24 @@ def test_probe_rows_are_the_history_rows(shot):
     assert np.array_equal(p["t_s"], [r[0] for r in run.rows])
     assert list(p.dtype.names[:4]) == ["t_s", "tail_ux_m", "tail_uy_m", "tail_uz_m"]
     assert "wall_von_mises_Pa" in p.dtype.names and "nose_temperature_K" in p.dtype.names
+
+
+def test_an_accelerometer_is_its_nodes_acceleration_on_the_body_axes(shot):
+    """The tail's accelerometer and the tail's node probe read the same node: its three raw channels are that
+    acceleration turned onto the body's axes (the same length; the axial one along the history's tail-to-nose
+    axis), in g; the filtered channels keep the record's time."""
+    run, h, p = shot
+    a = np.stack([p[f"tail_a{c}_m_s2"] for c in "xyz"], 1) / results.G0
+    g = np.stack([p[f"gauge_{c}_g"] for c in ("axial", "lateral", "out_of_plane")], 1)
+    rows = np.array(run.rows)
+    tip = np.stack([rows[:, 1], -rows[:, 2]], 1)  # the scene's frame, mm (z: the plane of fire holds it here)
+    tail = np.stack([rows[:, 3], -rows[:, 4]], 1)
+    axis = (tip - tail) / np.linalg.norm(tip - tail, axis=1)[:, None]
+    peak = np.abs(a).max()
+    assert peak > 1e3  # the tail rings at thousands of g in the first 30 µs
+    assert np.allclose(np.linalg.norm(g, axis=1), np.linalg.norm(a, axis=1), rtol=0, atol=1e-9 * peak)
+    assert np.allclose(g[:, 0], a[:, 0] * axis[:, 0] + a[:, 1] * axis[:, 1], rtol=0, atol=1e-4 * peak)
+    assert all(f"gauge_{c}_filtered_g" in p.dtype.names for c in ("axial", "lateral", "out_of_plane"))
 
 
 def test_tail_probe_is_the_history_tail(shot):
