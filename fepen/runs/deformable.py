@@ -217,12 +217,16 @@ class DeformableRun(Run):
 
     def _field_writer(self, times) -> FieldWriter:
         scalars = ["interface_gap_m", "interface_slip_m"] if self.contact is not None else []
+        nodal = ["displacement_m", "velocity_m_s"]
+        if self.model.law is not None:  # the target's load (a rigid wall has none)
+            nodal.append("target_force_N")
+            scalars += ["target_normal_stress_Pa", "target_friction_traction_Pa"]
         if self.model.recession is not None:
             scalars.append("wear_depth_m")
         if self.comm.rank == 0:
             paraview.write_view_script(self.out)
         names = list(self.shot.outputs.field_names)
-        return FieldWriter(self.out, self.solver, ["displacement_m", "velocity_m_s"], names, times, scalars,
+        return FieldWriter(self.out, self.solver, nodal, names, times, scalars,
                            integer=("cell_tag",))
 
     def write_fields(self) -> None:
@@ -231,7 +235,10 @@ class DeformableRun(Run):
         axis = unit_axis(probes.node_value(s, m.tip, x), probes.node_value(s, m.tail, x))
         values = {"displacement_m": x - s.X0, "velocity_m_s": s.velocity_at_step(),
                   "von_mises_Pa": diagnostics.von_mises(s), "axial_stress_Pa": diagnostics.axial_stress(s, axis),
-                  "peeq": diagnostics.live_peeq(s), "temperature_K": s.temp, "cell_tag": s.mat + 1.0}
+                  "peeq": diagnostics.live_peeq(s), "temperature_K": s.temp, "cell_tag": s.mat + 1.0,
+                  **diagnostics.stress_fields(s)}
+        if self.model.law is not None:  # the target's load (a rigid wall has none)
+            values.update(self.load.surface_fields(s))
         if self.contact is not None:
             values.update(self.contact.nodal_gap_and_slip())
         if m.recession is not None:

@@ -166,9 +166,15 @@ def _wear(scene) -> WearParameters | None:
                           m.density, w.distribution)
 
 
+def diagnostics_stress_names() -> list[str]:
+    """The stress tensor's six fields (fepen.solver.diagnostics.STRESS_COMPONENTS)."""
+    return [f"stress_{c}_Pa" for c in ("xx", "yy", "zz", "xy", "yz", "xz")]
+
+
 def _outputs(scene) -> OutputSettings:
     r = scene.run
-    names = ["von_mises_Pa", "axial_stress_Pa"]  # fields of switched-off physics are not written
+    names = ["von_mises_Pa", "axial_stress_Pa", "pressure_Pa", "triaxiality", *diagnostics_stress_names()]
+    # fields of switched-off physics are not written
     if scene.effects.fidelity == "plastic":
         names.append("peeq")
         if scene.effects.thermal:

@@ -283,11 +283,34 @@ def von_mises(solver) -> np.ndarray:
                           + 2 * (sd[:, 3] ** 2 + sd[:, 4] ** 2 + sd[:, 5] ** 2)))
 
 
+def mean_stress(solver) -> np.ndarray:
+    """Mean (Cauchy) stress of the owned cells (Pa, positive in tension): the average of the cell's nodes'
+    pressures with the averaged-nodal-pressure element, else the trace of its stress over 3 (as
+    fepen.solver.probes.mean_stress, one cell)."""
+    if solver.passes.nodal:
+        return solver.nodal_p[solver.dofs, np.maximum(solver.mat, 0)[:, None]].mean(axis=1) * (solver.mat >= 0)
+    return solver.s[:, :3].sum(axis=1) / 3.0
+
+
+def stress_fields(solver) -> dict[str, np.ndarray]:
+    """The owned cells' Cauchy stress tensor (Pa; xx, yy, zz, xy, yz, xz in the target's frame, tension
+    positive), pressure (Pa, positive in compression) and stress triaxiality (the mean stress over von Mises,
+    -; 0 where von Mises vanishes)."""
+    sd = solver.s
+    pm = mean_stress(solver)
+    add = pm if solver.passes.nodal else 0.0  # the deviator carries the trace otherwise
+    out = {f"stress_{c}_Pa": sd[:, i] + (add if i < 3 else 0.0) for i, c in enumerate(("xx", "yy", "zz", "xy",
+                                                                                       "yz", "xz"))}
+    vm = von_mises(solver)
+    out["pressure_Pa"] = -pm
+    out["triaxiality"] = np.divide(pm, vm, out=np.zeros_like(vm), where=vm > 0.0)
+    return out
+
+
 def axial_stress(solver, axis: np.ndarray) -> np.ndarray:
     """Normal Cauchy stress along the axis of the owned cells (Pa): a·s·a plus the cells' mean stress."""
     sd = solver.s
-    pm = solver.nodal_p[solver.dofs, np.maximum(solver.mat, 0)[:, None]].mean(axis=1) * (solver.mat >= 0) \
-        if solver.passes.nodal else 0.0
+    pm = mean_stress(solver) if solver.passes.nodal else 0.0
     ax, ay, az = axis
     return (sd[:, 0] * ax * ax + sd[:, 1] * ay * ay + sd[:, 2] * az * az
             + 2 * (sd[:, 3] * ax * ay + sd[:, 4] * ay * az + sd[:, 5] * ax * az)) + pm

@@ -60,6 +60,7 @@ class TargetLoad:
         self.angular_impulse = np.zeros(3)
         self.angular_since, self.moment_o = np.zeros(3), np.zeros(3)
         self.last_X = np.zeros((0, 3))  # and those points' reference positions
+        self.last_area, self.last_n = np.zeros(0), np.zeros((0, 3))  # and their areas and normals
         if tunnel:
             from fepen.laws.tunnel import Tunnel
 
@@ -129,10 +130,34 @@ class TargetLoad:
         n_own = solver.n_owned
         solver.fext[:n_own] += self._nodes[:n_own]
         self.force, self.contact_nodes, self.area = load.total, load.loaded, load.area
-        self.last_force = load.force
+        self.last_force, self.last_area, self.last_n = load.force, area, n
         # the points it acted on: an erosion may rebuild the surface before the history row splits it
         self.last_X = (self.surf if self.nodal is None else self.nodal).X
         solver.clock.times.target_comm += comm_s
+
+    def surface_fields(self, solver) -> dict[str, np.ndarray]:
+        """The load the last step applied, as nodal fields (fields.xdmf; collective): ``target_force_N`` the
+        target's force on each owned node (N; their sum over the nodes is the history's target force), and
+        the traction it makes on the surface around the node, ``target_normal_stress_Pa`` (pressing in:
+        positive) and ``target_friction_traction_Pa`` (the tangential part's size): with facet points, each
+        facet's σ_n = −f·n/A and |f − (f·n) n|/A averaged over the node's facets weighted by their areas;
+        with node points, the node's own."""
+        f, a, n = self.last_force, self.last_area, self.last_n
+        safe = np.maximum(a, 1e-300)
+        fn = np.einsum("ij,ij->i", f, n) if len(f) else np.zeros(0)
+        sigma = -fn / safe
+        tau = np.linalg.norm(f - fn[:, None] * n, axis=1) / safe if len(f) else np.zeros(0)
+        sig_node, tau_node = np.zeros(solver.n_nodes), np.zeros(solver.n_nodes)
+        if self.nodal is None:
+            out = np.zeros((solver.n_nodes, 3))
+            third = a / 3.0
+            self._facet_sum(solver)(np.ascontiguousarray(np.column_stack([third * sigma, third * tau, third])), out)
+            hit = out[:, 2] > 0.0
+            sig_node[hit], tau_node[hit] = out[hit, 0] / out[hit, 2], out[hit, 1] / out[hit, 2]
+        else:
+            sig_node[self.nodal.node], tau_node[self.nodal.node] = sigma, tau
+        return {"target_force_N": self._nodes.copy(), "target_normal_stress_Pa": sig_node,
+                "target_friction_traction_Pa": tau_node}
 
     def angular_impulse_now(self, comm) -> np.ndarray:
         """The target's angular impulse about O since the run began (N m s; collective, exact: the same on any

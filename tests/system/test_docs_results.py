@@ -30,10 +30,11 @@ pytestmark = pytest.mark.xdist_group("test_docs_results")
 #: a deformable run kept short and coarse: no fields, no checkpoints
 SHORT = ["mesh.size=0.005", "run.end_time=3e-5", "run.fields=false", "run.checkpoint_interval=0"]
 LAYERS = {"target": {"layers": [{"material": "concrete", "thickness": 0.1, "gap": 0.05}, {"material": "concrete"}]}}
-#: a node and a cell probe (probes.csv); the docs write a probe's name as <name>
+#: a node, a cell and an accelerometer probe (probes.csv); the docs write a probe's name as <name>
 PROBES = {"output": {"probes": [{"name": "nose", "point": [0.0, 0.005, 0.0], "kind": "node"},
-                                {"name": "wall", "point": [0.009, 0.07, 0.0], "kind": "cell"}]}}
-PROBE_NAMES = re.compile(r"^(nose|wall)_")
+                                {"name": "wall", "point": [0.009, 0.07, 0.0], "kind": "cell"},
+                                {"name": "gauge", "point": [0.0, 0.14, 0.0], "kind": "accelerometer"}]}}
+PROBE_NAMES = re.compile(r"^(nose|wall|gauge)_")
 
 #: name -> (scene source, --set overrides): together every fidelity and every effect that adds an output
 RUNS = {
