@@ -78,37 +78,14 @@ def columns(probes) -> list[str]:
     return out
 
 
-def filtered(rows, header: list[str], cutoff_hz: float) -> list[list[float]]:
-    """The rows with every accelerometer's filtered columns filled from its raw ones (zero-phase low-pass over
-    the whole record, fepen.post.signals.lowpass; the rows as given are left alone).
-
-    Args:
-        rows: the rows, t then the values in the header's order (the filtered columns' values are ignored).
-        header: columns(probes). cutoff_hz: run.acceleration_filter_hz.
-    """
-    import numpy as np
-
-    from fepen.post import signals
-
-    table = np.array(rows, dtype=float).reshape(len(rows), len(header))
-    for j, name in enumerate(header):
-        if name.endswith("_filtered_g"):
-            raw = header.index(name.replace("_filtered_g", "_g"))
-            table[:, j] = signals.lowpass(table[:, 0], table[:, raw], cutoff_hz) if len(rows) else []
-    return table.tolist()
-
-
-def write(rows, out: Path, header: list[str], comm=MPI.COMM_WORLD, cutoff_hz: float = 0.0) -> None:
+def write(rows, out: Path, header: list[str], comm=MPI.COMM_WORLD) -> None:
     """probes.csv (rank 0, atomically; collective: a failed write raises MachineFault on every rank, and the
     file keeps its last complete version).
 
     Args:
         rows: the rows, each t then the values in the header's order.
         out: the results directory. header: columns(probes). comm: the run's communicator.
-        cutoff_hz: the accelerometers' low-pass cut-off (run.acceleration_filter_hz; 0: unfiltered).
     """
-    if any(h.endswith("_filtered_g") for h in header):
-        rows = filtered(rows, header, cutoff_hz)
 
     def write_file():
         buf = io.StringIO()

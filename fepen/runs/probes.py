@@ -17,8 +17,9 @@ import numpy as np
 from fepen.errors import InputError
 from fepen.geometry.frames import unit_axis
 from fepen.io import probes as probes_io
+from fepen.post import signals
 
-__all__ = ["check_inside", "Probes", "MeshProbes", "RigidProbes"]
+__all__ = ["check_inside", "filtered", "Probes", "MeshProbes", "RigidProbes"]
 
 #: points this close outside the exact outline (m) are taken as on it
 OUTLINE_TOLERANCE = 1e-9
@@ -79,7 +80,9 @@ class Probes:
     def write(self, out, comm, cutoff_hz: float = 0.0) -> None:
         """probes.csv of the rows so far (collective); cutoff_hz: the accelerometers' low-pass
         (run.acceleration_filter_hz)."""
-        probes_io.write(self.rows, out, self.header, comm, cutoff_hz)
+        rows = filtered(self.rows, self.header, cutoff_hz) if any(h.endswith("_filtered_g") for h in self.header) \
+            else self.rows
+        probes_io.write(rows, out, self.header, comm)
 
     def state(self) -> dict:
         """The rows (a checkpoint's arrays)."""
@@ -162,6 +165,22 @@ class RigidProbes(Probes):
         a = F / body.mass + np.cross(alpha, r) + np.cross(w, np.cross(w, r))
         axis = R @ np.array([0.0, -1.0, 0.0])  # tail to nose: the reference body's nose tip is at y = 0, its tail at +y
         return _in_order(self.specs, np.concatenate([u, v, a], axis=1), np.zeros((0, 0)), axis)
+
+
+def filtered(rows, header: list[str], cutoff_hz: float) -> list[list[float]]:
+    """The rows with every accelerometer's filtered columns filled from its raw ones (zero-phase low-pass over
+    the whole record, fepen.post.signals.lowpass; the rows as given are left alone).
+
+    Args:
+        rows: the rows, t then the values in the header's order (the filtered columns' values are ignored).
+        header: columns(probes). cutoff_hz: run.acceleration_filter_hz.
+    """
+    table = np.array(rows, dtype=float).reshape(len(rows), len(header))
+    for j, name in enumerate(header):
+        if name.endswith("_filtered_g"):
+            raw = header.index(name.replace("_filtered_g", "_g"))
+            table[:, j] = signals.lowpass(table[:, 0], table[:, raw], cutoff_hz) if len(rows) else []
+    return table.tolist()
 
 
 def _in_order(specs, nodes: np.ndarray, cells: np.ndarray, axis: np.ndarray) -> list[float]:
