@@ -17,7 +17,7 @@ export OMPI_MCA_rmaps_base_oversubscribe := 1
 export OMPI_MCA_mpi_yield_when_idle := 1
 export OMP_NUM_THREADS := 1
 
-.PHONY: setup run test lint bench clean notebook setup-current test-current
+.PHONY: setup run test lint bench clean notebook setup-current test-current docs
 
 setup:
 	@bash tools/bootstrap.sh
@@ -64,6 +64,12 @@ test-current: setup setup-current
 notebook: setup
 	$(PY) -m pip install -q --disable-pip-version-check -c tools/constraints.txt -e ".[test,parquet,notebook]"
 	@echo "JupyterLab installed: .venv/bin/jupyter lab demos/   (right-click a .py demo: Open With > Notebook)"
+
+# Every figure the docs quote, made again by the command that makes it and written back into its page
+# (tools/make_docs.py: the blocks between <!-- make docs: NAME --> markers; about 8 minutes on 2 cores).
+# `make docs ONLY="ricochet ballistic-limit"` makes the named ones.
+docs: setup
+	$(PY) tools/make_docs.py $(if $(ONLY),--only $(ONLY))
 
 lint: setup
 	$(PY) -m ruff check --no-cache fepen tests demos benchmarks tools

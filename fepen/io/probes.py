@@ -10,8 +10,9 @@ accelerometer fixed in the body, as instrumented penetrators carry): the node's 
 body's axes, in g (9.80665 m/s²), ``_axial_g`` along the axis tail to nose (negative while the body slows, as
 every acceleration fepen writes), ``_lateral_g`` across it in the plane of fire (ẑ × axis) and
 ``_out_of_plane_g`` (the third, toward +z); raw, then each low-pass filtered like accelerations.csv
-(``_axial_filtered_g``, ...; zero-phase, run.acceleration_filter_hz, over the whole record so far). Values are written with the digits that give
-back the same double (the rank-count invariance is checked on the file itself).
+(``_axial_filtered_g``, ...; zero-phase, run.acceleration_filter_hz, over the whole record so far). Values are
+written with the digits that give back the same double (the rank-count invariance is checked on the file
+itself).
 """
 
 from __future__ import annotations

@@ -132,6 +132,12 @@ static inline int law_at_point(const double *p, const LawConstants *c, const dou
     return 1;
 }
 
+/* 1 when the point's patch lies wholly above the target's face (law_at_point's immersed fraction is 0 there,
+ * whatever else holds): the loops skip it before locating it in the tunnel, which changes no bit */
+static inline int above_face(const double *p, const double *xi, double ell) {
+    return !(clip01(0.5 - (xi[1] + p[P_TOP]) / ell) > 0.0);
+}
+
 /* The point's wall, when it is in the tunnel T (NULL: no tunnel): the WallHit, or NULL */
 static inline const WallHit *wall_of(const double *T, const double *xi_point, double xi, WallHit *hit) {
     if (!T) return 0;
@@ -159,9 +165,11 @@ int32_t point_forces(int32_t k, const double *x, const double *v, const double *
         double *fi = f + 3 * i;
         fi[0] = fi[1] = fi[2] = 0.0;
         sig[i] = 0.0;
+        const double ell = sqrt(area[i]);
+        if (above_face(p, x + 3 * i, ell)) continue;
         WallHit hit;
         const WallHit *wall = wall_of(T, x + 3 * i, T ? body_xi[i] : 0.0, &hit);
-        if (law_at_point(p, &c, x + 3 * i, v + 3 * i, n + 3 * i, area[i], sqrt(area[i]), radius[i], Rm[i], sphi0[i],
+        if (law_at_point(p, &c, x + 3 * i, v + 3 * i, n + 3 * i, area[i], ell, radius[i], Rm[i], sphi0[i],
                          axis, wall, gauss, ng, fi, sig + i) && sig[i] > 0.0) {
             sums[3] += 1.0;
             sums[4] += area[i];

@@ -74,6 +74,22 @@ def check_ricochet(scene_path, sets, speeds, obliquity_max: float, tol: float) -
     return base, probe, speeds
 
 
+def envelope_of(base: dict, **keys) -> dict:
+    """The validated envelope's verdict (fepen.stats.envelope) on the base scene with the given keys set, its
+    printed line under "line": the study's boundary as far as fepen was checked there.
+
+    Args:
+        base: the study's base keys. keys: dotted keys with "__" for "." (impact__velocity=311.6).
+    """
+    from fepen.runs import setup
+    from fepen.stats import envelope
+
+    sc = fscene.Scene({**base, **{k.replace("__", "."): float(v) for k, v in keys.items()}})
+    v = envelope.verdict(setup.envelope_facts(sc, setup.check_supported(sc)))
+    v["line"] = envelope.line(v)
+    return v
+
+
 def scene_line(sc) -> str:
     """What a study's figure says of its base scene: fidelity, projectile mass and calibre, the target."""
     layers = sc.get("target.layers")
@@ -211,6 +227,7 @@ class BallisticLimit(_Limit):
         if len(pts) >= 3:
             a, p, rms = fit_recht_ipson([v for v, _ in pts], [vr for _, vr in pts], v_bl)
             result.update(a=a, p=p, rms_m_s=rms)
+        result["envelope"] = envelope_of(plan.base, impact__velocity=v_bl)
         return result
 
     def draw(self, fig, res: dict, plan: LimitPlan) -> None:
@@ -230,7 +247,7 @@ class BallisticLimit(_Limit):
         return [f"ballistic limit {v_bl:.1f} m/s (bracket {lo:.2f}-{hi:.2f}, tol {tol:g}); "
                 f"{v_bl - tol:.1f} m/s: {check['below']['outcome']}, {v_bl + tol:.1f} m/s: {check['above']['outcome']}"
                 + (f"; Recht-Ipson a = {res['a']:.3f}, p = {res['p']:.2f}, rms {res['rms_m_s']:.1f} m/s"
-                   if "a" in res else "")]
+                   if "a" in res else ""), f"at the limit: {res['envelope']['line']}"]
 
 
 @register
@@ -301,8 +318,11 @@ class Ricochet(_Limit):
 
     def result(self, plan: LimitPlan, records: list[dict], info) -> dict:
         critical = [0.5 * (lo + hi) for lo, hi in self.brackets]
+        # the envelope at the boundary's ends: the slowest and the fastest speed at its critical obliquity
+        ends = {f"{v:g}": envelope_of(plan.base, impact__velocity=v, impact__obliquity_deg=c)
+                for v, c in ((plan.speeds[0], critical[0]), (plan.speeds[-1], critical[-1]))}
         return {"speeds_m_s": plan.speeds, "critical_obliquity_deg": critical, "brackets": self.brackets,
-                "tol_deg": plan.tol, "map": self.cells}
+                "tol_deg": plan.tol, "map": self.cells, "envelope": ends}
 
     def draw(self, fig, res: dict, plan: LimitPlan) -> None:
         from fepen.post import study_figures
@@ -311,7 +331,8 @@ class Ricochet(_Limit):
 
     def lines(self, res: dict) -> list[str]:
         return ["critical obliquity: " + ", ".join(f"{v:g} m/s {c:.1f} deg" for v, c in
-                                                   zip(res["speeds_m_s"], res["critical_obliquity_deg"]))]
+                                                   zip(res["speeds_m_s"], res["critical_obliquity_deg"])),
+                *(f"at {v} m/s on the boundary: {e['line']}" for v, e in res["envelope"].items())]
 
 
 def _perforates(s: dict) -> bool:

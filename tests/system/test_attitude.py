@@ -36,7 +36,8 @@ def accelerometer_check(out, fidelity):
         assert axial[j] == pytest.approx(decel[k], rel=tol), (name, axial[j], decel[k])
         # measured (plastic, 5 mm): cg +0.48 %, tail +0.25 %; rigid: the centre's exactly, the tail's 1e-3 off
     if fidelity == "rigid":  # out of the plane of turning, the rigid body's axial channel is the deceleration
-        np.testing.assert_allclose(-p["cg_axial_g"], h["decel_g"], rtol=1e-5, atol=1e-5 * abs(decel[k]))  # history.csv: 6 digits
+        # (history.csv's digits)
+        np.testing.assert_allclose(-p["cg_axial_g"], h["decel_g"], rtol=1e-5, atol=1e-5 * abs(decel[k]))
     else:  # a node rings: its raw peak is far above the filtered one
         assert np.abs(p["cg_axial_g"]).max() > 1.5 * decel[k]
 

@@ -8,7 +8,6 @@ import pytest
 from mpi4py import MPI
 
 from fepen import scene
-from fepen.io import results
 from fepen.runs.deformable import DeformableRun
 
 SETS = ["mesh.size=0.005", "run.end_time=1e-4", "run.output_interval=2.5e-5", "run.checkpoint_interval=0"]

@@ -10,8 +10,8 @@ from mpi4py import MPI
 
 from fepen import scene
 from fepen.errors import InputError
-from fepen.runs.deformable import DeformableRun
 from fepen.io import results
+from fepen.runs.deformable import DeformableRun
 from fepen.runs.rigid import RigidRun
 
 pytestmark = pytest.mark.xdist_group("probes")
