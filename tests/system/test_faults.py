@@ -153,11 +153,11 @@ def test_full_disk_at_the_only_history_write_of_a_rigid_run(tmp_path):
 
 
 def test_full_disk_for_real_on_a_small_tmpfs(whole, tmp_path):
-    """A real full disk: the run writes into a 2.5 MB tmpfs; after it is enlarged, the resume completes
+    """A real full disk: the run writes into a 4 MB tmpfs (its fields fill it after the first checkpoint); after it is enlarged, the resume completes
     identically. Needs root (mount); skipped, saying why, where the machine does not allow it."""
     mnt = tmp_path / "small"
     mnt.mkdir()
-    m = subprocess.run(["mount", "-t", "tmpfs", "-o", "size=2560k", "tmpfs", str(mnt)], capture_output=True, text=True)
+    m = subprocess.run(["mount", "-t", "tmpfs", "-o", "size=4096k", "tmpfs", str(mnt)], capture_output=True, text=True)
     if m.returncode != 0:
         pytest.skip(f"cannot mount a small tmpfs here: {m.stderr.strip()}")
     try:
