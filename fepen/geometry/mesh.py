@@ -51,6 +51,23 @@ def progress(on: bool):
         _PROGRESS["on"] = before
 
 
+@contextlib.contextmanager
+def phase(desc: str, rank: int = 0):
+    """A phase without steps to count (a deformable run's set-up: ffcx, numba and the C kernels compiled on a
+    first run), shown as its name and the elapsed time, on rank 0 within ``progress(True)`` and on a terminal
+    (as the mesh's bar).
+
+    Args:
+        desc: what is being done ("setup: compiling the kernels"). rank: this process's rank.
+    """
+    bar = _MeshBar(desc) if _PROGRESS["on"] and rank == 0 else None
+    try:
+        yield
+    finally:
+        if bar is not None:
+            bar.close()
+
+
 def bar_disabled() -> bool | None:
     """tqdm's ``disable`` for a bar that is wanted: FEPEN_PROGRESS=1 shows it, 0 hides it, unset: None (shown
     only on a terminal)."""
@@ -60,14 +77,14 @@ def bar_disabled() -> bool | None:
 
 class _MeshBar:
     """The stages of gmsh and the elapsed time, refreshed every second by a thread (gmsh's calls release the
-    interpreter lock)."""
+    interpreter lock). ``desc``: the first stage's words."""
 
-    def __init__(self):
+    def __init__(self, desc: str = "mesh: building"):
         import sys
 
         from tqdm import tqdm
 
-        self.bar = tqdm(desc="mesh: building", bar_format="{desc} [{elapsed}]", file=sys.stderr, leave=False,
+        self.bar = tqdm(desc=desc, bar_format="{desc} [{elapsed}]", file=sys.stderr, leave=False,
                         disable=bar_disabled())
         self.tries, self.done = 0, threading.Event()
         self.thread = threading.Thread(target=self._tick, daemon=True)

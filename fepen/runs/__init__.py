@@ -49,7 +49,8 @@ def run_scene(scene, out, comm=MPI.COMM_WORLD, progress: bool = False, resume: d
         scene: a resolved Scene.
         out: the results directory (None: write nothing; rigid runs only).
         comm: the communicator of the run.
-        progress: progress bars on rank 0 (deformable runs: the mesh's stages, then the simulated time).
+        progress: progress bars on rank 0, on a terminal (deformable runs: the mesh's stages, then the simulated
+            time; rigid runs: the simulated time).
         resume: a checkpoint's state (fepen.runs.checkpoint.read_state) to continue from (deformable runs).
         sh: the scene's Shot when already resolved.
 
@@ -58,7 +59,7 @@ def run_scene(scene, out, comm=MPI.COMM_WORLD, progress: bool = False, resume: d
     """
     sh = sh or resolve(scene)
     if sh.rigid:
-        return RigidRun(sh, out, comm).run()
+        return RigidRun(sh, out, comm, progress=progress).run()
     from fepen.geometry import mesh as fmesh
     from fepen.runs.deformable import DeformableRun  # dolfinx: only a deformable run pays for importing it
 

@@ -77,7 +77,8 @@ def build(sh, comm: MPI.Comm = MPI.COMM_WORLD) -> Model:
     pm = setup.build_mesh(sh.built, sh.mesh, comm)
     mesh_s = time.perf_counter() - t0
     t0 = time.perf_counter()
-    s = solver(sh, pm)
+    with fmesh.phase("setup: solver and kernels (compiled once per machine)", comm.rank):
+        s = solver(sh, pm)
     contact = None
     if pm.split:
         contact = shell_charge.ShellChargeContact(s, pm.facet_tags, sh.charge_friction)

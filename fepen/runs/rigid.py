@@ -28,7 +28,7 @@ from fepen.laws.rigid_body import (
     tet_mass_properties,
 )
 from fepen.laws.tunnel import Tunnel
-from fepen.runs import budget, setup, shot
+from fepen.runs import budget, outputs, setup, shot
 from fepen.runs import probes as run_probes
 from fepen.runs.run import Removal, Run, Snapshot
 
@@ -121,9 +121,11 @@ class RigidRun(Run):
     fidelity = "rigid"
 
     def __init__(self, shot_, out, comm=MPI.COMM_WORLD, points: dict | None = None,
-                 mass_properties: tuple | None = None, history: bool = True):
+                 mass_properties: tuple | None = None, history: bool = True, progress: bool = False):
         sh = shot.of(shot_)
         super().__init__(sh, out, comm)
+        if progress and comm.rank == 0:  # a terminal's bar (a slow shot's thousands of steps take seconds)
+            self.outputs.append(outputs.Progress(sh.end_time or sh.hard_end, 0.0))
         if not history:
             self.history.clock.interval = 0.0  # never due: finish_loop records the final row
         self.check_finite = not history

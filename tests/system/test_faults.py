@@ -153,8 +153,9 @@ def test_full_disk_at_the_only_history_write_of_a_rigid_run(tmp_path):
 
 
 def test_full_disk_for_real_on_a_small_tmpfs(whole, tmp_path):
-    """A real full disk: the run writes into a 4 MB tmpfs (its fields fill it after the first checkpoint); after it is enlarged, the resume completes
-    identically. Needs root (mount); skipped, saying why, where the machine does not allow it."""
+    """A real full disk: the run writes into a 4 MB tmpfs (its fields fill it after the first checkpoint); after
+    it is enlarged, the resume completes identically. Needs root (mount); skipped, saying why, where the machine
+    does not allow it."""
     mnt = tmp_path / "small"
     mnt.mkdir()
     m = subprocess.run(["mount", "-t", "tmpfs", "-o", "size=4096k", "tmpfs", str(mnt)], capture_output=True, text=True)
