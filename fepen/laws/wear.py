@@ -18,7 +18,6 @@ nose's own volume, ΔL/Δm = y_c/(ρ V_zone).
 
 from __future__ import annotations
 
-import numba
 import numpy as np
 
 __all__ = ["LATENT_HEAT_STEEL", "MIN_CONTRACTION", "contract_points", "contraction_after", "heat_rate", "heat_rates",
@@ -43,8 +42,21 @@ def melt_enthalpy(specific_heat: float, melt_temperature: float, room_temperatur
     return specific_heat * (melt_temperature - room_temperature) + latent_heat
 
 
-@numba.njit(cache=True)
+_JIT: dict = {}
+
+
 def heat_rates(force: np.ndarray, n: np.ndarray, v: np.ndarray, mu: float) -> np.ndarray:
+    """_heat_rates compiled by numba on its first call (cached on disk): a run without wear does not import
+    numba for it (a rigid shot's start-up)."""
+    fn = _JIT.get("heat_rates")
+    if fn is None:
+        import numba
+
+        fn = _JIT["heat_rates"] = numba.njit(cache=True)(_heat_rates)
+    return fn(force, n, v, mu)
+
+
+def _heat_rates(force: np.ndarray, n: np.ndarray, v: np.ndarray, mu: float) -> np.ndarray:
     """Each point's interface heat per unit time (W), the formula's one home: μ σ_n A |v_t|, with σ_n A =
     max(−f·n, 0) from the target's force on the point (the normal part; a friction force is tangential and
     drops out). The rigid run sums it (heat_rate), the deformable one spreads it to the facets' nodes
