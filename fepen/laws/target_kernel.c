@@ -139,11 +139,12 @@ static inline int above_face(const double *p, const double *xi, double ell) {
 }
 
 /* The point's wall, when it is in the tunnel T (NULL: no tunnel): the WallHit, or NULL */
-static inline const WallHit *wall_of(const double *T, const double *xi_point, double xi, WallHit *hit) {
+static inline const WallHit *wall_of(const double *T, const TunnelEnd *e, const double *xi_point, double xi,
+                                     WallHit *hit) {
     if (!T) return 0;
     int32_t kn, sec;
     double rho;
-    if (!tunnel_locate(T, xi_point, xi, &hit->delta, hit->er, &kn, &sec, &rho)) return 0;
+    if (!tunnel_locate(T, e, xi_point, xi, &hit->delta, hit->er, &kn, &sec, &rho)) return 0;
     return hit;
 }
 
@@ -160,6 +161,8 @@ int32_t point_forces(int32_t k, const double *x, const double *v, const double *
     const LawConstants c = law_constants(p);
     const int commit = T && T[T_COMMIT] != 0.0;
     if (commit) tunnel_record(T);
+    TunnelEnd end;
+    if (T) tunnel_end(T, &end);
     for (int j = 0; j < 5; ++j) sums[j] = 0.0;
     for (int32_t i = 0; i < k; ++i) {
         double *fi = f + 3 * i;
@@ -168,7 +171,7 @@ int32_t point_forces(int32_t k, const double *x, const double *v, const double *
         const double ell = sqrt(area[i]);
         if (above_face(p, x + 3 * i, ell)) continue;
         WallHit hit;
-        const WallHit *wall = wall_of(T, x + 3 * i, T ? body_xi[i] : 0.0, &hit);
+        const WallHit *wall = wall_of(T, &end, x + 3 * i, T ? body_xi[i] : 0.0, &hit);
         if (law_at_point(p, &c, x + 3 * i, v + 3 * i, n + 3 * i, area[i], ell, radius[i], Rm[i], sphi0[i],
                          axis, wall, gauss, ng, fi, sig + i) && sig[i] > 0.0) {
             sums[3] += 1.0;
@@ -177,7 +180,7 @@ int32_t point_forces(int32_t k, const double *x, const double *v, const double *
     }
     if (commit) {
         for (int32_t i = 0; i < k; ++i)
-            if (sig[i] > 0.0) tunnel_expand(T, x + 3 * i, body_xi[i]);
+            if (sig[i] > 0.0) tunnel_expand(T, &end, x + 3 * i, body_xi[i]);
         T[T_COMMIT] = 0.0;
     }
     for (int32_t i = 0; i < k; ++i) {

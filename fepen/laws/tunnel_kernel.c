@@ -57,13 +57,28 @@ static void tunnel_open_end(const double *T, double *c, double *t, double *s) {
 }
 
 static void tunnel_at(const double *T, double s, const double *c_end, const double *t_end, double s_end,
-                      TunnelAt *at) {
+                      int32_t hint, TunnelAt *at) {
     const int32_t m = (int32_t)T[T_M];
     int32_t lo = 0, hi = m; /* stations 0..m-1 recorded, m the open end */
     if (s >= tunnel_station((double *)T, m - 1)[T_ARC]) {
         lo = m - 1;
     } else {
-        while (hi - lo > 1) { /* the last recorded station at or before s */
+        /* the last recorded station at or before s (the arcs increase: one answer however it is searched); a
+         * hint (a nearby station, or -1) narrows the bracket by doubling steps from it first */
+        if (hint >= 0 && hint < m) {
+            if (tunnel_station((double *)T, hint)[T_ARC] <= s) { /* arc[lo] <= s; then arc[hi] > s or hi = m */
+                int32_t step = 1;
+                lo = hint;
+                while (lo + step < m && tunnel_station((double *)T, lo + step)[T_ARC] <= s) {
+                    lo += step;
+                    step *= 2;
+                }
+                hi = lo + step < m ? lo + step : m;
+            } else {
+                hi = hint;
+            }
+        }
+        while (hi - lo > 1) {
             int32_t mid = (lo + hi) / 2;
             if (tunnel_station((double *)T, mid)[T_ARC] <= s) lo = mid;
             else hi = mid;
@@ -88,26 +103,36 @@ static void tunnel_at(const double *T, double s, const double *c_end, const doub
     at->w = w;
 }
 
-/* A point p at body-axial distance xi in the tunnel: returns 1 with its penetration of the wall delta (m), the
- * outward unit vector er, its nearest recorded station kn (-1: the open end) and sector sec and its distance
- * rho from the axis; 0 when it is not in the tunnel (ahead of the shoulder, no station yet, or on the axis). */
-static int tunnel_locate(const double *T, const double *p, double xi, double *delta, double *er, int32_t *kn,
-                         int32_t *sec, double *rho) {
+/* The open end of one call's tunnel (tunnel_open_end), computed once per call after the station is recorded:
+ * every point of the call is located against the same end. */
+typedef struct {
+    double c[3], t[3], s;
+} TunnelEnd;
+
+static inline void tunnel_end(const double *T, TunnelEnd *e) {
+    if ((int32_t)T[T_M] >= 1) tunnel_open_end(T, e->c, e->t, &e->s);
+}
+
+/* A point p at body-axial distance xi in the tunnel (e: its open end, tunnel_end): returns 1 with its penetration
+ * of the wall delta (m), the outward unit vector er, its nearest recorded station kn (-1: the open end) and sector
+ * sec and its distance rho from the axis; 0 when it is not in the tunnel (ahead of the shoulder, no station yet,
+ * or on the axis). */
+static int tunnel_locate(const double *T, const TunnelEnd *e, const double *p, double xi, double *delta,
+                         double *er, int32_t *kn, int32_t *sec, double *rho) {
     const int32_t m = (int32_t)T[T_M], S = (int32_t)T[T_S];
     if (m < 1) return 0;
-    double c_end[3], t_end[3], s_end;
-    tunnel_open_end(T, c_end, t_end, &s_end);
+    const double *c_end = e->c, *t_end = e->t, s_end = e->s;
     double s = s_end - (xi - T[T_XI_SH]);
     if (s > s_end) return 0; /* ahead of the shoulder: the nose */
     const double s0 = tunnel_station((double *)T, 0)[T_ARC];
     if (s < s0) s = s0;
     TunnelAt at;
-    tunnel_at(T, s, c_end, t_end, s_end, &at);
+    tunnel_at(T, s, c_end, t_end, s_end, -1, &at);
     double d[3] = {p[0] - at.c[0], p[1] - at.c[1], p[2] - at.c[2]};
     s += tdot(d, at.t); /* one projection onto the axis: a body turned in its tunnel */
     if (s > s_end) s = s_end;
     if (s < s0) s = s0;
-    tunnel_at(T, s, c_end, t_end, s_end, &at);
+    tunnel_at(T, s, c_end, t_end, s_end, at.ia, &at); /* near the first: its station is the hint */
     for (int j = 0; j < 3; ++j) d[j] = p[j] - at.c[j];
     double along = tdot(d, at.t), r[3];
     for (int j = 0; j < 3; ++j) r[j] = d[j] - along * at.t[j];
@@ -165,10 +190,10 @@ static void tunnel_record(double *T) {
 
 /* A step's first stage, after the law: the wall pushed out to every point the wall loads (the plastic cavity
  * keeps the radius it was opened to), at the point's nearest recorded station and sector. */
-static void tunnel_expand(double *T, const double *p, double xi) {
+static void tunnel_expand(double *T, const TunnelEnd *e, const double *p, double xi) {
     double delta, er[3], rho;
     int32_t kn, sec;
-    if (!tunnel_locate(T, p, xi, &delta, er, &kn, &sec, &rho) || kn < 0) return;
+    if (!tunnel_locate(T, e, p, xi, &delta, er, &kn, &sec, &rho) || kn < 0) return;
     double *a = tunnel_station(T, kn) + T_STATION + sec;
     if (rho > *a) *a = rho;
 }

@@ -34,13 +34,15 @@ __attribute__((noinline)) static int32_t law_points(int32_t k, const double *x, 
     const LawConstants c = law_constants(p);
     const int commit = T && T[T_COMMIT] != 0.0;
     if (commit) tunnel_record(T);
+    TunnelEnd end;
+    if (T) tunnel_end(T, &end);
     int32_t m = 0;
     for (int j = 0; j < 5; ++j) sums[j] = 0.0;
     for (int32_t i = 0; i < k; ++i) {
         double sg = 0.0;
         if (above_face(p, x + 3 * i, ell[i])) continue;
         WallHit hit;
-        const WallHit *wall = wall_of(T, x + 3 * i, T ? body_xi[i] : 0.0, &hit);
+        const WallHit *wall = wall_of(T, &end, x + 3 * i, T ? body_xi[i] : 0.0, &hit);
         if (!law_at_point(p, &c, x + 3 * i, v + 3 * i, n + 3 * i, area[i], ell[i], radius[i], Rm[i], sphi0[i], axis,
                           wall, gauss, ng, f + 3 * i, &sg))
             continue;
@@ -53,7 +55,7 @@ __attribute__((noinline)) static int32_t law_points(int32_t k, const double *x, 
     }
     if (commit) {
         for (int32_t j = 0; j < m; ++j)
-            if (sgs[j] > 0.0) tunnel_expand(T, x + 3 * idx[j], body_xi[idx[j]]);
+            if (sgs[j] > 0.0) tunnel_expand(T, &end, x + 3 * idx[j], body_xi[idx[j]]);
         T[T_COMMIT] = 0.0;
     }
     for (int32_t j = 0; j < m; ++j) {

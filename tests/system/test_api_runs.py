@@ -24,7 +24,9 @@ def test_run_a_dict_and_load_it_back(tmp_path):
 @pytest.mark.slow
 @pytest.mark.parametrize("ranks", [2])
 def test_api_tour(tmp_path, ranks):
-    r = run_python(ROOT / "demos" / "api_tour.py", "--out", tmp_path, ranks=ranks)
+    # a 6 mm deformable shot (12 s on 2 ranks; the tour's 4 mm default took 66 s): the agreement checked below
+    # holds on it (plastic 352.6 mm against rigid 351.5 mm)
+    r = run_python(ROOT / "demos" / "api_tour.py", "--out", tmp_path, "--size", "0.006", ranks=ranks)
     assert r.returncode == 0, r.stderr[-3000:]
     assert "refused: impact.velocity" in r.stdout
     rigid = json.loads((tmp_path / "rigid" / "summary.json").read_text())
