@@ -71,7 +71,7 @@ def _parser() -> argparse.ArgumentParser:
 
 
 def version_line() -> str:
-    """``fepen 0.2.0 (revision abc123…)``: the version and the code revision of this source tree."""
+    """``fepen 0.3.0 (revision abc123…)``: the version and the code revision of this source tree."""
     from fepen.io.rundir import revision
     from fepen.version import __version__
 
