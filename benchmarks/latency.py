@@ -1,0 +1,92 @@
+"""Where a user waits: the whole `fepen run` process of the default C3 shot against its time loop, with every
+cache empty (a fresh machine) and with every cache warm, for this tree and a baseline revision in one run.
+
+    .venv/bin/python benchmarks/latency.py [--baseline REV] [--ranks 2] [--repeats 2]
+
+Each run is a whole ``mpirun -n RANKS python -m fepen run scenes/default.toml`` process, timed from outside;
+its split (mesh, set-up and compilation, time loop, output, the rest) is the run's summary.json
+``time_split_s``. "cold": empty caches of its own (FEPEN_MESH_CACHE, FEPEN_KERNEL_CACHE, NUMBA_CACHE_DIR,
+XDG_CACHE_HOME and MPLCONFIGDIR in a new temporary folder); "warm": the same folder again, after the cold run
+filled it. The baseline is a git worktree of REV run from this tree's .venv with its own source first on
+PYTHONPATH (its meshes and kernels built in its own temporary caches, as a fresh machine would). The ratio
+whole / time_loop is issue 48's first acceptance figure (≤ 2.5 cold, ≤ 1.5 warm).
+"""
+
+from __future__ import annotations
+
+import argparse
+import json
+import os
+import shutil
+import subprocess
+import sys
+import tempfile
+import time
+from pathlib import Path
+
+ROOT = Path(__file__).resolve().parents[1]
+
+
+def one(tree: Path, caches: Path, ranks: int) -> dict:
+    """One whole process of the default shot from source tree ``tree`` with its caches in ``caches``."""
+    out = Path(tempfile.mkdtemp(prefix="fepen-latency-"))
+    env = dict(os.environ, PYTHONPATH=str(tree), FEPEN_MESH_CACHE=str(caches / "meshes"),
+               FEPEN_KERNEL_CACHE=str(caches / "kernels"), NUMBA_CACHE_DIR=str(caches / "numba"),
+               XDG_CACHE_HOME=str(caches / "xdg"), MPLCONFIGDIR=str(caches / "mpl"), FEPEN_PROGRESS="0")
+    cmd = ["mpirun", "-n", str(ranks), sys.executable, "-m", "fepen", "run", str(tree / "scenes" / "default.toml"),
+           "--out", str(out), "--force"]
+    t0 = time.perf_counter()
+    r = subprocess.run(cmd, cwd=tree, env=env, capture_output=True, text=True)
+    whole = time.perf_counter() - t0
+    if r.returncode != 0:
+        raise SystemExit(f"latency: the run in {tree} failed (exit {r.returncode}):\n{r.stderr[-2000:]}")
+    s = json.loads((out / "summary.json").read_text())
+    shutil.rmtree(out, ignore_errors=True)
+    split = s.get("time_split_s", {})
+    return {"whole_s": whole, "loop_s": split.get("time_loop", float("nan")), "mesh_s": split.get("mesh", 0.0),
+            "setup_s": split.get("setup_jit", 0.0), "output_s": split.get("output", 0.0), "Hy_mm": s["Hy_mm"],
+            "steps": s["steps"]}
+
+
+def measure(tree: Path, label: str, ranks: int, repeats: int) -> list[dict]:
+    rows = []
+    for _ in range(repeats):
+        caches = Path(tempfile.mkdtemp(prefix="fepen-latency-caches-"))
+        try:
+            rows.append({"tree": label, "caches": "cold", **one(tree, caches, ranks)})
+            rows.append({"tree": label, "caches": "warm", **one(tree, caches, ranks)})
+        finally:
+            shutil.rmtree(caches, ignore_errors=True)
+    return rows
+
+
+def main(argv=None) -> int:
+    ap = argparse.ArgumentParser(description=__doc__.split("\n\n")[0])
+    ap.add_argument("--baseline", help="a git revision measured beside this tree (a worktree of it)")
+    ap.add_argument("--ranks", type=int, default=2)
+    ap.add_argument("--repeats", type=int, default=1)
+    args = ap.parse_args(argv)
+    trees = [(ROOT, "this tree")]
+    worktree = None
+    if args.baseline:
+        worktree = Path(tempfile.mkdtemp(prefix="fepen-baseline-")) / "tree"
+        subprocess.run(["git", "worktree", "add", "--detach", str(worktree), args.baseline], cwd=ROOT, check=True,
+                       capture_output=True)
+        trees.append((worktree, f"baseline {args.baseline}"))
+    try:
+        rows = [r for tree, label in trees for r in measure(tree, label, args.ranks, args.repeats)]
+    finally:
+        if worktree is not None:
+            subprocess.run(["git", "worktree", "remove", "--force", str(worktree)], cwd=ROOT, capture_output=True)
+    print(f"default C3 shot, {args.ranks} ranks, whole process against its time loop")
+    print(f"{'tree':24s} {'caches':6s} {'whole_s':>8} {'loop_s':>7} {'ratio':>6} {'mesh_s':>7} {'setup_s':>8} "
+          f"{'output_s':>8} {'steps':>6} {'Hy_mm':>8}")
+    for r in rows:
+        print(f"{r['tree']:24s} {r['caches']:6s} {r['whole_s']:8.1f} {r['loop_s']:7.1f} "
+              f"{r['whole_s'] / r['loop_s']:6.2f} {r['mesh_s']:7.2f} {r['setup_s']:8.2f} {r['output_s']:8.2f} "
+              f"{r['steps']:6d} {r['Hy_mm']:8.2f}")
+    return 0
+
+
+if __name__ == "__main__":
+    sys.exit(main())
