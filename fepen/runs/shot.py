@@ -173,7 +173,9 @@ def diagnostics_stress_names() -> list[str]:
 
 def _outputs(scene) -> OutputSettings:
     r = scene.run
-    names = ["von_mises_Pa", "axial_stress_Pa", "pressure_Pa", "triaxiality", *diagnostics_stress_names()]
+    names = ["von_mises_Pa", "axial_stress_Pa", "pressure_Pa", "triaxiality"]
+    if scene.get("run.stress_tensor_fields"):  # asked for: six more cell fields
+        names += diagnostics_stress_names()
     # fields of switched-off physics are not written
     if scene.effects.fidelity == "plastic":
         names.append("peeq")

@@ -10,7 +10,8 @@ from mpi4py import MPI
 from fepen import scene
 from fepen.runs.deformable import DeformableRun
 
-SETS = ["mesh.size=0.005", "run.end_time=1e-4", "run.output_interval=2.5e-5", "run.checkpoint_interval=0"]
+SETS = ["mesh.size=0.005", "run.end_time=1e-4", "run.output_interval=2.5e-5", "run.checkpoint_interval=0",
+        "run.stress_tensor_fields=true"]
 
 
 @pytest.fixture(scope="module")
