@@ -235,8 +235,9 @@ class DeformableRun(Run):
         axis = unit_axis(probes.node_value(s, m.tip, x), probes.node_value(s, m.tail, x))
         values = {"displacement_m": x - s.X0, "velocity_m_s": s.velocity_at_step(),
                   "von_mises_Pa": diagnostics.von_mises(s), "axial_stress_Pa": diagnostics.axial_stress(s, axis),
-                  "peeq": diagnostics.live_peeq(s), "temperature_K": s.temp, "cell_tag": s.mat + 1.0,
-                  **diagnostics.stress_fields(s)}
+                  "peeq": diagnostics.live_peeq(s), "temperature_K": s.temp, "cell_tag": s.mat + 1.0}
+        stress = diagnostics.stress_fields(s)
+        values.update(zip(shot.STRESS_TENSOR_FIELDS, stress.pop("stress_Pa").T), **stress)
         if self.model.law is not None:  # the target's load (a rigid wall has none)
             values.update(self.load.surface_fields(s))
         if self.contact is not None:

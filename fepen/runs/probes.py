@@ -129,8 +129,9 @@ class MeshProbes(Probes):
         s = run.solver
         x = s.positions()
         nodes = cells = np.zeros((0, 0))
-        m = run.model
-        axis = unit_axis(sp.node_value(s, m.tip, x), sp.node_value(s, m.tail, x))
+        axis = None
+        if self.cells or any(p["kind"] == "accelerometer" for p in self.specs):  # (collective: every rank's specs)
+            axis = unit_axis(sp.node_value(s, run.model.tip, x), sp.node_value(s, run.model.tail, x))
         if self.nodes:
             u = sp.node_values(s, self.nodes, x - s.X0)
             v = sp.node_values(s, self.nodes, s.velocity_at_step())
@@ -183,7 +184,7 @@ def filtered(rows, header: list[str], cutoff_hz: float) -> list[list[float]]:
     return table.tolist()
 
 
-def _in_order(specs, nodes: np.ndarray, cells: np.ndarray, axis: np.ndarray) -> list[float]:
+def _in_order(specs, nodes: np.ndarray, cells: np.ndarray, axis: np.ndarray | None) -> list[float]:
     """The node and cell probes' value rows merged back into the scene's order; an accelerometer's node
     acceleration resolved on the body's axes (its filtered columns left at 0: probes.csv's writer fills them
     from the whole record)."""

@@ -166,16 +166,16 @@ def _wear(scene) -> WearParameters | None:
                           m.density, w.distribution)
 
 
-def diagnostics_stress_names() -> list[str]:
-    """The stress tensor's six fields (fepen.solver.diagnostics.STRESS_COMPONENTS)."""
-    return [f"stress_{c}_Pa" for c in ("xx", "yy", "zz", "xy", "yz", "xz")]
+#: the stress tensor's six fields (run.stress_tensor_fields), in the order of the solver's stress columns
+#: (fepen.solver.diagnostics.stress_fields)
+STRESS_TENSOR_FIELDS = tuple(f"stress_{c}_Pa" for c in ("xx", "yy", "zz", "xy", "yz", "xz"))
 
 
 def _outputs(scene) -> OutputSettings:
     r = scene.run
     names = ["von_mises_Pa", "axial_stress_Pa", "pressure_Pa", "triaxiality"]
     if scene.get("run.stress_tensor_fields"):  # asked for: six more cell fields
-        names += diagnostics_stress_names()
+        names += STRESS_TENSOR_FIELDS
     # fields of switched-off physics are not written
     if scene.effects.fidelity == "plastic":
         names.append("peeq")

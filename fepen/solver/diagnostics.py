@@ -293,18 +293,16 @@ def mean_stress(solver) -> np.ndarray:
 
 
 def stress_fields(solver) -> dict[str, np.ndarray]:
-    """The owned cells' Cauchy stress tensor (Pa; xx, yy, zz, xy, yz, xz in the target's frame, tension
-    positive), pressure (Pa, positive in compression) and stress triaxiality (the mean stress over von Mises,
-    -; 0 where von Mises vanishes)."""
-    sd = solver.s
+    """The owned cells' Cauchy stress tensor ``stress_Pa`` (n, 6) in the solver's column order xx, yy, zz, xy,
+    yz, xz (target's frame, tension positive), ``pressure_Pa`` (positive in compression) and ``triaxiality``
+    (the mean stress over von Mises, -; 0 where von Mises vanishes)."""
     pm = mean_stress(solver)
-    add = pm if solver.passes.nodal else 0.0  # the deviator carries the trace otherwise
-    out = {f"stress_{c}_Pa": sd[:, i] + (add if i < 3 else 0.0) for i, c in enumerate(("xx", "yy", "zz", "xy",
-                                                                                       "yz", "xz"))}
+    stress = solver.s.copy()
+    if solver.passes.nodal:  # the deviator with the nodal pressure's mean stress (else s carries the trace)
+        stress[:, :3] += pm[:, None]
     vm = von_mises(solver)
-    out["pressure_Pa"] = -pm
-    out["triaxiality"] = np.divide(pm, vm, out=np.zeros_like(vm), where=vm > 0.0)
-    return out
+    return {"stress_Pa": stress, "pressure_Pa": -pm,
+            "triaxiality": np.divide(pm, vm, out=np.zeros_like(vm), where=vm > 0.0)}
 
 
 def axial_stress(solver, axis: np.ndarray) -> np.ndarray:

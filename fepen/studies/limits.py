@@ -74,17 +74,12 @@ def check_ricochet(scene_path, sets, speeds, obliquity_max: float, tol: float) -
     return base, probe, speeds
 
 
-def envelope_of(base: dict, **keys) -> dict:
-    """The validated envelope's verdict (fepen.stats.envelope) on the base scene with the given keys set, its
-    printed line under "line": the study's boundary as far as fepen was checked there.
-
-    Args:
-        base: the study's base keys. keys: dotted keys with "__" for "." (impact__velocity=311.6).
-    """
+def envelope_of(sc: fscene.Scene) -> dict:
+    """The validated envelope's verdict (fepen.stats.envelope) on a shot of the study, its printed line under
+    "line": the study's boundary as far as fepen was checked there."""
     from fepen.runs import setup
     from fepen.stats import envelope
 
-    sc = fscene.Scene({**base, **{k.replace("__", "."): float(v) for k, v in keys.items()}})
     v = envelope.verdict(setup.envelope_facts(sc, setup.check_supported(sc)))
     v["line"] = envelope.line(v)
     return v
@@ -227,7 +222,7 @@ class BallisticLimit(_Limit):
         if len(pts) >= 3:
             a, p, rms = fit_recht_ipson([v for v, _ in pts], [vr for _, vr in pts], v_bl)
             result.update(a=a, p=p, rms_m_s=rms)
-        result["envelope"] = envelope_of(plan.base, impact__velocity=v_bl)
+        result["envelope"] = envelope_of(fscene.Scene({**plan.base, "impact.velocity": v_bl}))
         return result
 
     def draw(self, fig, res: dict, plan: LimitPlan) -> None:
@@ -319,7 +314,7 @@ class Ricochet(_Limit):
     def result(self, plan: LimitPlan, records: list[dict], info) -> dict:
         critical = [0.5 * (lo + hi) for lo, hi in self.brackets]
         # the envelope at the boundary's ends: the slowest and the fastest speed at its critical obliquity
-        ends = {f"{v:g}": envelope_of(plan.base, impact__velocity=v, impact__obliquity_deg=c)
+        ends = {f"{v:g}": envelope_of(self._at(plan, v, c))
                 for v, c in ((plan.speeds[0], critical[0]), (plan.speeds[-1], critical[-1]))}
         return {"speeds_m_s": plan.speeds, "critical_obliquity_deg": critical, "brackets": self.brackets,
                 "tol_deg": plan.tol, "map": self.cells, "envelope": ends}
