@@ -9,8 +9,9 @@ included), ``_vx_m_s, ...`` the velocity and ``_ax_m_s2, ...`` the acceleration.
 accelerometer fixed in the body, as instrumented penetrators carry): the node's acceleration resolved on the
 body's axes, in g (9.80665 m/s²), ``_axial_g`` along the axis tail to nose (negative while the body slows, as
 every acceleration fepen writes), ``_lateral_g`` across it in the plane of fire (ẑ × axis) and
-``_out_of_plane_g`` (the third, toward +z); raw, then each low-pass filtered like accelerations.csv
-(``_axial_filtered_g``, ...; zero-phase, run.acceleration_filter_hz, over the whole record so far). Values are
+``_out_of_plane_g`` (the third, toward +z), each low-pass filtered like accelerations.csv (zero-phase,
+run.acceleration_filter_hz, over the whole record so far), and each raw as its ``_raw`` twin
+(``_axial_g_raw``, ...: the node's acceleration at the row). Values are
 written with the digits that give back the same double (the rank-count invariance is checked on the file
 itself).
 """
@@ -25,17 +26,19 @@ from mpi4py import MPI
 from fepen.io import files
 from fepen.io.results import G0
 
-__all__ = ["NODE_COLUMNS", "CELL_COLUMNS", "ACCELEROMETER_COLUMNS", "quantities", "columns", "body_axes_g",
+__all__ = ["NODE_COLUMNS", "CELL_COLUMNS", "ACCELEROMETER_COLUMNS", "ACCELEROMETER_FILTERED", "quantities", "columns", "body_axes_g",
            "write"]
 
 #: a node probe's quantities, in the order of its values
 NODE_COLUMNS = ("ux_m", "uy_m", "uz_m", "vx_m_s", "vy_m_s", "vz_m_s", "ax_m_s2", "ay_m_s2", "az_m_s2")
 #: a cell probe's quantities, in the order of its values
 CELL_COLUMNS = ("von_mises_Pa", "axial_stress_Pa", "pressure_Pa", "peeq", "temperature_K")
-#: an accelerometer probe's raw channels (g, body axes); each is followed in the file by its filtered twin
-ACCELEROMETER_RAW = ("axial_g", "lateral_g", "out_of_plane_g")
+#: an accelerometer probe's filtered channels (g, body axes: what an instrumented penetrator's record shows)
+ACCELEROMETER_FILTERED = ("axial_g", "lateral_g", "out_of_plane_g")
+#: an accelerometer probe's raw channels, each its filtered channel's name with _raw
+ACCELEROMETER_RAW = tuple(c + "_raw" for c in ACCELEROMETER_FILTERED)
 #: an accelerometer probe's columns: the raw channels, then the filtered ones
-ACCELEROMETER_COLUMNS = ACCELEROMETER_RAW + tuple(c.replace("_g", "_filtered_g") for c in ACCELEROMETER_RAW)
+ACCELEROMETER_COLUMNS = ACCELEROMETER_RAW + ACCELEROMETER_FILTERED
 
 
 def quantities(kind: str) -> tuple[str, ...]:

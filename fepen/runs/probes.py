@@ -80,7 +80,7 @@ class Probes:
     def write(self, out, comm, cutoff_hz: float = 0.0) -> None:
         """probes.csv of the rows so far (collective); cutoff_hz: the accelerometers' low-pass
         (run.acceleration_filter_hz)."""
-        rows = filtered(self.rows, self.header, cutoff_hz) if any(h.endswith("_filtered_g") for h in self.header) \
+        rows = filtered(self.rows, self.header, cutoff_hz) if any(h.endswith("_g_raw") for h in self.header) \
             else self.rows
         probes_io.write(rows, out, self.header, comm)
 
@@ -178,8 +178,8 @@ def filtered(rows, header: list[str], cutoff_hz: float) -> list[list[float]]:
     """
     table = np.array(rows, dtype=float).reshape(len(rows), len(header))
     for j, name in enumerate(header):
-        if name.endswith("_filtered_g"):
-            raw = header.index(name.replace("_filtered_g", "_g"))
+        if name + "_raw" in header:  # an accelerometer's filtered channel
+            raw = header.index(name + "_raw")
             table[:, j] = signals.lowpass(table[:, 0], table[:, raw], cutoff_hz) if len(rows) else []
     return table.tolist()
 

@@ -68,7 +68,7 @@ def test_an_accelerometer_is_its_nodes_acceleration_on_the_body_axes(shot):
     axis), in g; the filtered channels keep the record's time."""
     run, h, p = shot
     a = np.stack([p[f"tail_a{c}_m_s2"] for c in "xyz"], 1) / results.G0
-    g = np.stack([p[f"gauge_{c}_g"] for c in ("axial", "lateral", "out_of_plane")], 1)
+    g = np.stack([p[f"gauge_{c}_g_raw"] for c in ("axial", "lateral", "out_of_plane")], 1)
     rows = np.array(run.rows)
     tip = np.stack([rows[:, 1], -rows[:, 2]], 1)  # the scene's frame, mm (z: the plane of fire holds it here)
     tail = np.stack([rows[:, 3], -rows[:, 4]], 1)
@@ -77,7 +77,7 @@ def test_an_accelerometer_is_its_nodes_acceleration_on_the_body_axes(shot):
     assert peak > 1e3  # the tail rings at thousands of g in the first 30 µs
     assert np.allclose(np.linalg.norm(g, axis=1), np.linalg.norm(a, axis=1), rtol=0, atol=1e-9 * peak)
     assert np.allclose(g[:, 0], a[:, 0] * axis[:, 0] + a[:, 1] * axis[:, 1], rtol=0, atol=1e-4 * peak)
-    assert all(f"gauge_{c}_filtered_g" in p.dtype.names for c in ("axial", "lateral", "out_of_plane"))
+    assert all(f"gauge_{c}_g{raw}" in p.dtype.names for c in ("axial", "lateral", "out_of_plane") for raw in ("", "_raw"))
 
 
 def test_tail_probe_is_the_history_tail(shot):
