@@ -40,7 +40,7 @@ test: setup
 	$(PY) -m ruff check --no-cache fepen tests demos benchmarks tools
 	FEPEN_MESH_CACHE=$${FEPEN_MESH_CACHE:-$(TEST_MESHES)} $(PY) -m pytest -q -m "not mpi" -n $(WORKERS) tests/unit
 	FEPEN_MESH_CACHE=$${FEPEN_MESH_CACHE:-$(TEST_MESHES)} $(PY) -m pytest -q -m "not mpi" -n $(WORKERS) \
-	  --dist loadgroup tests/system
+	  --dist loadgroup --durations=20 tests/system
 	FEPEN_MESH_CACHE=$${FEPEN_MESH_CACHE:-$(TEST_MESHES)} mpirun -n $(NP) $(PY) -m pytest -q -m mpi \
 	  -p no:cacheprovider tests
 

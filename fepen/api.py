@@ -306,7 +306,7 @@ def study(name: str, out=None, comm=None, ranks_per_shot: int = 1, fresh: bool =
     validate``, ``fepen validate-depth``; the registry: fepen.studies.study.STUDIES), and return its result.
 
     Args:
-        name: "ballistic-limit", "ricochet", "uncertainty", "accuracy-cost", "sweep", "validate",
+        name: "ballistic-limit", "ricochet", "uncertainty", "charge-safety", "accuracy-cost", "sweep", "validate",
             "validate-depth", "calibration", "wear-calibration" or "prediction-errors".
         out: its folder (None: a new temporary one). comm: the communicator (None: COMM_WORLD).
         ranks_per_shot: ranks of each shot's group. fresh: remove what the study wrote in ``out`` first.

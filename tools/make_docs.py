@@ -362,6 +362,19 @@ def depth_errors(tmp: Path) -> str:
             f"|error|: default law {err['default']:.1f} %, closed form {err['closed form']:.1f} % (fepen {version()}).")
 
 
+# ---- the charge-safety map (docs/charge.md) ------------------------------------------------------------------
+CHARGE_SAFETY = ["demos/charge/charge_800.toml", "--speeds", "100,200,400,800,1200", "--obliquities", "0,10,20",
+                 "--set", "mesh.size=0.005"]
+
+
+def charge_safety(tmp: Path) -> str:
+    s = fepen("study", "charge-safety", *CHARGE_SAFETY, "--out", str(tmp / "cs"), ranks=2)
+    figure(tmp / "cs" / "charge_safety.png", "charge-safety-map.png")
+    text = (tmp / "cs" / "charge_safety.md").read_text().split("\n", 2)[2].strip()  # without its title
+    return (f"`mpirun -n 2 fepen study charge-safety {' '.join(CHARGE_SAFETY)}` ({s:.0f} s on 2 ranks, fepen "
+            f"{version()}):\n\n" + text + "\n\n![the charge-safety map](img/charge-safety-map.png)")
+
+
 #: name -> (page, generator, rough cost on 2 cores)
 BLOCKS = {
     "table1": ("docs/validation.md", table1, "5 min"),
@@ -373,6 +386,7 @@ BLOCKS = {
     "depth-errors": ("docs/validation-depth.md", depth_errors, "1 min"),
     "run-interval": ("docs/uncertainty.md", run_interval, "5 s"),
     "worked-example": ("docs/uncertainty.md", worked_example, "40 s"),
+    "charge-safety": ("docs/charge.md", charge_safety, "2.5 min"),
 }
 
 

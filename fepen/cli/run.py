@@ -34,7 +34,8 @@ def run(args) -> int:
             *(("max_peeq",) if summary.get("fidelity") != "rigid" else ()), "energy_error", "steps", "dt_s", "wall_s")
     keys += tuple(k for k in ("mass_loss_kg", "mass_loss_percent") if k in summary)
     say(*(f"{k} = {summary[k]:.6g}" if isinstance(summary[k], float) else f"{k} = {summary[k]}"
-          for k in keys), *experiment_lines(summary), *prediction_lines(summary), written_line(out))
+          for k in keys), *experiment_lines(summary), *safety_lines(summary), *prediction_lines(summary),
+        written_line(out))
     return 0
 
 
@@ -47,6 +48,15 @@ def experiment_lines(summary: dict) -> list[str]:
             f"{100 * e['tail_error']:.1f} %, final axis {summary['final_axis_angle_deg']:.1f} deg (test "
             f"{e['final_axis_angle_deg']:.1f}), nose offset {summary['nose_offset_mm']:.0f} mm (test "
             f"{e['nose_offset_mm']:.0f})"]
+
+
+def safety_lines(summary: dict) -> list[str]:
+    """A charged run's charge-safety verdict, one line (docs/charge.md)."""
+    if not summary.get("charge_safety"):
+        return []
+    from fepen.runs.charge_safety import line
+
+    return [line(summary["charge_safety"])]
 
 
 def prediction_lines(summary: dict) -> list[str]:

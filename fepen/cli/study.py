@@ -6,6 +6,7 @@ line before anything is written), then fepen.studies.study.run on the ranks it w
     fepen study ballistic-limit [SCENE.toml] [--speeds LOW,HIGH] [--tol M/S] [--set KEY=VALUE ...]
     fepen study ricochet [SCENE.toml] [--speeds V,...] [--tol DEG] [--obliquity-max DEG] [--set KEY=VALUE ...]
     fepen study uncertainty [SCENE.toml] [--scatter SWEEP.toml] [--samples N] [--seed S] [--no-model-scatter]
+    fepen study charge-safety [SCENE.toml] [--speeds V,...] [--obliquities DEG,...] [--attacks DEG,...] [--set ...]
     fepen study accuracy-cost [--ranks N] [--quick]          (it starts its own MPI jobs: no mpirun)
     fepen study calibration | wear-calibration | prediction-errors   (fepen's own calibrations and tables)
 """
@@ -14,7 +15,8 @@ from __future__ import annotations
 
 from fepen.cli.common import say
 
-HELP = "a study of many shots: " + "; ".join(("ballistic-limit", "ricochet", "uncertainty", "accuracy-cost",
+HELP = "a study of many shots: " + "; ".join(("ballistic-limit", "ricochet", "uncertainty", "charge-safety",
+                                               "accuracy-cost",
                                                "calibration, ...")) + " (docs/studies.md)"
 FRESH = "remove what the study wrote in --out first (exactly that) and run every shot again"
 

@@ -5,6 +5,8 @@ docs/paper.md):
 - ``steels``: the named projectile steels (steels.toml), ``projectile.material.name``: ``STEELS``;
 - ``targets``: the named target materials (targets.toml), ``target.material``: ``TARGETS``, ``FAMILIES``,
   ``CONSTANTS``;
+- ``explosives``: the named explosives (explosives.toml), ``charge.explosive``: ``EXPLOSIVES``, the thresholds of
+  the charge-safety criteria;
 - ``prediction_errors``: fepen's errors on the public data (prediction_errors.csv), for the validated
   envelope and the prediction intervals.
 
@@ -13,10 +15,11 @@ standard library only: the scene and every layer above may import it.
 """
 
 from fepen.data.experiments import SHOTS, Shot, shot
+from fepen.data.explosives import EXPLOSIVES
 from fepen.data.steels import STEELS
 from fepen.data.steels import names as steel_names
 from fepen.data.targets import CONSTANTS, FAMILIES, TARGETS
 
-__all__ = ["experiments", "steels", "targets", "prediction_errors",
+__all__ = ["experiments", "steels", "targets", "explosives", "prediction_errors", "EXPLOSIVES",
            "SHOTS", "Shot", "shot", "STEELS", "steel_names", "TARGETS", "FAMILIES",
            "CONSTANTS"]

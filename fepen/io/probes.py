@@ -26,7 +26,8 @@ from mpi4py import MPI
 from fepen.io import files
 from fepen.io.results import G0
 
-__all__ = ["NODE_COLUMNS", "CELL_COLUMNS", "ACCELEROMETER_COLUMNS", "ACCELEROMETER_FILTERED", "quantities", "columns", "body_axes_g",
+__all__ = ["NODE_COLUMNS", "CELL_COLUMNS", "ACCELEROMETER_COLUMNS", "ACCELEROMETER_FILTERED", "quantities", "columns",
+           "body_axes_g",
            "write"]
 
 #: a node probe's quantities, in the order of its values

@@ -9,6 +9,7 @@
     model        the deformable model: mesh, solver, target, contact, wear, erosion
     deformable   DeformableRun: the explicit solver's time loop, its outputs and checkpoints
     closing      the closing analyses of a completed deformable run
+    charge_safety  the charge-safety criteria watched over a charged run, its verdict and margin fields
     events       the stop rules
     outputs      History, Fields, Checkpoint, Progress: due / write / close on one clock
     checkpoint   checkpoint files and --resume
@@ -24,7 +25,8 @@ from fepen.runs import setup, shot
 from fepen.runs.rigid import RigidRun
 from fepen.runs.shot import Shot, resolve
 
-__all__ = ["shot", "budget", "setup", "run", "rigid", "batch", "model", "deformable", "closing", "events", "outputs",
+__all__ = ["shot", "budget", "setup", "run", "rigid", "batch", "model", "deformable", "closing", "charge_safety",
+           "events", "outputs",
            "probes", "checkpoint", "interrupts", "run_scene", "run_in_directory", "expected_end", "resolve", "Shot",
            "RigidRun"]
 

@@ -22,6 +22,7 @@ class Closing:
         self.charge: dict | None = None
         self.profile: dict | None = None
         self.first_yield: dict | None = None
+        self.safety: dict | None = None
 
     def write(self, run) -> None:
         """Write the closing analyses of ``run`` (a fepen.runs.deformable.DeformableRun; collective)."""
@@ -35,6 +36,8 @@ class Closing:
             if run.comm.rank == 0:
                 report = slices.charge_report(run.out, run.sections.sections, self.peaks["charge_acc"]["t_s"])
             self.charge = run.comm.bcast(report, root=0)
+        if getattr(run, "safety", None) is not None:
+            self.safety = run.safety.summary(self.peaks.get("charge_acc"))
         s = run.solver
         if run.fields is not None:  # the cut planes at peak load and at the end, and the shot (Figs. 18, 20-21)
             if run.comm.rank == 0:
@@ -52,7 +55,7 @@ class Closing:
     def summary(self) -> dict:
         """The summary keys of the closing analyses (None where they were not written)."""
         return {"peak_accelerations": self.peaks, "charge": self.charge, "nose_profile": self.profile,
-                "first_yield": self.first_yield}
+                "first_yield": self.first_yield, "charge_safety": self.safety}
 
 
 def accelerations(run) -> dict:

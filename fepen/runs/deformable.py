@@ -18,6 +18,7 @@ from fepen.io.fields import FieldWriter
 from fepen.post import analyses, paraview
 from fepen.runs import checkpoint, closing, events, model, outputs, shot
 from fepen.runs import probes as run_probes
+from fepen.runs.charge_safety import ChargeSafety
 from fepen.runs.run import Removal, Run, Snapshot
 from fepen.solver import diagnostics, explicit, probes
 
@@ -54,6 +55,8 @@ class DeformableRun(Run):
         self.initial_mass = self.solver.initial_mass
         self.gauges = analyses.Gauges(self.solver, self.pm)
         self.sections = analyses.ChargeSections(self.solver, self.pm) if self.pm.charge else None
+        self.safety = (ChargeSafety(self.solver, self.contact, sh.safety, sh.outputs.acceleration_filter_hz)
+                       if self.pm.charge and sh.safety is not None else None)
         self.closing = closing.Closing()
         o = sh.outputs
         self.fields_out = outputs.Fields(o.output_interval, grid=True) if o.fields else None
@@ -188,6 +191,8 @@ class DeformableRun(Run):
             f = self.contact.resultant() if self.contact is not None else diagnostics.tied_interface_force(s)
             extra += [f[0], -f[1], float(np.linalg.norm(f))]
             self.sections.record(tip, tail)
+            if self.safety is not None:
+                self.safety.record(s.t)
         if self.contact is not None:
             i = self.contact.summary()
             extra += [e.friction, i["gap_max_mm"], i["penetration_max_mm"], i["slip_max_mm"], i["free_fraction"],
@@ -223,9 +228,11 @@ class DeformableRun(Run):
             scalars += ["target_normal_stress_Pa", "target_friction_traction_Pa"]
         if self.model.recession is not None:
             scalars.append("wear_depth_m")
+        if self.safety is not None and self.contact is not None:
+            scalars.append("interface_friction_work_J_m2")
         if self.comm.rank == 0:
             paraview.write_view_script(self.out)
-        names = list(self.shot.outputs.field_names)
+        names = list(self.shot.outputs.field_names) + (self.safety.field_names() if self.safety is not None else [])
         return FieldWriter(self.out, self.solver, nodal, names, times, scalars,
                            integer=("cell_tag",))
 
@@ -244,6 +251,10 @@ class DeformableRun(Run):
             values.update(self.contact.nodal_gap_and_slip())
         if m.recession is not None:
             values["wear_depth_m"] = m.recession.depth
+        if self.safety is not None:
+            values.update(self.safety.cell_fields())
+            if self.contact is not None:
+                values.update(self.safety.nodal_fields())
         self.fields.write(s.t, values)
 
     def write_closing(self) -> None:
@@ -266,6 +277,7 @@ class DeformableRun(Run):
         """(the components whose state is arrays, per rank; those whose state is small, kept in state.json)."""
         m = self.model
         arrays = {"solver": self.solver, "load": self.load, "gauges": self.gauges, "sections": self.sections,
+                  "contact": self.contact, "safety": self.safety,
                   "surface": m.surface if self.removing else None, "recession": m.recession, "probes": self.probes}
         small = {"rules": self.rules, "crossings": self.crossings, "erosion": m.erosion, "history": self.history,
                  "fields": self.fields_out, "checkpoints": self.checkpoints}

@@ -60,6 +60,51 @@ class OutputSettings:
     acceleration_filter_hz: float
 
 
+@dataclass(frozen=True)
+class SafetyThresholds:
+    """The thresholds of the charge-safety criteria (fepen.laws.explosive; None: no threshold, no margin) and
+    where each came from.
+
+    Attributes:
+        explosive: charge.explosive. density: the charge's (kg/m^3).
+        values: {criterion: threshold or None} in fepen.laws.explosive.CRITERIA's order (Pa, Pa, J/m^2,
+            W/m^2, m, m/s, g).
+        sources: {criterion: "charge.safety.KEY" (the user's), the named explosive's source, or the charge
+            law's yield stress}.
+    """
+
+    explosive: str
+    density: float
+    values: dict
+    sources: dict
+
+
+def safety_thresholds(scene) -> SafetyThresholds:
+    """The charge-safety thresholds of a scene: each charge.safety.* key given, else the named explosive's
+    (fepen/data/explosives.toml), else none; the strength's last resort the charge law's yield stress."""
+    from fepen.data.explosives import EXPLOSIVES
+
+    name = scene.charge.explosive
+    entry = EXPLOSIVES[name]
+    keys = {"strength": "strength", "tension": "tensile_strength", "friction_work": "friction_work",
+            "friction_power": "friction_power", "gap": "gap", "closure_speed": "closure_speed",
+            "acceleration_g": "acceleration_g"}
+    values, sources = {}, {}
+    for criterion, key in keys.items():
+        given = scene.get(f"charge.safety.{key}")
+        if given is not None:
+            values[criterion], sources[criterion] = float(given), f"charge.safety.{key}"
+        elif key in entry:
+            values[criterion] = float(entry[key])
+            sources[criterion] = f"{name}: " + entry.get(f"{key}_source", entry["source"])
+        else:
+            values[criterion], sources[criterion] = None, "none given"
+    if values["strength"] is None:
+        values["strength"] = float(scene.charge.material.yield_stress)
+        sources["strength"] = "the charge law's yield stress (charge.material.yield_stress): the onset of damage"
+    return SafetyThresholds(name, float(scene.charge.material.density), values, sources)
+
+
 @dataclass(frozen=True, eq=False)
 class Shot:
     """One resolved shot.
@@ -93,6 +138,7 @@ class Shot:
         envelope: what the validated envelope looks at (fepen.runs.setup.envelope_facts).
         inputs: what the shot was made of (inputs_record): the resolved scene, the files it read by content and
             their digest, recorded in run.json and in every checkpoint (a resume compares its own with it).
+        safety: the charge-safety thresholds (SafetyThresholds) of a deformable charged shot, else None.
     """
 
     fidelity: str
@@ -123,6 +169,7 @@ class Shot:
     load_points: str = "facets"
     envelope: dict = field(repr=False, default_factory=dict)
     inputs: dict = field(repr=False, default_factory=dict)
+    safety: SafetyThresholds | None = None
 
     @property
     def rigid(self) -> bool:
@@ -228,7 +275,8 @@ def resolve(scene, toml: bool = True) -> Shot:
         scene_toml=to_toml(scene) if toml else "", probes=probes, envelope=setup.envelope_facts(scene, built),
         tunnel=bool(scene.effects.tunnel and law is not None and not getattr(law, "layered", False)),
         load_points=_load_points(scene),
-        inputs=inputs_record(scene) if toml else {})
+        inputs=inputs_record(scene) if toml else {},
+        safety=safety_thresholds(scene) if scene.effects.charge and not rigid else None)
 
 
 def _load_points(scene) -> str:

@@ -8,7 +8,7 @@ cavity, tensile strength, ...) are explained in docs/theory.md.
 
 from __future__ import annotations
 
-from fepen.data import CONSTANTS, FAMILIES, SHOTS, STEELS, TARGETS, shot
+from fepen.data import CONSTANTS, EXPLOSIVES, FAMILIES, SHOTS, STEELS, TARGETS, shot
 from fepen.errors import InputError
 from fepen.scene.keys import (
     ABSENT,
@@ -190,6 +190,32 @@ SCHEMA: dict[str, Key] = {
                              doc="the shell-charge interface: 'frictional', the charge has nodes of its own on "
                                  "the cavity wall, the interface opens and slides with Coulomb friction "
                                  "(charge.friction); 'tied', shell and charge share the wall's nodes (bonded)"),
+    # --- the charge's safety (docs/charge.md, docs/theory.md §20) ---
+    "charge.explosive": choice("paper-fill", *EXPLOSIVES,
+                               doc="a named explosive of fepen/data/explosives.toml: the thresholds of the "
+                                   "charge-safety criteria it gives (each charge.safety.* key overrides one)"),
+    "charge.safety.strength": positive(ABSENT, "Pa", 1.0e11,
+                                       doc="the equivalent stress at which the explosive's damage begins; absent: "
+                                           "the named explosive's, else the charge law's yield stress"),
+    "charge.safety.tensile_strength": positive(ABSENT, "Pa", 1.0e10,
+                                               doc="the largest principal stress the charge bears in tension; "
+                                                   "absent: the named explosive's (none: no margin)"),
+    "charge.safety.friction_work": positive(ABSENT, "J/m^2", 1.0e12,
+                                            doc="the friction work per unit area of the shell-charge interface "
+                                                "that ignites the explosive; absent: the named explosive's "
+                                                "(none: no margin)"),
+    "charge.safety.friction_power": positive(ABSENT, "W/m^2", 1.0e16,
+                                             doc="the friction power per unit area (mu p v) that ignites it; "
+                                                 "absent: the named explosive's (none: no margin)"),
+    "charge.safety.gap": positive(ABSENT, "m", 1.0,
+                                  doc="the largest safe gap at the charge's ends; absent: the named explosive's "
+                                      "(none: no margin)"),
+    "charge.safety.closure_speed": positive(ABSENT, "m/s", 1.0e5,
+                                            doc="the largest safe speed at which an end gap closes; absent: the "
+                                                "named explosive's (none: no margin)"),
+    "charge.safety.acceleration_g": positive(ABSENT, "g", 1.0e8,
+                                             doc="the largest acceleration the charge survives (g); absent: the "
+                                                 "named explosive's (none: no margin)"),
     # --- target (Table 3; the law: docs/paper.md §4) ---
     "target.kind": choice("concrete", "concrete", "rigid-wall",
                           doc="'concrete': a cavity-expansion target of target.material (or target.layers); "

@@ -8,6 +8,7 @@ from mpi4py import MPI
 
 from fepen.geometry import tags
 from fepen.laws.contact import pair_forces, pair_work, wall_facet_normals
+from fepen.laws.explosive import pair_friction
 from fepen.solver import assembly
 
 
@@ -21,8 +22,14 @@ class ShellChargeContact:
 
     Attributes:
         pa, pb: local shell and charge node of each pair held on this rank.
-        force, fn, state: the last contact forces (on a), normal forces and states (0 open, 1 stuck, 2 sliding).
+        force, fn, pair_state: the last contact forces (on a), normal forces and states (0 open, 1 stuck, 2 sliding).
         count: pairs this rank counts in sums (its shell node is owned).
+        area: each pair's wall area (m², its charge node's share of the wall facets, current configuration).
+        friction_heat: the friction heat dissipated at each pair so far (J; their sum over the counted pairs is
+            the interface's friction dissipation).
+        friction_work: the same per unit area (J/m²), each step's heat over the pair's area then.
+        friction_power: its rate at the last step (W/m²): mu p v on a sliding pair, 0 on a stuck or open one.
+        friction_power_peak: the largest friction_power of each pair so far (W/m²).
     """
 
     def __init__(self, solver, facet_tags, friction: float):
@@ -66,9 +73,14 @@ class ShellChargeContact:
         k = len(self.pa)
         self.force = np.zeros((k, 3))
         self.fn = np.zeros(k)
-        self.state = np.zeros(k, dtype=np.int8)
+        self.pair_state = np.zeros(k, dtype=np.int8)
         self.normal = np.zeros((k, 3))
         self._work = np.zeros(2)
+        self.area = np.zeros(k)
+        self.friction_heat = np.zeros(k)
+        self.friction_work = np.zeros(k)
+        self.friction_power = np.zeros(k)
+        self.friction_power_peak = np.zeros(k)
         self.X_pairs = s.X[self.pb]
         # constant over the run: which pair ends this rank owns (it applies their forces), their masses
         self._a_own, self._b_own = np.flatnonzero(self.pa < n), np.flatnonzero(self.pb < n)
@@ -83,7 +95,8 @@ class ShellChargeContact:
         self._wall_sum(self._facet_n, self.nodal_n)  # in the facets' canonical order: any partition alike
         self._nvec.scatter_forward()
         nn = self.nodal_n[self.pb]
-        return nn / np.linalg.norm(nn, axis=1)[:, None]
+        self.area = np.linalg.norm(nn, axis=1)
+        return nn / self.area[:, None]
 
     def __call__(self, solver) -> None:
         """Add the contact forces of the coming step to solver.acc (owned nodes), then refresh the ghosts."""
@@ -92,16 +105,30 @@ class ShellChargeContact:
         x = s.positions()  # X + U: the positions of the solver's last force evaluation
         self.normal = self.normals(x)
         pair_forces(x, s.Vel, s.acc, s.mass, self.pa, self.pb, self.normal, dt, dt_avg, self.mu,
-                    self.force, self.fn, self.state)
+                    self.force, self.fn, self.pair_state)
         self._work[:] = 0.0
         pair_work(s.Vel, s.acc, s.mass, self.pa, self.pb, self.normal, self.force, self.fn, s.dt_prev, dt,
                   dt_avg, self.count, self._work)
         s.sums.interface_normal += self._work[0]
         s.sums.interface_tangential += self._work[1]
+        pair_friction(s.Vel, s.acc, s.mass, self.pa, self.pb, self.normal, self.force, self.fn, s.dt_prev, dt, dt_avg,
+                      self.area, self.friction_heat, self.friction_work, self.friction_power,
+                      self.friction_power_peak)
         ia, ib = self._a_own, self._b_own
         s.acc[self.pa[ia]] += self.force[ia] * self._inv_ma
         s.acc[self.pb[ib]] -= self.force[ib] * self._inv_mb
         s.node.a_fn.x.scatter_forward()
+
+    def state(self) -> dict:
+        """The friction heat per pair so far and its largest rate (a checkpoint's arrays)."""
+        return {"friction_heat": self.friction_heat, "friction_work": self.friction_work,
+                "friction_power_peak": self.friction_power_peak}
+
+    def restore(self, state: dict) -> None:
+        """Put back what state() returned."""
+        self.friction_heat[:] = state["friction_heat"]
+        self.friction_work[:] = state["friction_work"]
+        self.friction_power_peak[:] = state["friction_power_peak"]
 
     def resultant(self) -> np.ndarray:
         """The resultant of the last step's contact forces on the charge (N, world), all ranks: what the shell
@@ -139,6 +166,6 @@ class ShellChargeContact:
         m = self.count
         mx = np.array([g[m].max(initial=0.0), (-g[m]).max(initial=0.0), slip[m].max(initial=0.0)])
         c.Allreduce(MPI.IN_PLACE, mx, op=MPI.MAX)
-        counts = c.allreduce(np.array([np.sum(self.state[m] == k) for k in (0, 2)], dtype=float), op=MPI.SUM)
+        counts = c.allreduce(np.array([np.sum(self.pair_state[m] == k) for k in (0, 2)], dtype=float), op=MPI.SUM)
         return {"gap_max_mm": mx[0] * 1e3, "penetration_max_mm": mx[1] * 1e3, "slip_max_mm": mx[2] * 1e3,
                 "free_fraction": counts[0] / max(self.n_pairs, 1), "sliding_fraction": counts[1] / max(self.n_pairs, 1)}

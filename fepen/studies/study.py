@@ -37,6 +37,7 @@ STUDIES = {
     "ballistic-limit": ("fepen.studies.limits", "BallisticLimit"),
     "ricochet": ("fepen.studies.limits", "Ricochet"),
     "uncertainty": ("fepen.studies.uncertainty", "Uncertainty"),
+    "charge-safety": ("fepen.studies.charge_safety", "ChargeSafetyStudy"),
     "calibration": ("fepen.studies.calibration", "Calibration"),
     "wear-calibration": ("fepen.studies.wear_calibration", "WearCalibration"),
     "prediction-errors": ("fepen.studies.prediction_errors", "PredictionErrors"),

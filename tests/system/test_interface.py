@@ -86,13 +86,27 @@ def test_energy_balance_holds_with_friction_and_the_wall_stays_closed():
     sy = cm.yield_stress + hardening * maps["charge"]["peeq_max"]
     assert 0 < maps["charge"]["von_mises_max_Pa"] <= 1.001 * sy
     assert maps["shell"]["von_mises_max_Pa"] > 3 * maps["charge"]["von_mises_max_Pa"]
+    # the charge-safety watch (docs/charge.md): the pairs' friction heat is the interface's dissipation; the
+    # strength criterion's demand (the low-passed equivalent stress) stays within the hardened flow stress of
+    # the most strained charge cell; the governing margin is the smallest; the margin fields are written
+    c = sim.contact
+    assert c.friction_heat[c.count].sum() == pytest.approx(col["friction_J"][-1], rel=1e-9)
+    cs = summary["charge_safety"]
+    eps = sim.solver.eps_p[: sim.solver.n_cells][sim.solver.mat[: sim.solver.n_cells] == 1].max()
+    assert 0.5 * cm.yield_stress < cs["strength"]["demand"] <= 1.001 * (cm.yield_stress + hardening * eps)
+    judged = {k: v["margin"] for k, v in cs.items() if isinstance(v, dict) and v["margin"] is not None}
+    assert cs["margin"] == min(judged.values()) and judged[cs["governing"]] == cs["margin"]
+    assert cs["friction_work"]["demand"] > 0 and cs["friction_work"]["where"]["part"] == "interface"
+    xdmf = (sim.out / "fields.xdmf").read_text()
+    assert all(f'Name="{n}"' in xdmf for n in ("charge_strength_margin", "interface_friction_work_J_m2"))
 
 
 @pytest.mark.mpi
 def test_frictional_charge_is_the_same_on_any_rank_count():
-    _, world, sim = frictional_run(MPI.COMM_WORLD, "6e-5")
-    _, alone, _ = frictional_run(MPI.COMM_SELF, "6e-5")
+    s_world, world, sim = frictional_run(MPI.COMM_WORLD, "6e-5")
+    s_alone, alone, _ = frictional_run(MPI.COMM_SELF, "6e-5")
     assert world.shape == alone.shape
+    assert s_world["charge_safety"] == s_alone["charge_safety"]  # every margin, place and time, to the bit
     cols = [sim.columns.index(k) for k in ("nose_y_mm", "tail_y_mm", "speed_m_s", "shell_acc_g", "charge_acc_g",
                                            "friction_J", "interface_gap_max_mm", "interface_slip_max_mm")]
     scale = np.abs(alone[:, cols]).max(axis=0)

@@ -77,7 +77,8 @@ def test_an_accelerometer_is_its_nodes_acceleration_on_the_body_axes(shot):
     assert peak > 1e3  # the tail rings at thousands of g in the first 30 µs
     assert np.allclose(np.linalg.norm(g, axis=1), np.linalg.norm(a, axis=1), rtol=0, atol=1e-9 * peak)
     assert np.allclose(g[:, 0], a[:, 0] * axis[:, 0] + a[:, 1] * axis[:, 1], rtol=0, atol=1e-4 * peak)
-    assert all(f"gauge_{c}_g{raw}" in p.dtype.names for c in ("axial", "lateral", "out_of_plane") for raw in ("", "_raw"))
+    assert all(f"gauge_{c}_g{raw}" in p.dtype.names for c in ("axial", "lateral", "out_of_plane")
+               for raw in ("", "_raw"))
 
 
 def test_tail_probe_is_the_history_tail(shot):

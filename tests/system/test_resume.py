@@ -107,6 +107,7 @@ def test_killed_run_resumes_to_the_same_results(tmp_path, ranks, extra):
     for k in ("Hx_mm", "Hy_mm", "Tx_mm", "Ty_mm", "depth_mm", "residual_speed_m_s", "energy_error",
               "max_peeq", "steps", "dt_s", "outcome", "mass_loss_kg", "eroded_cells", "length_change_mm"):
         assert a[k] == b[k], k  # the same operations: equal, not merely close
+    assert a.get("charge_safety") == b.get("charge_safety")  # the friction heat and the stresses' filter resumed
     assert (whole / "history.csv").read_text() == (cut / "history.csv").read_text()
     if extra is PROBES:
         rows = (whole / "probes.csv").read_text().splitlines()
