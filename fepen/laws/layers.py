@@ -77,8 +77,12 @@ class Layered:
         f = np.zeros_like(x)
         sums = np.zeros(5)
         half = 0.5 * np.sqrt(area)
+        lo, hi = float(x[:, 1].min(initial=np.inf)), float(x[:, 1].max(initial=-np.inf))
+        reach = float(half.max(initial=0.0))
         for layer in self.layers:
             d = self.block_tops[layer.block]
+            if lo + d >= -layer.law.top + reach or (layer.law.lower is not None and hi + d <= -layer.law.lower - reach):
+                continue  # no point near this layer (the masks below would select none)
             y = x[:, 1] + d  # in the block's frame
             near = y < -layer.law.top + half
             if layer.law.lower is not None:

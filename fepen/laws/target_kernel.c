@@ -139,7 +139,7 @@ static inline int above_face(const double *p, const double *xi, double ell) {
 }
 
 /* The point's wall, when it is in the tunnel T (NULL: no tunnel): the WallHit, or NULL */
-static inline const WallHit *wall_of(const double *T, const TunnelEnd *e, const double *xi_point, double xi,
+static inline const WallHit *wall_of(const double *T, TunnelEnd *e, const double *xi_point, double xi,
                                      WallHit *hit) {
     if (!T) return 0;
     int32_t kn, sec;

@@ -74,8 +74,14 @@ static void tunnel_at(const double *T, double s, const double *c_end, const doub
                     step *= 2;
                 }
                 hi = lo + step < m ? lo + step : m;
-            } else {
+            } else { /* arc[hint] > s: back from it by doubling steps; then arc[lo] <= s or lo = 0 */
+                int32_t step = 1;
                 hi = hint;
+                while (hi - step >= 0 && tunnel_station((double *)T, hi - step)[T_ARC] > s) {
+                    hi -= step;
+                    step *= 2;
+                }
+                lo = hi - step > 0 ? hi - step : 0;
             }
         }
         while (hi - lo > 1) {
@@ -104,12 +110,16 @@ static void tunnel_at(const double *T, double s, const double *c_end, const doub
 }
 
 /* The open end of one call's tunnel (tunnel_open_end), computed once per call after the station is recorded:
- * every point of the call is located against the same end. */
+ * every point of the call is located against the same end. hint: the station the call's last point was found
+ * at (-1: none yet); the points of a call come ring by ring, so the next one's station is near it and the search
+ * starts there (the same station however it is searched: no bit changes). */
 typedef struct {
     double c[3], t[3], s;
+    int32_t hint;
 } TunnelEnd;
 
 static inline void tunnel_end(const double *T, TunnelEnd *e) {
+    e->hint = -1;
     if ((int32_t)T[T_M] >= 1) tunnel_open_end(T, e->c, e->t, &e->s);
 }
 
@@ -117,7 +127,7 @@ static inline void tunnel_end(const double *T, TunnelEnd *e) {
  * of the wall delta (m), the outward unit vector er, its nearest recorded station kn (-1: the open end) and sector
  * sec and its distance rho from the axis; 0 when it is not in the tunnel (ahead of the shoulder, no station yet,
  * or on the axis). */
-static int tunnel_locate(const double *T, const TunnelEnd *e, const double *p, double xi, double *delta,
+static int tunnel_locate(const double *T, TunnelEnd *e, const double *p, double xi, double *delta,
                          double *er, int32_t *kn, int32_t *sec, double *rho) {
     const int32_t m = (int32_t)T[T_M], S = (int32_t)T[T_S];
     if (m < 1) return 0;
@@ -127,12 +137,13 @@ static int tunnel_locate(const double *T, const TunnelEnd *e, const double *p, d
     const double s0 = tunnel_station((double *)T, 0)[T_ARC];
     if (s < s0) s = s0;
     TunnelAt at;
-    tunnel_at(T, s, c_end, t_end, s_end, -1, &at);
+    tunnel_at(T, s, c_end, t_end, s_end, e->hint, &at);
     double d[3] = {p[0] - at.c[0], p[1] - at.c[1], p[2] - at.c[2]};
     s += tdot(d, at.t); /* one projection onto the axis: a body turned in its tunnel */
     if (s > s_end) s = s_end;
     if (s < s0) s = s0;
     tunnel_at(T, s, c_end, t_end, s_end, at.ia, &at); /* near the first: its station is the hint */
+    e->hint = at.ia;
     for (int j = 0; j < 3; ++j) d[j] = p[j] - at.c[j];
     double along = tdot(d, at.t), r[3];
     for (int j = 0; j < 3; ++j) r[j] = d[j] - along * at.t[j];
@@ -190,7 +201,7 @@ static void tunnel_record(double *T) {
 
 /* A step's first stage, after the law: the wall pushed out to every point the wall loads (the plastic cavity
  * keeps the radius it was opened to), at the point's nearest recorded station and sector. */
-static void tunnel_expand(double *T, const TunnelEnd *e, const double *p, double xi) {
+static void tunnel_expand(double *T, TunnelEnd *e, const double *p, double xi) {
     double delta, er[3], rho;
     int32_t kn, sec;
     if (!tunnel_locate(T, e, p, xi, &delta, er, &kn, &sec, &rho) || kn < 0) return;
