@@ -13,7 +13,7 @@ from conftest import run_fepen
 
 from fepen.studies import processes
 
-SETS = ["--set", "mesh.size=0.004", "--set", "run.end_time=1.2e-4", "--set", "run.output_interval=1e-5",
+SETS = ["--set", "mesh.size=0.005", "--set", "run.end_time=1.2e-4", "--set", "run.output_interval=1e-5",
         "--set", "run.checkpoint_interval=1.5e-5", "--set", 'impact.shot="C7"']
 
 
