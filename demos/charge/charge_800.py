@@ -60,6 +60,10 @@ def row(contact: str, s: dict, out: Path) -> dict:
          "axis_front_min_MPa": float(sec["axis0_axial_Pa"].min()) * 1e-6,
          "axis_mid_min_MPa": float(sec["axis2_axial_Pa"].min()) * 1e-6,
          "energy_error": s["energy_error"], "wall_s": s["wall_s"]}
+    cs = s.get("charge_safety") or {}  # the safety verdict (docs/charge.md, "Will the charge survive?")
+    r.update(safety_governing=cs.get("governing"), safety_margin=cs.get("margin"),
+             strength_margin=(cs.get("strength") or {}).get("margin"),
+             tension_margin=(cs.get("tension") or {}).get("margin"))
     if "friction_J" in hist.dtype.names:
         r.update(friction_J=float(hist["friction_J"][-1]), slip_max_mm=float(hist["interface_slip_max_mm"].max()),
                  gap_max_mm=float(hist["interface_gap_max_mm"].max()),

@@ -59,6 +59,11 @@ def test_charge_demo_tied_against_frictional(tmp_path):
     assert fric["friction_J"] > 0 and fric["slip_max_mm"] > 0.01 and fric["gap_max_mm"] > 0.01
     assert fric["penetration_max_mm"] < 0.01 * 4.0
     assert len(list((tmp_path / "img").glob("charge-*.png"))) == 8
+    # the safety verdict tells the contacts apart: the sliding charge is driven harder onto the cavity's step
+    # (measured 0.74 against the bonded 1.07, its yield passed), the bonded one is pulled by its wall instead
+    # (tension 0.86 against 1.48: the sliding charge's rear opens rather than pulls)
+    assert fric["strength_margin"] < tied["strength_margin"]
+    assert fric["tension_margin"] > tied["tension_margin"]
 
 
 @pytest.mark.parametrize("ranks", [1, 2])
