@@ -37,6 +37,20 @@ def test_grid_clock_is_due_on_the_grid_and_the_old_clock_keeps_its_sums():
     assert math.isclose(old.next, 300e-6, rel_tol=1e-12)
 
 
+def test_a_clock_far_behind_catches_up_in_one_jump():
+    """A rigid run's history every 1e-13 s (run.output_interval = 1e-12) over its 1 ms: the clock reaches the
+    time in one jump, not in 1e10 additions, and is then due at the next step, as every row of a clock
+    whose interval is below the step; a clock a few intervals behind still adds (the same sums as before)."""
+    far = outputs.Clock(1e-13)
+    far.advance(1e-3)
+    assert 1e-3 < far.next <= 1e-3 + 1e-13 * (1 + 1e-6) and far.due(1e-3 + 5e-9)
+    near, sums = outputs.Clock(1e-6), 0.0
+    near.advance(5.5e-6)
+    for _ in range(6):
+        sums += 1e-6
+    assert near.next == sums
+
+
 def test_landing_merges_the_grids_and_lands_on_the_end():
     land = outputs.Landing((1e-6, 5e-5, 0.0, 3.3e-5), end=1.205e-4)
     assert land(0.0) == 1e-6
