@@ -93,3 +93,17 @@ def test_the_boundary_is_where_the_log_margin_crosses_zero():
     assert boundary([600.0, 800.0, 1000.0], [3.0, 1.5, 1.2]) is None  # never crosses
     assert boundary([600.0, 800.0, 1000.0], [None, 2.0, 0.5]) == pytest.approx(900.0)  # a point without a result
     assert boundary([600.0, 800.0], [1.0, 0.5]) == pytest.approx(600.0)  # at the threshold on a point
+
+
+def test_the_runs_compiled_pass_gives_the_same_invariants():
+    """cell_demands (what a run evaluates at each row) unfiltered (alpha = 1) on random full tensors, without the
+    nodal pressure: its von Mises and largest principal stress are LAPACK's, and its peaks keep the largest."""
+    rng = np.random.default_rng(3)
+    sd = rng.uniform(-5e7, 5e7, (50, 6))
+    dofs, mat, cells = np.zeros((50, 4), dtype=np.int64), np.ones(50, dtype=np.int64), np.arange(50)
+    filtered, demand, peak, raw = np.zeros((50, 6)), np.zeros((2, 50)), np.zeros((2, 50)), np.zeros(1)
+    explosive.cell_demands(sd, np.zeros((1, 2)), dofs, mat, cells, False, 1.0, filtered, demand, peak, raw)
+    eig = [np.linalg.eigvalsh(np.array([[a, d, f], [d, b, e], [f, e, c]]))[-1] for a, b, c, d, e, f in sd]
+    np.testing.assert_allclose(demand[1], eig, rtol=0, atol=1e-7 * 5e7)
+    np.testing.assert_allclose(demand[0], explosive.von_mises(sd), rtol=1e-12)
+    assert raw[0] == pytest.approx(demand[0].max(), rel=1e-12) and np.array_equal(peak, np.maximum(demand, 0.0))
