@@ -32,12 +32,14 @@ class MeshOptions:
     Attributes:
         size: nominal element size (m).
         nose_size: element size at the nose tip (m), growing to ``size`` over one nose length.
-        optimize: "netgen", "gmsh" or "none".
+        optimize: "hxt" (gmsh's parallel Delaunay, HXT, with gmsh's own optimiser on every tetrahedron of
+            quality below 0.5: the default), "netgen" (Delaunay, then Netgen's and gmsh's optimisers: the
+            default before 0.5), "gmsh" (Delaunay and gmsh's optimiser) or "none".
     """
 
     size: float
     nose_size: float | None = None
-    optimize: str = "netgen"
+    optimize: str = "hxt"
 
 
 def _profile_loop(occ, pts: list[tuple[float, float]], curves: dict | None = None) -> int:
@@ -104,27 +106,37 @@ def _stage(name: str) -> None:
         stage_hook(name)
 
 
-def build_best(shape: Shape | cad.CadBody, opts: MeshOptions, charge: bool) -> float:
-    """Mesh with :func:`build`, retrying new seeds until the shortest altitude reaches ALTITUDE_GOAL x size.
+def best_seed(opts: MeshOptions) -> float:
+    """While the shortest altitude of the mesh in gmsh (built with seed 1) is below ALTITUDE_GOAL x size, mesh
+    its volumes again with new seeds, up to MAX_SEEDS, and keep the best. The surface mesh is kept: the mesh's
+    volume, hence its mass, is the same for every seed.
 
     Returns:
-        The shortest altitude over the nominal size of the mesh left in gmsh (the best one tried).
+        The shortest altitude over the nominal size of the mesh left in gmsh.
     """
-    import gmsh
-
-    best_seed, best = 1, -1.0
-    for seed in range(1, MAX_SEEDS + 1):
-        gmsh.clear()
-        build(shape, opts, charge, seed)
+    best_seed = seed = 1
+    best = ratio = float(tetra.shortest_altitudes(tet_points()).min()) / opts.size
+    while ratio < ALTITUDE_GOAL and opts.optimize != "none" and seed < MAX_SEEDS:
+        seed += 1
+        _remesh_volumes(opts, seed)
         ratio = float(tetra.shortest_altitudes(tet_points()).min()) / opts.size
         if ratio > best:
             best_seed, best = seed, ratio
-        if ratio >= ALTITUDE_GOAL or opts.optimize == "none":
-            return ratio
-    if best_seed != MAX_SEEDS:
-        gmsh.clear()
-        build(shape, opts, charge, best_seed)
+    if best_seed != seed:
+        _remesh_volumes(opts, best_seed)
     return best
+
+
+def _remesh_volumes(opts: MeshOptions, seed: int) -> None:
+    """The volume mesh made again with another random seed, on the surface mesh as it is."""
+    import gmsh
+
+    _stage("building")
+    gmsh.model.mesh.clear([(3, t) for _, t in gmsh.model.getEntities(3)])
+    gmsh.option.setNumber("Mesh.RandomSeed", seed)
+    _stage("meshing")
+    gmsh.model.mesh.generate(3)
+    _optimise(opts)
 
 
 def build(shape: Shape | cad.CadBody, opts: MeshOptions, charge: bool, seed: int = 1) -> None:
@@ -225,7 +237,7 @@ def _size_and_mesh(opts: MeshOptions, nose_length: float, seed: int, algorithm: 
     gmsh.option.setNumber("Mesh.MeshSizeExtendFromBoundary", 1)
     gmsh.option.setNumber("Mesh.MeshSizeFromPoints", 0)
     gmsh.option.setNumber("Mesh.Algorithm", algorithm)
-    gmsh.option.setNumber("Mesh.Algorithm3D", 1)
+    gmsh.option.setNumber("Mesh.Algorithm3D", 10 if opts.optimize == "hxt" else 1)
     gmsh.option.setNumber("Mesh.RandomSeed", seed)
     gmsh.option.setNumber("Mesh.OptimizeThreshold", 0.5)
     gmsh.option.setNumber("Mesh.Optimize", 1 if opts.optimize != "none" else 0)
@@ -243,11 +255,18 @@ def _size_and_mesh(opts: MeshOptions, nose_length: float, seed: int, algorithm: 
         f.setAsBackgroundMesh(thr)
     _stage("meshing")
     gmsh.model.mesh.generate(3)
-    if opts.optimize != "none":
+    _optimise(opts)
+
+
+def _optimise(opts: MeshOptions) -> None:
+    """The optimisers run after gmsh.model.mesh.generate (which ran gmsh's own, and Netgen's for "netgen")."""
+    import gmsh
+
+    if opts.optimize in ("netgen", "gmsh"):
         _stage("optimising")
     if opts.optimize == "netgen":
         gmsh.model.mesh.optimize("Netgen")
-    if opts.optimize != "none":
+    if opts.optimize in ("netgen", "gmsh"):
         gmsh.model.mesh.optimize("")
 
 

@@ -394,18 +394,19 @@ def _build_on_root(shape, opts, charge: bool, mass, rho_s, rho_c, use_cache: boo
 
     t0 = time.perf_counter()
     current = shape
-    for _ in range(5):
+    for attempt in range(5):  # the cavity sized to the mass on seed 1's meshes; then the seeds for the altitude
         gmsh.clear()
-        gmsh_model.build_best(current, opts, charge)
+        gmsh_model.build(current, opts, charge, 1)
         if mass is None or not current.has_cavity:
             break
         error = _gmsh_mass(rho_s, rho_c) - mass
-        if abs(error) <= MASS_TOLERANCE:
+        if abs(error) <= MASS_TOLERANCE or attempt == 4:
             break
         r = 0.5 * current.cavity_diameter
         step = error / ((rho_s - (rho_c or 0.0)) * math.pi * r * r)
         current = replace(current, cavity_length=current.cavity_length + step)
         check(current)
+    gmsh_model.best_seed(opts)  # the volumes again with other seeds: the surface mesh, hence the mass, kept
     current = current.after_meshing()  # a CAD body's tracked ends: mesh nodes
     seconds = time.perf_counter() - t0
     if use_cache:

@@ -377,8 +377,11 @@ SCHEMA: dict[str, Key] = {
                              doc="the most tetrahedra fepen meshes unless told more: a finer mesh.size is refused "
                                  "before gmsh starts (about 2.2 kB per cell before the first step, 1e6 cells about "
                                  "3.0 GB on one process); a mesh past the machine's memory is refused all the same"),
-    "mesh.optimize": choice("netgen", "none", "gmsh", "netgen",
-                            doc="tetrahedron optimiser; the stable step is set by the worst element"),
+    "mesh.optimize": choice("hxt", "hxt", "netgen", "gmsh", "none",
+                            doc="tetrahedron mesher and optimiser: 'hxt' gmsh's parallel Delaunay with its optimiser, "
+                                "'netgen' Delaunay with Netgen's and gmsh's optimisers (the default before 0.5: "
+                                "4-5x slower), 'gmsh' Delaunay with gmsh's; the stable step is set by the worst "
+                                "element"),
     # --- run control ---
     "run.end_time": positive(ABSENT, "s", 1.0,
                              doc="simulated time after the first contact at which the run ends (outcome "

@@ -263,4 +263,5 @@ def test_internal_force_is_the_compiled_forms_vector():
     terms = np.bincount(s.dofs.ravel(), minlength=s.n_nodes)[:, None]
     err = np.abs(s.node.fint_fn.x.array.reshape(-1, 3) - ref.reshape(-1, 3))
     assert np.all(err <= 0.5 * s.internal.force_quantum * terms + 1e-12 * scale)
-    assert s.internal.force_quantum < 1e-12 * scale
+    # the quantum is a power of two at or above its range: within 2e-12 of the largest force of this P
+    assert s.internal.force_quantum < 2e-12 * scale
