@@ -3,7 +3,9 @@
 #               concrete target, default mesh) on $(NP) ranks into results/C3, the same shot with the rigid
 #               projectile into results/C3-rigid, and the mesh with its picture into results/C3-mesh
 #   make test   installs what is missing, lints, runs the fast unit lane and the system tests on $(WORKERS)
-#               pytest-xdist workers each, then the MPI ones (marked mpi) on 2 ranks; the serial lanes leave the
+#               pytest-xdist workers each, then the system tests that start 2-rank processes (marked two_ranks)
+#               one at a time (beside another worker's test, a 2-rank run waits on its descheduled rank at every
+#               collective: 7x slower), then the MPI ones (marked mpi) on 2 ranks; the serial lanes leave the
 #               mpi-marked tests to that last lane (on one rank their two runs would be one run twice)
 PY := .venv/bin/python
 NP ?= 2
@@ -39,8 +41,10 @@ TEST_MESHES ?= $(HOME)/.cache/fepen/test-meshes
 test: setup
 	$(PY) -m ruff check --no-cache fepen tests demos benchmarks tools
 	FEPEN_MESH_CACHE=$${FEPEN_MESH_CACHE:-$(TEST_MESHES)} $(PY) -m pytest -q -m "not mpi" -n $(WORKERS) tests/unit
-	FEPEN_MESH_CACHE=$${FEPEN_MESH_CACHE:-$(TEST_MESHES)} $(PY) -m pytest -q -m "not mpi" -n $(WORKERS) \
-	  --dist loadgroup --durations=20 tests/system
+	FEPEN_MESH_CACHE=$${FEPEN_MESH_CACHE:-$(TEST_MESHES)} $(PY) -m pytest -q -m "not mpi and not two_ranks" \
+	  -n $(WORKERS) --dist loadgroup --durations=20 tests/system
+	FEPEN_MESH_CACHE=$${FEPEN_MESH_CACHE:-$(TEST_MESHES)} $(PY) -m pytest -q -m "not mpi and two_ranks" \
+	  -p no:cacheprovider --durations=10 tests/system
 	FEPEN_MESH_CACHE=$${FEPEN_MESH_CACHE:-$(TEST_MESHES)} mpirun -n $(NP) $(PY) -m pytest -q -m mpi \
 	  -p no:cacheprovider tests
 

@@ -72,9 +72,38 @@ SLOW_TESTS = {
 }
 
 
+#: the system tests that start processes on 2 ranks, marked ``two_ranks`` (pytest_collection_modifyitems): whole
+#: modules whose module-scoped fixtures hold 2-rank runs, and tests by name; a test parametrized ``ranks=2`` is
+#: marked too. The system lane runs them after the others, one at a time, so that each 2-rank run has both
+#: cores: beside the other xdist worker's test, three processes on two cores, a 2-rank run waits on every
+#: collective for its descheduled rank (the API tour on 2 ranks: 8.8 s alone, 65 s beside another test).
+TWO_RANKS_MODULES = {"tests/system/test_paraview.py", "tests/system/test_charge_safety.py",
+                     "tests/system/test_faults.py"}
+TWO_RANKS_TESTS = {
+    "tests/system/test_demos.py::test_mpi_shot_demo", "tests/system/test_demos.py::test_hard_cases_demo",
+    "tests/system/test_demos.py::test_charge_demo_tied_against_frictional",
+    "tests/system/test_sweep.py::test_two_ranks_give_the_same_table",
+    "tests/system/test_sweep.py::test_deformable_shots_on_groups_of_one_and_two_ranks",
+    "tests/system/test_uncertainty_study.py::test_the_table_is_the_same_on_one_and_two_ranks",
+    "tests/system/test_data_safety.py::test_rerun_into_a_finished_deformable_run_leaves_no_file_of_the_old_run",
+}
+
+
+def _two_ranks(item) -> bool:
+    if item.nodeid.split("::", 1)[0] in TWO_RANKS_MODULES or item.nodeid.split("[", 1)[0] in TWO_RANKS_TESTS:
+        return True
+    callspec = getattr(item, "callspec", None)
+    return callspec is not None and callspec.params.get("ranks") == 2
+
+
 def pytest_collection_modifyitems(session, config, items):
     """Longest first: modules by SLOW_MODULES, tests within a module by SLOW_TESTS (a stable sort: the rest
-    keep their order). The order is the same on every xdist worker, as xdist requires."""
+    keep their order). The order is the same on every xdist worker, as xdist requires. The system tests that
+    start 2-rank processes are marked ``two_ranks`` (TWO_RANKS_MODULES, TWO_RANKS_TESTS)."""
+    for item in items:
+        if item.nodeid.startswith("tests/system/") and _two_ranks(item):
+            item.add_marker(pytest.mark.two_ranks)
+
     def cost(item):
         module = item.nodeid.split("::", 1)[0]
         return -SLOW_MODULES.get(module, 0), module, -SLOW_TESTS.get(item.nodeid, 0)
