@@ -23,6 +23,19 @@ def run_python(script, *args, ranks: int = 1, timeout: float = 600):
     return processes.run([script, *args], ranks, fepen=False, timeout=timeout)
 
 
+class Runs(dict):
+    """Runs made when first asked for, by key (``make(key)``), then kept: the 2-rank run is made only in the
+    system lane's two_ranks phase, the serial one only where a serial test asks for it (tests/conftest.py)."""
+
+    def __init__(self, make):
+        super().__init__()
+        self.make = make
+
+    def __missing__(self, key):
+        self[key] = value = self.make(key)
+        return value
+
+
 @pytest.fixture
 def fepen_cli():
     return run_fepen
@@ -77,8 +90,7 @@ SLOW_TESTS = {
 #: marked too. The system lane runs them after the others, one at a time, so that each 2-rank run has both
 #: cores: beside the other xdist worker's test, three processes on two cores, a 2-rank run waits on every
 #: collective for its descheduled rank (the API tour on 2 ranks: 8.8 s alone, 65 s beside another test).
-TWO_RANKS_MODULES = {"tests/system/test_paraview.py", "tests/system/test_charge_safety.py",
-                     "tests/system/test_faults.py"}
+TWO_RANKS_MODULES = {"tests/system/test_charge_safety.py", "tests/system/test_paraview.py"}
 TWO_RANKS_TESTS = {
     "tests/system/test_demos.py::test_mpi_shot_demo", "tests/system/test_demos.py::test_hard_cases_demo",
     "tests/system/test_demos.py::test_charge_demo_tied_against_frictional",
@@ -90,7 +102,8 @@ TWO_RANKS_TESTS = {
 
 
 def _two_ranks(item) -> bool:
-    if item.nodeid.split("::", 1)[0] in TWO_RANKS_MODULES or item.nodeid.split("[", 1)[0] in TWO_RANKS_TESTS:
+    if (item.nodeid.split("::", 1)[0] in TWO_RANKS_MODULES or item.nodeid in TWO_RANKS_TESTS
+            or item.nodeid.split("[", 1)[0] in TWO_RANKS_TESTS):
         return True
     callspec = getattr(item, "callspec", None)
     return callspec is not None and callspec.params.get("ranks") == 2

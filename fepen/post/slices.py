@@ -40,26 +40,26 @@ def cut(points: np.ndarray, normal, offset: float, basis: np.ndarray):
     d = points @ np.asarray(normal, dtype=float) - offset
     neg = d < 0.0
     crossing = np.flatnonzero(neg.any(axis=1) & (~neg).any(axis=1))
-    polys, cells = [], []
-    for c in crossing:
-        p, s = points[c], d[c]
-        pts = []
-        for i, j in _EDGES:
-            if (s[i] < 0.0) != (s[j] < 0.0):
-                w = s[i] / (s[i] - s[j])
-                pts.append(p[i] + w * (p[j] - p[i]))
-        q = np.array(pts) @ basis.T
-        centre = q.mean(axis=0)
-        order = np.argsort(np.arctan2(q[:, 1] - centre[1], q[:, 0] - centre[0]))
-        q = q[order]
-        # duplicate points (a vertex on the plane is met by up to three edges)
-        keep = np.ones(len(q), dtype=bool)
-        keep[1:] = np.linalg.norm(np.diff(q, axis=0), axis=1) > 1e-15
-        q = q[keep]
-        if len(q) >= 3:
-            polys.append(q)
-            cells.append(c)
-    return polys, np.array(cells, dtype=np.int64)
+    if not len(crossing):
+        return [], np.zeros(0, dtype=np.int64)
+    p, s, below = points[crossing], d[crossing], neg[crossing]
+    i, j = np.array(_EDGES).T
+    hit = below[:, i] != below[:, j]  # (k, 6): the edges the plane crosses (3 or 4 of each cell)
+    si, sj = s[:, i], s[:, j]
+    w = np.divide(si, si - sj, out=np.zeros_like(si), where=hit)
+    q = (p[:, i] + w[..., None] * (p[:, j] - p[:, i])) @ basis.T  # (k, 6, 2)
+    centre = (q * hit[..., None]).sum(axis=1) / hit.sum(axis=1)[:, None]
+    angle = np.where(hit, np.arctan2(q[..., 1] - centre[:, 1:], q[..., 0] - centre[:, :1]), np.inf)
+    order = np.argsort(angle, axis=1, kind="stable")  # the crossed edges first, around the centroid
+    q = np.take_along_axis(q, order[..., None], axis=1)
+    valid = np.take_along_axis(hit, order, axis=1)
+    # duplicate points (a vertex on the plane is met by up to three edges): dropped after the first
+    keep = valid.copy()
+    keep[:, 1:] &= np.linalg.norm(np.diff(q, axis=1), axis=2) > 1e-15
+    count = keep.sum(axis=1)
+    polys = np.split(q[keep], np.cumsum(count)[:-1])
+    good = np.flatnonzero(count >= 3)
+    return [polys[k] for k in good], crossing[good].astype(np.int64)
 
 
 def polygon_area(q: np.ndarray) -> float:

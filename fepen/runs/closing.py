@@ -40,11 +40,14 @@ class Closing:
             self.safety = run.safety.summary(self.peaks.get("charge_acc"))
         s = run.solver
         if run.fields is not None:  # the cut planes at peak load and at the end, and the shot (Figs. 18, 20-21)
-            if run.comm.rank == 0:
-                name = run.shot.experiment
-                slices.stress_maps(run.out, run.out / "stress_maps_peak.png", self.peaks["decel"]["t_s"])
-                slices.stress_maps(run.out, run.out / "stress_maps_end.png")
-                slices.trajectory_figure(run.out, run.out / "trajectory.png", table1_shot(name) if name else None)
+            name, out = run.shot.experiment, run.out
+            shared(run.comm, out, [
+                (lambda: slices.stress_maps(out, out / "stress_maps_peak.png", self.peaks["decel"]["t_s"]),
+                 ("stress_maps_peak.png", "stress_maps_peak.vtu")),
+                (lambda: slices.stress_maps(out, out / "stress_maps_end.png"),
+                 ("stress_maps_end.png", "stress_maps_end.vtu")),
+                (lambda: slices.trajectory_figure(out, out / "trajectory.png", table1_shot(name) if name else None),
+                 ("trajectory.png",))])
         else:
             analyses.deformed_picture(s, run.out / "deformed.png", f"t = {s.t * 1e6:.0f} µs, max PEEQ "
                                       f"{diagnostics.max_peeq(s):.3g}", run.gauges.peak_von_mises)
@@ -56,6 +59,44 @@ class Closing:
         """The summary keys of the closing analyses (None where they were not written)."""
         return {"peak_accelerations": self.peaks, "charge": self.charge, "nose_profile": self.profile,
                 "first_yield": self.first_yield, "charge_safety": self.safety}
+
+
+def shared(comm, out, jobs: list) -> None:
+    """Jobs that read the run's files and write files of their own (the figures), shared out over the ranks:
+    job k on rank k mod size, so that on 2 ranks the two stress maps are drawn at once (collective). Rank 0
+    first records in the run's manifest the names the other ranks are about to write (its claim on the
+    directory, fepen.atomic: the manifest lists every file a run writes, whichever rank wrote it).
+
+    Args:
+        comm: the run's communicator. out: the run's directory.
+        jobs: (callable without arguments, the names it writes in ``out``) pairs.
+
+    Raises:
+        On every rank, when a job failed on any: the job's own exception on its rank, a RuntimeError naming the
+        rank and the error elsewhere (no rank is left waiting for another).
+    """
+    from pathlib import Path
+
+    from fepen import atomic
+
+    if comm.rank == 0 and comm.size > 1 and out is not None:
+        claim = atomic.claim_of(Path(out) / "x")
+        for k, (_, names) in enumerate(jobs):
+            for name in names if claim is not None and k % comm.size else ():
+                claim.own(name)
+    error = None
+    for k, (job, _) in enumerate(jobs):
+        if k % comm.size == comm.rank and error is None:
+            try:
+                job()
+            except Exception as e:  # raised below, once every rank knows
+                error = e
+    said = comm.allgather(None if error is None else f"{type(error).__name__}: {error}")
+    if error is not None:
+        raise error
+    for rank, what in enumerate(said):
+        if what is not None:
+            raise RuntimeError(f"a closing figure failed on rank {rank}: {what}")
 
 
 def accelerations(run) -> dict:

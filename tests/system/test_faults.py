@@ -14,7 +14,7 @@ import xml.etree.ElementTree as ET
 
 import numpy as np
 import pytest
-from conftest import run_fepen
+from conftest import Runs, run_fepen
 
 from fepen.io import rundir
 from fepen.studies import processes
@@ -32,14 +32,13 @@ SAME = ("Hx_mm", "Hy_mm", "Tx_mm", "Ty_mm", "depth_mm", "residual_speed_m_s", "e
 
 @pytest.fixture(scope="module")
 def whole(tmp_path_factory):
-    """The uninterrupted runs on 1 and 2 ranks, by rank count."""
-    runs = {}
-    for ranks in (1, 2):
+    """The uninterrupted runs on 1 and 2 ranks, by rank count (each made when first asked for)."""
+    def make(ranks):
         out = tmp_path_factory.mktemp(f"whole{ranks}")
         r = run_fepen("run", *SETS, "--out", out, ranks=ranks)
         assert r.returncode == 0, r.stderr
-        runs[ranks] = out
-    return runs
+        return out
+    return Runs(make)
 
 
 def fepen_lines(stderr: str) -> list[str]:
@@ -214,11 +213,12 @@ def test_damaged_or_foreign_checkpoint_is_refused(tmp_path):
     assert res.returncode == 2 and "--force" in lines[0] and "--resume" in lines[0]
 
 
-def test_the_manifest_lists_every_file_a_run_writes(whole):
+@pytest.mark.parametrize("ranks", [1, 2])
+def test_the_manifest_lists_every_file_a_run_writes(whole, ranks):
     """run.json's manifest names every file a run with fields, gauges, profiles and pictures left in its
     directory, and each is one of rundir.RUN_NAMES (checked before a run starts), so that --force removes exactly
     the old run's files."""
-    for out in whole.values():
+    for out in (whole[ranks],):
         names = {p.name for p in out.iterdir()}
         files = set(json.loads((out / "run.json").read_text())["files"])
         assert names <= files <= rundir.RUN_NAMES, (names - files, files - rundir.RUN_NAMES)

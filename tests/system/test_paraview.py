@@ -19,7 +19,7 @@ from pathlib import Path
 
 import numpy as np
 import pytest
-from conftest import ROOT, run_fepen
+from conftest import ROOT, Runs, run_fepen
 
 #: one pytest-xdist worker runs this module (make test: -n 2 --dist loadgroup), so that its module-scoped
 #: runs are made once, not once per worker
@@ -38,15 +38,17 @@ CELL_FIELDS = {"von_mises_Pa", "axial_stress_Pa", "peeq", "temperature_K", "cell
 
 @pytest.fixture(scope="module")
 def runs(tmp_path_factory):
-    """Finished runs: serial, 2 ranks, charged (serial)."""
+    """Finished runs: serial, 2 ranks, charged (serial), each made when first asked for (conftest.Runs: the
+    2-rank run only in the system lane's two_ranks phase)."""
     base = tmp_path_factory.mktemp("pv")
-    out = {}
-    for name, ranks, extra in (("serial", 1, []), ("ranks2", 2, []),
-                               ("charged", 1, ["--set", "effects.charge=true"])):
+    how = {"serial": (1, []), "ranks2": (2, []), "charged": (1, ["--set", "effects.charge=true"])}
+
+    def make(name):
+        ranks, extra = how[name]
         r = run_fepen("run", *SMALL, *extra, "--out", str(base / name), ranks=ranks)
         assert r.returncode == 0, r.stderr[-2000:]
-        out[name] = base / name
-    return out
+        return base / name
+    return Runs(make)
 
 
 def xdmf_times(out: Path) -> list[float]:
