@@ -25,7 +25,7 @@ def run_python(script, *args, ranks: int = 1, timeout: float = 600):
 
 class Runs(dict):
     """Runs made when first asked for, by key (``make(key)``), then kept: the 2-rank run is made only in the
-    system lane's two_ranks phase, the serial one only where a serial test asks for it (tests/conftest.py)."""
+    system lane's two_ranks phase, the serial one only where a serial test asks for it."""
 
     def __init__(self, make):
         super().__init__()
@@ -96,14 +96,12 @@ TWO_RANKS_TESTS = {
     "tests/system/test_demos.py::test_charge_demo_tied_against_frictional",
     "tests/system/test_sweep.py::test_two_ranks_give_the_same_table",
     "tests/system/test_sweep.py::test_deformable_shots_on_groups_of_one_and_two_ranks",
-    "tests/system/test_uncertainty_study.py::test_the_table_is_the_same_on_one_and_two_ranks",
     "tests/system/test_data_safety.py::test_rerun_into_a_finished_deformable_run_leaves_no_file_of_the_old_run",
 }
 
 
 def _two_ranks(item) -> bool:
-    if (item.nodeid.split("::", 1)[0] in TWO_RANKS_MODULES or item.nodeid in TWO_RANKS_TESTS
-            or item.nodeid.split("[", 1)[0] in TWO_RANKS_TESTS):
+    if item.nodeid.split("::", 1)[0] in TWO_RANKS_MODULES or item.nodeid.split("[", 1)[0] in TWO_RANKS_TESTS:
         return True
     callspec = getattr(item, "callspec", None)
     return callspec is not None and callspec.params.get("ranks") == 2

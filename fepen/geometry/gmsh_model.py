@@ -262,12 +262,12 @@ def _optimise(opts: MeshOptions) -> None:
     """The optimisers run after gmsh.model.mesh.generate (which ran gmsh's own, and Netgen's for "netgen")."""
     import gmsh
 
-    if opts.optimize in ("netgen", "gmsh"):
-        _stage("optimising")
+    if opts.optimize not in ("netgen", "gmsh"):
+        return
+    _stage("optimising")
     if opts.optimize == "netgen":
         gmsh.model.mesh.optimize("Netgen")
-    if opts.optimize in ("netgen", "gmsh"):
-        gmsh.model.mesh.optimize("")
+    gmsh.model.mesh.optimize("")
 
 
 def _tip_point() -> int:

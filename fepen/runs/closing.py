@@ -75,14 +75,12 @@ def shared(comm, out, jobs: list) -> None:
         On every rank, when a job failed on any: the job's own exception on its rank, a RuntimeError naming the
         rank and the error elsewhere (no rank is left waiting for another).
     """
-    from pathlib import Path
-
     from fepen import atomic
 
-    if comm.rank == 0 and comm.size > 1 and out is not None:
-        claim = atomic.claim_of(Path(out) / "x")
-        for k, (_, names) in enumerate(jobs):
-            for name in names if claim is not None and k % comm.size else ():
+    claim = atomic.claim_of(out) if comm.rank == 0 and comm.size > 1 and out is not None else None
+    for k, (_, names) in enumerate(jobs):
+        if claim is not None and k % comm.size:
+            for name in names:
                 claim.own(name)
     error = None
     for k, (job, _) in enumerate(jobs):
