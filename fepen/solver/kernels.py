@@ -15,6 +15,12 @@ from fepen.laws import materials as M
 #: fast-math flags that keep IEEE NaN/inf semantics (inverted or NaN elements must still be detected)
 _FAST = {"nsz", "arcp", "contract", "afn", "reassoc"}
 
+# The small helpers below are plain numba functions, called, not inlined at numba's IR level (inline="always"):
+# IR inlining made stress_update take 38 s and plastic_pass 7.5 s to compile on a machine's first run (fresh
+# clone, empty numba cache), against 5.2 s and 2.7 s now; LLVM still inlines what pays. The runs give the same
+# bits (history.csv of a worn, eroding C7 and of the soft hard case: the same SHA-256); the numba reference
+# stress_update runs 7-15 % slower per cell (the fused C pass, the default, does not use it).
+
 
 def reference_gradients(X: np.ndarray, dofs: np.ndarray):
     """Shape-function gradients, volumes and orientation signs of the reference cells.
@@ -59,7 +65,7 @@ def _reference_gradients(X, dofs, grad0, vol0, orient):
         orient[e] = 1.0 if det > 0.0 else (-1.0 if det < 0.0 else 0.0)
 
 
-@numba.njit(cache=True, inline="always", fastmath=_FAST, error_model="numpy")
+@numba.njit(cache=True, fastmath=_FAST, error_model="numpy")
 def _six_volume(x, dofs, e):
     """det(x1 - x0, x2 - x0, x3 - x0) of cell e: six times its signed volume."""
     n0, n1, n2, n3 = dofs[e, 0], dofs[e, 1], dofs[e, 2], dofs[e, 3]
@@ -142,7 +148,7 @@ def cell_jacobians(x, dofs, orient, vol0, mat, out):
         out[e] = _six_volume(x, dofs, e) / (6.0 * vol0[e]) * orient[e] if mat[e] >= 0 else 1.0
 
 
-@numba.njit(cache=True, inline="always", fastmath=_FAST, error_model="numpy")
+@numba.njit(cache=True, fastmath=_FAST, error_model="numpy")
 def _cofactor(A):
     """Cofactor matrix (det A · A^-T) and determinant of a 3x3 matrix A given as a 9-tuple, row-major.
 
@@ -170,13 +176,13 @@ def nodal_pressures(nodal_vol, nodal_vol0, bulk, out):
                 out[n, m] = 0.0
 
 
-@numba.njit(cache=True, inline="always", fastmath=_FAST, error_model="numpy")
+@numba.njit(cache=True, fastmath=_FAST, error_model="numpy")
 def _moduli(p):
     """(G, K): shear and bulk moduli of the material parameter vector p."""
     return p[M.E_] / (2.0 * (1.0 + p[M.NU])), p[M.E_] / (3.0 * (1.0 - 2.0 * p[M.NU]))
 
 
-@numba.njit(cache=True, inline="always", fastmath=_FAST, error_model="numpy")
+@numba.njit(cache=True, fastmath=_FAST, error_model="numpy")
 def _gradient(y, f, dofs, grad0, e):
     """Σ_a (f y_a) ⊗ grad0_a over the nodes of cell e, a 9-tuple, row-major: F for (x, 1), ΔF for (v, dt)."""
     G00 = G01 = G02 = G10 = G11 = G12 = G20 = G21 = G22 = 0.0
@@ -196,7 +202,7 @@ def _gradient(y, f, dofs, grad0, e):
     return G00, G01, G02, G10, G11, G12, G20, G21, G22
 
 
-@numba.njit(cache=True, inline="always", fastmath=_FAST, error_model="numpy")
+@numba.njit(cache=True, fastmath=_FAST, error_model="numpy")
 def _velocity_gradient(F, D):
     """ΔL = ΔF F_m^-1 at the mid-step configuration F_m = F − ΔF/2 (through the cofactor of F_m), a 9-tuple.
 
@@ -216,7 +222,7 @@ def _velocity_gradient(F, D):
             (D20 * c20 + D21 * c21 + D22 * c22) * idet)
 
 
-@numba.njit(cache=True, inline="always", fastmath=_FAST, error_model="numpy")
+@numba.njit(cache=True, fastmath=_FAST, error_model="numpy")
 def _hughes_winget(L, s, e):
     """Q s_e Q^T, the deviatoric stress of cell e (Voigt 6-tuple) rotated by Q = (I − W/2)^-1 (I + W/2),
     W = skew(L), in closed form (Cayley): with w the axial vector of W/2, Q = I + 2 (W/2 + (W/2)^2) / (1 + |w|^2).
@@ -244,7 +250,7 @@ def _hughes_winget(L, s, e):
             T10 * Q20 + T11 * Q21 + T12 * Q22, T00 * Q20 + T01 * Q21 + T02 * Q22)
 
 
-@numba.njit(cache=True, inline="always", fastmath=_FAST, error_model="numpy")
+@numba.njit(cache=True, fastmath=_FAST, error_model="numpy")
 def _trial_stress(L, s, e, G, se, de):
     """Elastic trial deviatoric stress of cell e into se (6,): the rotated s_e + 2 G dev(sym L).
 
@@ -260,14 +266,14 @@ def _trial_stress(L, s, e, G, se, de):
         se[i] += 2.0 * G * de[i]
 
 
-@numba.njit(cache=True, inline="always", fastmath=_FAST, error_model="numpy")
+@numba.njit(cache=True, fastmath=_FAST, error_model="numpy")
 def _mises(S):
     """von Mises stress √(3/2 s:s) of a deviatoric stress S, a 6-tuple in Voigt order."""
     s0, s1, s2, s3, s4, s5 = S
     return math.sqrt(1.5 * (s0 * s0 + s1 * s1 + s2 * s2 + 2.0 * (s3 * s3 + s4 * s4 + s5 * s5)))
 
 
-@numba.njit(cache=True, inline="always", fastmath=_FAST, error_model="numpy")
+@numba.njit(cache=True, fastmath=_FAST, error_model="numpy")
 def _piola(P_out, e, add, s00, s11, s22, s01, s12, s02, C):
     """P_ij = Σ_k σ_ik C_kj of the symmetric σ (given by its six entries) and the 9-tuple C, row-major, into
     row e of P_out: written, or added to it if add."""
@@ -282,7 +288,7 @@ def _piola(P_out, e, add, s00, s11, s22, s01, s12, s02, C):
             P_out[e, i] = P[i]
 
 
-@numba.njit(cache=True, inline="always", fastmath=_FAST, error_model="numpy")
+@numba.njit(cache=True, fastmath=_FAST, error_model="numpy")
 def _yielded(e, d, sy, T_new, scale, p, V, eps_p, temp, sy0, totals, se):
     """Bookkeeping of the radial return of a cell e that yields: its deviatoric stress se (6,) scaled from the
     trial state to the flow stress, its eps_p, temp and static flow stress sy0 updated, its plastic work, heat

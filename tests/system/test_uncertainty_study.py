@@ -99,7 +99,7 @@ def test_the_table_is_the_same_on_one_and_two_ranks(tmp_path_factory):
     world = MPI.COMM_WORLD
     assert world.size == 2
     root = world.bcast(str(tmp_path_factory.mktemp("unc-mpi")) if world.rank == 0 else None, root=0)
-    p = uncertainty.plan(None, DEMO, samples=40, seed=9)
+    p = uncertainty.plan(None, DEMO, samples=16, seed=9)
     quiet = dict(say=lambda *a: None, progress=False)
     two = uncertainty.study(p, f"{root}/two", world, **quiet)
     one = uncertainty.study(p, f"{root}/one", MPI.COMM_SELF, **quiet) if world.rank == 0 else None
