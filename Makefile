@@ -50,7 +50,7 @@ test: setup
 
 # The second stack (docs/install.md): the current dolfinx (0.11, PyPI's dolfinx-solver-real) on Python 3.12 with
 # numpy 2 and MPICH, in .venv-current (tools/bootstrap_current.sh). Its lane: the unit lane, the MPI lane on 2
-# ranks under MPICH's own mpiexec, and tests/stacks (Table 1 rigid and a short 4 mm deformable shot on both
+# ranks under MPICH's own mpiexec, and tests/stacks (Table 1 rigid and deformable at 6 mm on both
 # stacks, the same numbers; it needs `make setup`'s .venv too). CI runs it after `make test` (.ci/run).
 CURRENT := .venv-current/bin/python
 

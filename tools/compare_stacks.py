@@ -152,10 +152,11 @@ def table(rows: list[dict], label: str) -> str:
     return "\n".join(lines)
 
 
-def run_both(out: Path) -> list[tuple[str, Path, Path]]:
-    """Table 1 rigid and at 4 mm deformable (fields off) with each stack's fepen validate."""
+def run_both(out: Path, size_mm: int = 4) -> list[tuple[str, Path, Path]]:
+    """Table 1 rigid and deformable at ``size_mm`` (fields off) with each stack's fepen validate; the deformable
+    case is named plastic-{size_mm}mm."""
     cases = {"rigid": ["--set", "effects.fidelity=rigid"],
-             "plastic-4mm": ["--set", "mesh.size=4e-3", "--set", "run.fields=false"]}
+             f"plastic-{size_mm}mm": ["--set", f"mesh.size={size_mm}e-3", "--set", "run.fields=false"]}
     done = []
     for case, sets in cases.items():
         dirs = []

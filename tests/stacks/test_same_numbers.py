@@ -1,4 +1,4 @@
-"""The same numbers on both stacks (issue 34; docs/install.md): Table 1's eight shots, rigid and deformable at 4 mm,
+"""The same numbers on both stacks (issue 34; docs/install.md): Table 1's eight shots, rigid and deformable at 6 mm,
 and the default mesh, made by Debian's dolfinx 0.5.2 (.venv: numpy 1.24, Open MPI, Python 3.11) and by the
 current dolfinx (.venv-current: 0.11 from PyPI, numpy 2, MPICH, Python 3.12). ``make test-current`` runs this
 after the current stack's unit and MPI lanes; it needs both environments (make setup, make setup-current).
@@ -34,16 +34,20 @@ RTOL = 1e-6
 #: nearly normal shot, small themselves, carry it. Measured at 4 mm (tools/compare_stacks.py): C2 (0.58 deg)
 #: final axis 4e-5 of itself, its instantaneous out-of-plane moment moment_x_N_m 1.6e-3 of the moments' scale,
 #: C8 1.2e-5 and 2e-5; C3-C7 below 6e-6; the depths the same to the printed digit on every shot
-TOLERANCE = {"rigid": (RTOL, RTOL), "plastic-4mm": (1e-4, 5e-3)}
+#: The test runs the deformable shots at 6 mm, not the 4 mm of docs/install.md's table, for the suite's time (31 s
+#: against 47 s per stack on 2 cores): the same code on a coarser mesh, compared at the same tolerances (at 6 mm on
+#: this machine the largest summary difference was 4.5e-10, C2's Hx, and the largest history one 8.7e-9)
+SIZE_MM = 6
+TOLERANCE = {"rigid": (RTOL, RTOL), f"plastic-{SIZE_MM}mm": (1e-4, 5e-3)}
 
 
 @pytest.fixture(scope="module")
 def pairs(tmp_path_factory):
-    """{case: (debian dir, current dir)}: Table 1 rigid and at 4 mm deformable, run by both stacks."""
-    return {case: (a, b) for case, a, b in cs.run_both(tmp_path_factory.mktemp("stacks"))}
+    """{case: (debian dir, current dir)}: Table 1 rigid and at SIZE_MM deformable, run by both stacks."""
+    return {case: (a, b) for case, a, b in cs.run_both(tmp_path_factory.mktemp("stacks"), SIZE_MM)}
 
 
-@pytest.mark.parametrize("case", ["rigid", "plastic-4mm"])
+@pytest.mark.parametrize("case", ["rigid", f"plastic-{SIZE_MM}mm"])
 def test_table1_gives_the_same_figures_on_both_stacks(pairs, case):
     rows = cs.compare(*pairs[case])
     assert [r["shot"] for r in rows] == [f"C{k}" for k in range(1, 9)]
@@ -57,7 +61,7 @@ def test_table1_gives_the_same_figures_on_both_stacks(pairs, case):
             f"{r['shot']} {case}: history.csv {r['history_col']} differs by {r['history_rel']:.2g}"
 
 
-@pytest.mark.parametrize("case", ["rigid", "plastic-4mm"])
+@pytest.mark.parametrize("case", ["rigid", f"plastic-{SIZE_MM}mm"])
 def test_each_run_records_the_stack_it_ran_on(pairs, case):
     """summary.json (and a deformable run's run.json) name the MPI library, numpy and Python, and the dolfinx and
     PETSc of a deformable run (a rigid run imports neither)."""
