@@ -17,7 +17,7 @@ from fepen.studies import processes, sweep
 pytestmark = pytest.mark.xdist_group("test_sweep")
 
 DEMO = processes.ROOT / "demos" / "studies" / "c3_scatter.toml"  # the shipped C3 scatter, resized
-N = 120
+N = 60  # rigid shots: enough to kill a sweep half way and resume it (120 made each of its four sweeps 5-6 s longer)
 
 
 @pytest.fixture(scope="module")
