@@ -190,3 +190,23 @@ int32_t point_forces(int32_t k, const double *x, const double *v, const double *
     }
     return P_COUNT;
 }
+
+/* The sectors of k points' offsets r (k, 3) about unit axes t (k, 3), S sectors: q as tunnel_locate takes it (the
+ * polynomial, libm's atan2 near an edge) and q_exact from libm's atan2 alone (the tests: the two agree). */
+void tunnel_sectors(int32_t k, const double *r, const double *t, int32_t S, int32_t *q, int32_t *q_exact) {
+    for (int32_t i = 0; i < k; ++i) {
+        const double *ti = t + 3 * i, *ri = r + 3 * i;
+        double e1[3] = {-ti[2] * ti[0], -ti[2] * ti[1], 1.0 - ti[2] * ti[2]};
+        double n1sq = tdot(e1, e1);
+        if (n1sq < 1.0000001e-12 && sqrt(n1sq) < 1e-6) {
+            e1[0] = 1.0 - ti[0] * ti[0]; e1[1] = -ti[0] * ti[1]; e1[2] = -ti[0] * ti[2];
+            n1sq = tdot(e1, e1);
+        }
+        double u1[3] = {e1[0], e1[1], e1[2]};
+        q[i] = tunnel_sector(ri, ti, e1, n1sq, S);
+        const double n1 = sqrt(n1sq);
+        for (int j = 0; j < 3; ++j) u1[j] /= n1;
+        double e2[3] = {ti[1] * u1[2] - ti[2] * u1[1], ti[2] * u1[0] - ti[0] * u1[2], ti[0] * u1[1] - ti[1] * u1[0]};
+        q_exact[i] = tunnel_sector_exact(tdot(ri, e2), tdot(ri, u1), S);
+    }
+}

@@ -116,11 +116,53 @@ static void tunnel_at(const double *T, double s, const double *c_end, const doub
 typedef struct {
     double c[3], t[3], s;
     int32_t hint;
+    /* the last point's first guess (tunnel_locate): its arc length and where it lies. The points of a ring share
+     * their distance behind the tip, so the ring's points after the first take it as it is (a station's place
+     * depends on s alone, and a call changes no station's place: the same numbers, once a ring) */
+    double guess_s;
+    TunnelAt guess;
+    int32_t has_guess;
 } TunnelEnd;
 
 static inline void tunnel_end(const double *T, TunnelEnd *e) {
     e->hint = -1;
+    e->has_guess = 0;
     if ((int32_t)T[T_M] >= 1) tunnel_open_end(T, e->c, e->t, &e->s);
+}
+
+/* The sector of the angle theta = atan2(y, x) in [-pi, pi]: floor((theta + pi) / (2 pi) S), clamped to 0..S-1. The
+ * angle is first taken from a polynomial (Abramowitz and Stegun 4.4.47, |error| <= 1e-5 rad); where that lies
+ * within TUNNEL_SECTOR_MARGIN (ten times wider) of a sector's edge, the sector is taken from libm's atan2 as it
+ * always was. Elsewhere both give the same sector: the same integer, without atan2, a square root and a division
+ * on every point. */
+#define TUNNEL_SECTOR_MARGIN 1e-4
+static inline int32_t tunnel_sector_exact(double y, double x, int32_t S) {
+    double theta = atan2(y, x);
+    int32_t q = (int32_t)floor((theta + M_PI) / (2.0 * M_PI) * S);
+    return q < 0 ? 0 : (q >= S ? S - 1 : q);
+}
+
+/* r's sector about the unit axis t from e1 (not yet of unit length: e1 . e1 = n1sq). The polynomial takes r's
+ * components along e1 and t x e1 as they are (a common positive scale leaves the angle as it is); the exact path
+ * makes e1 a unit vector first, as it always did. */
+static inline int32_t tunnel_sector(const double *r, const double *t, double *e1, double n1sq, int32_t S) {
+    double e2[3] = {t[1] * e1[2] - t[2] * e1[1], t[2] * e1[0] - t[0] * e1[2], t[0] * e1[1] - t[1] * e1[0]};
+    const double x = tdot(r, e1), y = tdot(r, e2);
+    const double ax = fabs(x), ay = fabs(y), hi = ax > ay ? ax : ay, lo = ax > ay ? ay : ax;
+    if (hi > 0.0 && hi < INFINITY) {
+        const double z = lo / hi, z2 = z * z;
+        double a = z * (0.9998660 + z2 * (-0.3302995 + z2 * (0.1801410 + z2 * (-0.0851330 + z2 * 0.0208351))));
+        if (ay > ax) a = 0.5 * M_PI - a;
+        if (x < 0.0) a = M_PI - a;
+        if (y < 0.0) a = -a;
+        const double per_rad = S * (0.5 / M_PI), u = (a + M_PI) * per_rad, fl = floor(u);
+        const double margin = TUNNEL_SECTOR_MARGIN * per_rad;
+        if (u - fl > margin && fl + 1.0 - u > margin && fl >= 0.0 && fl < (double)S) return (int32_t)fl;
+    }
+    const double n1 = sqrt(n1sq);
+    for (int j = 0; j < 3; ++j) e1[j] /= n1;
+    double e2u[3] = {t[1] * e1[2] - t[2] * e1[1], t[2] * e1[0] - t[0] * e1[2], t[0] * e1[1] - t[1] * e1[0]};
+    return tunnel_sector_exact(tdot(r, e2u), tdot(r, e1), S);
 }
 
 /* A point p at body-axial distance xi in the tunnel (e: its open end, tunnel_end): returns 1 with its penetration
@@ -137,7 +179,14 @@ static int tunnel_locate(const double *T, TunnelEnd *e, const double *p, double 
     const double s0 = tunnel_station((double *)T, 0)[T_ARC];
     if (s < s0) s = s0;
     TunnelAt at;
-    tunnel_at(T, s, c_end, t_end, s_end, e->hint, &at);
+    if (e->has_guess && s == e->guess_s) {
+        at = e->guess;
+    } else {
+        tunnel_at(T, s, c_end, t_end, s_end, e->hint, &at);
+        e->guess_s = s;
+        e->guess = at;
+        e->has_guess = 1;
+    }
     double d[3] = {p[0] - at.c[0], p[1] - at.c[1], p[2] - at.c[2]};
     s += tdot(d, at.t); /* one projection onto the axis: a body turned in its tunnel */
     if (s > s_end) s = s_end;
@@ -152,17 +201,12 @@ static int tunnel_locate(const double *T, TunnelEnd *e, const double *p, double 
     for (int j = 0; j < 3; ++j) er[j] = r[j] / rr;
     /* the sector: the angle of r about t from e1, the world z axis's part across t (x when t is along z) */
     double e1[3] = {-at.t[2] * at.t[0], -at.t[2] * at.t[1], 1.0 - at.t[2] * at.t[2]};
-    double n1 = sqrt(tdot(e1, e1));
-    if (n1 < 1e-6) {
+    double n1sq = tdot(e1, e1);
+    if (n1sq < 1.0000001e-12 && sqrt(n1sq) < 1e-6) {
         e1[0] = 1.0 - at.t[0] * at.t[0]; e1[1] = -at.t[0] * at.t[1]; e1[2] = -at.t[0] * at.t[2];
-        n1 = sqrt(tdot(e1, e1));
+        n1sq = tdot(e1, e1);
     }
-    for (int j = 0; j < 3; ++j) e1[j] /= n1;
-    double e2[3] = {at.t[1] * e1[2] - at.t[2] * e1[1], at.t[2] * e1[0] - at.t[0] * e1[2],
-                    at.t[0] * e1[1] - at.t[1] * e1[0]};
-    double theta = atan2(tdot(r, e2), tdot(r, e1));
-    int32_t q = (int32_t)floor((theta + M_PI) / (2.0 * M_PI) * S);
-    q = q < 0 ? 0 : (q >= S ? S - 1 : q);
+    const int32_t q = tunnel_sector(r, at.t, e1, n1sq, S);
     double a_lo = tunnel_station((double *)T, at.ia)[T_STATION + q];
     double a_hi = at.ib < m ? tunnel_station((double *)T, at.ib)[T_STATION + q] : T[T_A0];
     *delta = rr - (a_lo + at.w * (a_hi - a_lo));

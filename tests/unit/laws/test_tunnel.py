@@ -120,3 +120,32 @@ def test_the_stress_develops_over_the_onset_speed():
         out.append((sig[i] - LAW.B * LAW.density * vn * vn) / LAW.sigma_s)
     assert out[0] == pytest.approx(0.2, rel=0.05) and out[1] == pytest.approx(0.5, rel=0.05)
     assert out[2] == pytest.approx(1.0, rel=1e-9) and out[3] == pytest.approx(1.0, rel=1e-9)
+
+
+def test_the_sector_is_atan2s_sector_everywhere_and_at_every_edge():
+    """tunnel_locate takes a point's sector from a polynomial angle (error 1e-5 rad) and from libm's atan2 only
+    within 1e-4 rad of an edge: the same sector as atan2's alone, on a million random offsets about random axes
+    and on offsets 1e-12 to 1e-3 rad either side of every edge (and on the axes the basis switches at)."""
+    from fepen import native
+
+    lib = native.kernel("target")
+    rng = np.random.default_rng(7)
+    S = 16
+
+    def sectors(r, t):
+        r, t = np.ascontiguousarray(r, dtype=float), np.ascontiguousarray(t, dtype=float)
+        q, qe = np.zeros(len(r), np.int32), np.zeros(len(r), np.int32)
+        lib.tunnel_sectors(len(r), r.ctypes.data, t.ctypes.data, S, q.ctypes.data, qe.ctypes.data)
+        return q, qe
+
+    t = rng.normal(size=(1_000_000, 3))
+    t /= np.linalg.norm(t, axis=1)[:, None]
+    q, qe = sectors(rng.normal(size=t.shape) * 10.0 ** rng.uniform(-4, 1, size=(len(t), 1)), t)
+    assert np.array_equal(q, qe) and len(set(qe)) == S
+    # edges: offsets at angle 2 pi j / S - pi + eps about the y axis (e1 = z, e2 = y x z = x) and about z (e1 = x)
+    for axis, e1, e2 in (((0.0, 1.0, 0.0), (0, 0, 1), (1, 0, 0)), ((0.0, 0.0, 1.0), (1, 0, 0), (0, 1, 0))):
+        eps = np.concatenate([s * 10.0 ** np.arange(-12.0, -2.5, 0.25) for s in (-1, 1)] + [[0.0]])
+        ang = (2 * math.pi * np.arange(S + 1) / S - math.pi)[:, None] + eps[None, :]
+        r = np.cos(ang).ravel()[:, None] * np.array(e1) + np.sin(ang).ravel()[:, None] * np.array(e2)
+        q, qe = sectors(r * 0.0118, np.tile(axis, (len(r), 1)))
+        assert np.array_equal(q, qe)
