@@ -73,28 +73,23 @@ class Layered:
 
     def point_forces(self, kernel, x, v, n, area, radius, R_meridian, sin_phi0, axis):
         """Each layer's law on the points near it, in its block's frame; forces (k, 3) and their sums (force
-        (3), loaded points, loaded area), as fepen.laws.target.point_forces returns them."""
+        (3), loaded points, loaded area), as fepen.laws.target.point_forces returns them.
+
+        A layer near any point takes all of them, shifted into its block's frame: the law's immersed fraction
+        is zero on the points whose patch lies wholly outside the layer's faces (no force, not counted), so
+        the forces are those of the points near it, without gathering them into new arrays every call."""
         f = np.zeros_like(x)
         sums = np.zeros(5)
-        half = 0.5 * np.sqrt(area)
         lo, hi = float(x[:, 1].min(initial=np.inf)), float(x[:, 1].max(initial=-np.inf))
-        reach = float(half.max(initial=0.0))
+        reach = 0.5 * float(np.sqrt(area.max(initial=0.0)))
         for layer in self.layers:
             d = self.block_tops[layer.block]
             if lo + d >= -layer.law.top + reach or (layer.law.lower is not None and hi + d <= -layer.law.lower - reach):
-                continue  # no point near this layer (the masks below would select none)
-            y = x[:, 1] + d  # in the block's frame
-            near = y < -layer.law.top + half
-            if layer.law.lower is not None:
-                near &= y > -layer.law.lower - half
-            idx = np.flatnonzero(near)
-            if not len(idx):
-                continue
-            xs = x[idx].copy()
-            xs[:, 1] = y[idx]
-            fi, si = kernel(layer.law, xs, v[idx], n[idx], area[idx], radius[idx], R_meridian[idx],
-                            sin_phi0[idx], axis)
-            f[idx] += fi
+                continue  # no point near this layer
+            xs = x.copy()
+            xs[:, 1] += d  # in the block's frame
+            fi, si = kernel(layer.law, xs, v, n, area, radius, R_meridian, sin_phi0, axis)
+            f += fi
             sums += si
         return f, sums
 
