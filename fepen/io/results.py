@@ -108,19 +108,43 @@ def history_row(t, tip, tail, velocity, force, mass, energies: dict, contact: in
     return row
 
 
-def write_history(rows, out: Path, comm=MPI.COMM_WORLD, columns=None) -> None:
+class HistoryText:
+    """The CSV text of a run's history rows, each row formatted once. history.csv is replaced whole at every
+    output (atomically: the file keeps its last complete version), and formatting every row again each time
+    made a long run's outputs grow as the square of its rows (a 33 ms layered shot: 333 writes of up to 33,000
+    rows, 94 s of its 236). The text is kept while the rows before the new ones are the same row objects; any
+    other change of the list (a row replaced or inserted) formats them all again."""
+
+    def __init__(self):
+        self.rows: list = []  #: the row objects formatted so far, in order
+        self.chunks: list[str] = []  #: their CSV text, a chunk per write
+
+    def of(self, rows) -> str:
+        """The CSV text (no header) of ``rows``, as csv.writer writes them with 9 significant digits."""
+        n = len(self.rows)
+        if n > len(rows) or any(a is not b for a, b in zip(self.rows, rows)):
+            self.rows, self.chunks, n = [], [], 0
+        if len(rows) > n:
+            buf = io.StringIO()
+            w = csv.writer(buf)
+            for r in rows[n:]:
+                w.writerow([f"{v:.9g}" for v in r])
+            self.chunks.append(buf.getvalue())
+            self.rows.extend(rows[n:])
+        return "".join(self.chunks)
+
+
+def write_history(rows, out: Path, comm=MPI.COMM_WORLD, columns=None, text: HistoryText | None = None) -> None:
     """history.csv (rank 0, atomically; collective: a failed write raises MachineFault on every rank, and
     the file keeps its last complete version); columns: HISTORY_COLUMNS (default), + CHARGE_COLUMNS, BODY_COLUMNS
-    and RESULTANT_COLUMNS with a charge, ..."""
+    and RESULTANT_COLUMNS with a charge, ...; text: the run's HistoryText (its rows formatted once), or None."""
 
     def write():
         files.inject("history")
         buf = io.StringIO()
-        w = csv.writer(buf)
-        w.writerow(columns or HISTORY_COLUMNS)
-        for r in rows:
-            w.writerow([f"{v:.9g}" for v in r])
-        files.write_text(Path(out) / "history.csv", buf.getvalue(), comm)
+        csv.writer(buf).writerow(columns or HISTORY_COLUMNS)
+        body = (text or HistoryText()).of(rows)
+        files.write_text(Path(out) / "history.csv", buf.getvalue() + body, comm)
 
     files.agree(comm, f"{Path(out) / 'history.csv'}", write)
 

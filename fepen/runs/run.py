@@ -102,6 +102,7 @@ class Run:
         self.output_s = 0.0
         self.out = files.prepare(out, comm) if out is not None else None
         self.rows: list[list[float]] = []
+        self.history_text = results.HistoryText()  # history.csv's rows, each formatted once
         law = shot.law
         self.rules = events.StopRules(law.thickness if law is not None else None, shot.end_time is None)
         self.crossings = fl.Crossings(law.faces()) if shot.layered else None
@@ -264,7 +265,7 @@ class Run:
     def write_history(self) -> None:
         """history.csv (and probes.csv) of the rows so far (collective)."""
         if self.out is not None:
-            results.write_history(self.rows, self.out, self.comm, self.columns)
+            results.write_history(self.rows, self.out, self.comm, self.columns, self.history_text)
             if self.probes is not None:
                 self.probes.write(self.out, self.comm, self.shot.outputs.acceleration_filter_hz)
 

@@ -52,3 +52,31 @@ def test_finished_runs_of_a_folder(tmp_path):
     assert [p.name for p in results.finished_runs(study)] == ["a", "b"]
     assert results.finished_runs(study / "a") == [study / "a"]
     assert np.isfinite(results.read(study / "a").history()["t_s"]).all()
+
+
+def test_history_text_formats_each_row_once_and_gives_the_whole_text(tmp_path):
+    """history.csv is replaced whole at every output: a run's HistoryText formats only the rows added since
+    its last write, and its text is, to the character, that of every row formatted afresh; a list whose
+    earlier rows changed (a row inserted at its head, as the batched rigid path does) is formatted again."""
+    import csv
+    import io
+
+    def afresh(rows):
+        buf = io.StringIO()
+        w = csv.writer(buf)
+        for r in rows:
+            w.writerow([f"{v:.9g}" for v in r])
+        return buf.getvalue()
+
+    rng = np.random.default_rng(3)
+    text, rows = results.HistoryText(), []
+    for n in (1, 5, 0, 40, 3):
+        rows.extend(list(rng.normal(size=6) * 10.0 ** rng.integers(-9, 9)) for _ in range(n))
+        assert text.of(rows) == afresh(rows)
+    assert len(text.chunks) == 4  # one chunk per write that added rows: none were formatted twice
+    rows.insert(0, [0.5] * 6)
+    assert text.of(rows) == afresh(rows) and len(text.chunks) == 1
+    restored = [list(r) for r in rows[:10]]  # a resumed run's rows: new objects, fewer
+    assert text.of(restored) == afresh(restored)
+    results.write_history(rows, tmp_path, text=text)
+    assert (tmp_path / "history.csv").read_text().splitlines()[1:] == afresh(rows).splitlines()
