@@ -134,8 +134,12 @@ def write_results(rows: list[dict]) -> None:
 
 
 def write_table() -> None:
-    """benchmarks/step_cost_results.md from the CSV."""
+    """benchmarks/step_cost_results.md from the CSV; the notes written below the table are kept."""
     path = RESULTS / "step_cost_results.csv"
+    md = RESULTS / "step_cost_results.md"
+    old = md.read_text().splitlines() if md.is_file() else []
+    rows_end = max((i for i, ln in enumerate(old) if ln.startswith("|")), default=len(old) - 1)
+    notes = old[rows_end + 1:]
     with path.open() as f:
         table = list(csv.DictReader(f))
     lines = ["# Cost of the deformable step (benchmarks/step_cost.py)", "",
@@ -146,7 +150,7 @@ def write_table() -> None:
              "shared the two cores (its times are inflated, ratios less so).", "",
              "| " + " | ".join(COLUMNS) + " |", "|" + "---|" * len(COLUMNS)]
     lines += ["| " + " | ".join(r.get(k) or "" for k in COLUMNS) + " |" for r in table]
-    (RESULTS / "step_cost_results.md").write_text("\n".join(lines) + "\n")
+    md.write_text("\n".join(lines + notes) + "\n")
 
 
 def main(argv=None) -> None:
