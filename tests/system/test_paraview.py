@@ -69,14 +69,30 @@ def mesh_counts(out: Path) -> tuple[int, int]:
 
 def run_reader(cmd: list[str], timeout: float = 300) -> dict:
     """A reader in its own process: its JSON line, or a failure with what it printed (a crash included)."""
-    r = subprocess.run(cmd, capture_output=True, text=True, timeout=timeout)
-    assert r.returncode == 0, f"{cmd[:3]} exit {r.returncode}: {r.stderr[-1500:]}"
-    line = [s for s in r.stdout.splitlines() if s.startswith("{")][-1]
-    return json.loads(line)
+    return run_readers([cmd], timeout)[0]
 
 
-def paraview(out: Path, which: str) -> dict:
-    return run_reader([PVPYTHON, str(HERE / "paraview_inspect.py"), str(out / "fields.xdmf"), which])
+def run_readers(cmds: list[list[str]], timeout: float = 300) -> list[dict]:
+    """Readers each in its own process, all at once (each mostly starts up: ParaView, VTK; the 2-rank phase
+    runs one test at a time, so a second core would wait): their JSON lines, in order, or a failure with what
+    the first failing one printed (a crash included)."""
+    procs = [subprocess.Popen(cmd, stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True) for cmd in cmds]
+    found = []
+    try:
+        for cmd, p in zip(cmds, procs):
+            stdout, stderr = p.communicate(timeout=timeout)
+            assert p.returncode == 0, f"{cmd[:3]} exit {p.returncode}: {stderr[-1500:]}"
+            found.append(json.loads([s for s in stdout.splitlines() if s.startswith("{")][-1]))
+    finally:
+        for p in procs:
+            if p.poll() is None:
+                p.kill()
+                p.communicate()
+    return found
+
+
+def paraview_cmd(out: Path, which: str) -> list[str]:
+    return [PVPYTHON, str(HERE / "paraview_inspect.py"), str(out / "fields.xdmf"), which]
 
 
 PYVISTA_MESHIO = """
@@ -99,8 +115,8 @@ print(json.dumps(out))
 """
 
 
-def pyvista_meshio(out: Path) -> dict:
-    return run_reader([sys.executable, "-c", PYVISTA_MESHIO, str(out / "fields.xdmf")])
+def pyvista_meshio_cmd(out: Path) -> list[str]:
+    return [sys.executable, "-c", PYVISTA_MESHIO, str(out / "fields.xdmf")]
 
 
 def same_times(found: list[float], times: list[float], running: bool) -> bool:
@@ -117,17 +133,16 @@ def check_all_readers(out: Path, cell_fields=CELL_FIELDS, point_fields=POINT_FIE
     times = xdmf_times(out)
     assert len(times) >= 2
     found = {}
-    if PVPYTHON is not None:
-        for which in ("xdmf3", "legacy"):
-            pv = paraview(out, which)
-            assert same_times(pv["times"], times, running), which
-            for row in pv["rows"]:
-                assert row["class"] == "vtkUnstructuredGrid", (which, row["class"])  # one dataset, not blocks
-                assert (row["points"], row["cells"]) == (n_points, n_cells), which
-                assert point_fields <= set(row["point_arrays"]) and cell_fields <= set(row["cell_arrays"]), which
-                assert row["precision"] == "double"
-            found[which] = pv
-    pm = pyvista_meshio(out)
+    kinds = ("xdmf3", "legacy") if PVPYTHON is not None else ()
+    *pvs, pm = run_readers([*(paraview_cmd(out, which) for which in kinds), pyvista_meshio_cmd(out)])
+    for which, pv in zip(kinds, pvs):
+        assert same_times(pv["times"], times, running), which
+        for row in pv["rows"]:
+            assert row["class"] == "vtkUnstructuredGrid", (which, row["class"])  # one dataset, not blocks
+            assert (row["points"], row["cells"]) == (n_points, n_cells), which
+            assert point_fields <= set(row["point_arrays"]) and cell_fields <= set(row["cell_arrays"]), which
+            assert row["precision"] == "double"
+        found[which] = pv
     p, m = pm["pyvista"], pm["meshio"]
     assert same_times(p["times"], times, running) and (p["points"], p["cells"]) == (n_points, n_cells)
     assert point_fields | cell_fields <= set(p["point_arrays"]) | set(p["cell_arrays"])
@@ -259,18 +274,20 @@ def test_the_mesh_files_open_in_every_reader(tmp_path):
             "    tags = sorted(set(m.cell_data[name][0].ravel().tolist()))\n"
             "    out[f] = [len(m.points), sum(len(c.data) for c in m.cells), tags, g.n_points, g.n_cells]\n"
             "print(json.dumps(out))")
-    found = run_reader([sys.executable, "-c", code, str(tmp_path)])
+    pv_cmds, expected = [], []
+    if PVPYTHON is not None:  # ParaView's two readers on both files, beside meshio and pyvista: all at once
+        for f in ("mesh.xdmf", "mesh_facets.xdmf"):
+            for reader in ("Xdmf3ReaderS(FileName=[f])", "XDMFReader(FileNames=[f])"):
+                script = ("import json, sys\nfrom paraview import servermanager\nfrom paraview.simple import *\n"
+                          f"f = sys.argv[1]\nr = {reader}\nr.UpdatePipeline()\nd = servermanager.Fetch(r)\n"
+                          "print(json.dumps({'r': [d.GetClassName(), d.GetNumberOfPoints(), d.GetNumberOfCells()]}))")
+                pv_cmds.append([PVPYTHON, "-c", script, str(tmp_path / f)])
+                expected.append((f, reader))
+    found, *pvs = run_readers([[sys.executable, "-c", code, str(tmp_path)], *pv_cmds])
     n, c = info["nodes"], info["cells"]
     assert found["mesh"] == [n, c, [1], n, c]
     assert found["mesh_facets"][0] == n and found["mesh_facets"][2] == [11, 12]
     assert found["mesh_facets"][1] == found["mesh_facets"][4] > 0
-    if PVPYTHON is None:
-        return
-    for f, cells in (("mesh.xdmf", c), ("mesh_facets.xdmf", found["mesh_facets"][1])):
-        for reader in ("Xdmf3ReaderS(FileName=[f])", "XDMFReader(FileNames=[f])"):
-            script = ("import json, sys\nfrom paraview import servermanager\nfrom paraview.simple import *\n"
-                      f"f = sys.argv[1]\nr = {reader}\nr.UpdatePipeline()\nd = servermanager.Fetch(r)\n"
-                      "print(json.dumps([d.GetClassName(), d.GetNumberOfPoints(), d.GetNumberOfCells()]))")
-            r = subprocess.run([PVPYTHON, "-c", script, str(tmp_path / f)], capture_output=True, text=True)
-            assert r.returncode == 0, r.stderr[-1000:]
-            assert json.loads(r.stdout.strip().splitlines()[-1]) == ["vtkUnstructuredGrid", n, cells], (f, reader)
+    cells = {"mesh.xdmf": c, "mesh_facets.xdmf": found["mesh_facets"][1]}
+    for (f, reader), pv in zip(expected, pvs):
+        assert pv["r"] == ["vtkUnstructuredGrid", n, cells[f]], (f, reader)
