@@ -272,6 +272,19 @@ def write_cut_planes(st: dict, x: np.ndarray, tip: np.ndarray, planes: dict, pat
         meshio.write(tmp, mesh, file_format="vtu")
 
 
+def _one_path(polys: list):
+    """The cut's polygons (the cells' sections: they tile the outline without overlapping) as one compound
+    matplotlib Path: one filled shape, drawn without seams between its cells, and one path, not thousands, for
+    the legend's search of an empty corner (matplotlib 3.11 tests every path of a collection)."""
+    from matplotlib.path import Path as MplPath
+
+    if not polys:
+        return MplPath(np.zeros((0, 2)))
+    verts = np.concatenate([np.vstack([q, q[:1]]) for q in polys])
+    codes = np.concatenate([[MplPath.MOVETO] + [MplPath.LINETO] * (len(q) - 1) + [MplPath.CLOSEPOLY] for q in polys])
+    return MplPath(verts, codes.astype(MplPath.code_type))
+
+
 def trajectory_figure(out: Path, path: Path, experiment=None, outlines: int = 6) -> None:
     """The shot in the plane of incidence (the paper's Fig. 18): the target face and the target, the
     projectile's deformed outline (its cut by the plane z = 0) at a few output times, the nose and tail paths
@@ -282,7 +295,7 @@ def trajectory_figure(out: Path, path: Path, experiment=None, outlines: int = 6)
         outlines: how many output times to draw, evenly spread from the first to the last.
     """
     import matplotlib
-    from matplotlib.collections import PolyCollection
+    from matplotlib.patches import PathPatch
 
     from fepen.post.figures import new_figure, run_title, save_figure
 
@@ -300,8 +313,11 @@ def trajectory_figure(out: Path, path: Path, experiment=None, outlines: int = 6)
         x = st["X"] + st["displacement_m"]
         polys, _ = cut(x[st["cells"][live]], ez, 0.0, basis)
         colour = cmap(i / max(len(picks) - 1, 1))
-        ax.add_collection(PolyCollection([q * 1e3 for q in polys], facecolors=colour, edgecolors="none", alpha=0.8,
-                                         label=f"projectile at t = {st['t'] * 1e6:.0f} µs"))
+        outline = _one_path([q * 1e3 for q in polys])
+        ax.add_artist(PathPatch(outline, facecolor=colour, edgecolor="none", alpha=0.8,
+                                label=f"projectile at t = {st['t'] * 1e6:.0f} µs"))
+        if len(outline.vertices):  # the limits from the vertices at once (add_patch walks every segment)
+            ax.update_datalim(outline.vertices)
     ax.plot(h["nose_x_mm"], h["nose_y_mm"], "-", color="C3", lw=1, label="nose path")
     ax.plot(h["tail_x_mm"], h["tail_y_mm"], "--", color="C0", lw=1, label="tail path")
     name = getattr(experiment, "name", None)
