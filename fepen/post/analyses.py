@@ -164,8 +164,8 @@ class Gauges:
                 out.append(peak)
         return tuple(out)
 
-    def write(self, out: Path) -> None:
-        """strains.csv, hazard.csv and hazard.png (collective; rank 0 writes)."""
+    def write(self, out: Path, figures: bool = True) -> None:
+        """strains.csv, hazard.csv and hazard.png (collective; rank 0 writes); figures: False, no hazard.png."""
         haz = self.hazard()
         if self.comm.rank:
             return
@@ -174,7 +174,8 @@ class Gauges:
         save_table(out / "hazard.csv", np.column_stack(haz),
                    "axial_from_nose_mm,max_surface_peeq,peak_surface_von_mises_Pa,max_peeq,peak_von_mises_Pa",
                    "%.6g")
-        hazard_figure(out, haz, np.array(self.rows), self.columns)
+        if figures:
+            hazard_figure(out, haz, np.array(self.rows), self.columns)
 
 
 def save_table(path: Path, rows: np.ndarray, header: str, fmt: str) -> None:
@@ -324,7 +325,7 @@ def deformed_picture(solver, path: Path, title: str = "", peak_von_mises: np.nda
 PROFILE_BIN = 0.5e-3
 
 
-def nose_profile(solver, shape, tip_node, tail_node, tri: np.ndarray, out: Path) -> dict | None:
+def nose_profile(solver, shape, tip_node, tail_node, tri: np.ndarray, out: Path, figures: bool = True) -> dict | None:
     """nose_profile.csv and nose_profile.png: the nose's outer radius against the distance behind the
     original tip, before (the exact shape) and after (the largest radius of the final surface's nodes in
     each PROFILE_BIN, in the frame of the deformed axis: tail node to tip node), over the nose and one
@@ -335,6 +336,7 @@ def nose_profile(solver, shape, tip_node, tail_node, tri: np.ndarray, out: Path)
             outside: the calibre over one calibre before).
         tip_node, tail_node: node handles of the nose tip and the tail centre (ExplicitSolver.node_at).
         tri: the surface's facets (node indices, fepen.solver.surface.Surface.tri). out: the results directory.
+        figures: False: nose_profile.csv alone (run.figures).
 
     Returns:
         {"tip_recession_mm", "max_radius_mm"} on every rank.
@@ -371,7 +373,8 @@ def nose_profile(solver, shape, tip_node, tail_node, tri: np.ndarray, out: Path)
         files.write_text(Path(out) / "nose_profile.csv", "\n".join(lines) + "\n", MPI.COMM_SELF)
         result = {"tip_recession_mm": float(behind.min() * 1e3) if len(behind) else 0.0,
                   "max_radius_mm": float(radius[sel].max() * 1e3) if sel.any() else 0.0}
-        nose_profile_figure(out, (z0, r0), (z_after, r_after), result)
+        if figures:
+            nose_profile_figure(out, (z0, r0), (z_after, r_after), result)
     return comm.bcast(result, root=0)
 
 

@@ -126,7 +126,7 @@ def _strain_axial(X, x, cells) -> np.ndarray:
 
 
 # ---- figures -----------------------------------------------------------------------------------------
-def stress_maps(out: Path, path: Path, time: float | None = None) -> dict:
+def stress_maps(out: Path, path: Path, time: float | None = None, figures: bool = True) -> dict:
     """Equivalent stress and PEEQ of shell and charge in the x–y and y–z planes, one figure; and the same
     cuts as data, ``path`` with the suffix .vtu (write_cut_planes), for ParaView, pyvista and meshio.
 
@@ -136,6 +136,8 @@ def stress_maps(out: Path, path: Path, time: float | None = None) -> dict:
     yielded (PEEQ 0)". PEEQ panels share one colour scale, the body's largest PEEQ anywhere. The von
     Mises panels' titles give the largest value and its fraction of the body's initial yield stress (the
     shell steel's Johnson–Cook A, the charge's yield stress).
+
+    figures: False: the .vtu and the returned figures only, no picture (run.figures).
 
     Returns:
         {"t_s", plane: {body: {"von_mises_max_Pa", "peeq_max", and where each is, "..._at_mm": [behind the
@@ -157,8 +159,8 @@ def stress_maps(out: Path, path: Path, time: float | None = None) -> dict:
         peeq_top[bname] = float(st["peeq"][mine].max()) if "peeq" in st and mine.any() else 0.0
         second[bname] = "peeq" if peeq_top[bname] > 0.0 or "axial_stress_Pa" not in st else "axial_stress_Pa"
     ncol = 2 * len(bodies)
-    fig = new_figure((2.7 * ncol + 1, 9.5))
-    axes = fig.subplots(len(planes), ncol, squeeze=False)
+    fig = new_figure((2.7 * ncol + 1, 9.5)) if figures else None
+    axes = fig.subplots(len(planes), ncol, squeeze=False) if figures else None
     report = {}
     write_cut_planes(st, x, tip, planes, Path(path).with_suffix(".vtu"))
     for r, (pname, (normal, basis)) in enumerate(planes.items()):
@@ -176,7 +178,7 @@ def stress_maps(out: Path, path: Path, time: float | None = None) -> dict:
                     entry[key] = float(vals[k] / scale)
                     entry[key.replace("_Pa", "") + "_at_mm"] = [float(v) for v in mine_polys[k].mean(axis=0)]
         col = 0
-        for quantity in ("von_mises_Pa", "second"):
+        for quantity in ("von_mises_Pa", "second") if figures else ():
             for value, bname, yield_Pa in bodies:
                 name = second[bname] if quantity == "second" else quantity
                 _map_panel(fig, axes[r, col], polys, body[cells] == value, st[name][cells[body[cells] == value]],
@@ -184,6 +186,8 @@ def stress_maps(out: Path, path: Path, time: float | None = None) -> dict:
                 axes[r, col].set_ylabel((f"{pname}\n" if col == 0 else "") + "behind the nose tip, along the axis "
                                         "(mm)", fontsize=8 if col == 0 else 7)
                 col += 1
+    if not figures:
+        return {"t_s": st["t"], **report}
     when = f"t = {st['t'] * 1e6:.0f} µs after impact"
     fig.suptitle(run_title(out, f"stress maps at {when}") + "\n(cuts through the deformed projectile's axis; "
                  "grey: the other body)", fontsize=10)
@@ -468,17 +472,20 @@ def charge_histories(out: Path, path: Path) -> None:
     save_figure(fig, path)
 
 
-def charge_report(out: Path, sections: dict, time: float | None = None) -> dict:
+def charge_report(out: Path, sections: dict, time: float | None = None, figures: bool = True) -> dict:
     """Every picture of a charged run into its directory; returns what they show (for summary.json).
 
     Args:
         out: results directory (with fields.h5 when fields were written).
         sections: label -> reference axial position (m) of the charge's cross-sections.
         time: the time of the maps and cross-sections (the output time nearest it; None: the last).
+        figures: False: no charge_histories.png (run.figures; the pictures made from the fields carry the
+            report's numbers and are drawn regardless).
     """
     out = Path(out)
     report = {}
-    charge_histories(out, out / "charge_histories.png")
+    if figures:
+        charge_histories(out, out / "charge_histories.png")
     if (out / "fields.h5").exists():
         report["stress_maps"] = stress_maps(out, out / "stress_maps.png", time)
         report["cross_sections"] = cross_sections(out, out / "cross_sections.png", sections, time)

@@ -99,7 +99,7 @@ def run_in_directory(scene, out, comm=MPI.COMM_WORLD, mode: str = "new", progres
         try:
             summary = run_scene(scene, out, comm, progress=progress, resume=resume, sh=sh)
         except BaseException:
-            if comm.rank == 0 and (out / "history.csv").is_file():  # the history a stop left, drawn
+            if comm.rank == 0 and sh.outputs.figures and (out / "history.csv").is_file():  # the history a stop left
                 try:
                     figures.history_figure(out, sh.experiment, MPI.COMM_SELF)
                 except Exception as err:  # noqa: BLE001 - the stop's own error is the one to report

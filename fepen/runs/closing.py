@@ -26,7 +26,8 @@ class Closing:
 
     def write(self, run) -> None:
         """Write the closing analyses of ``run`` (a fepen.runs.deformable.DeformableRun; collective)."""
-        run.gauges.write(run.out)
+        figures = run.shot.outputs.figures
+        run.gauges.write(run.out, figures)
         self.first_yield = run.gauges.first_yield()
         if run.sections is not None:
             run.sections.write(run.out)
@@ -34,26 +35,30 @@ class Closing:
         if run.pm.charge:
             report = None
             if run.comm.rank == 0:
-                report = slices.charge_report(run.out, run.sections.sections, self.peaks["charge_acc"]["t_s"])
+                report = slices.charge_report(run.out, run.sections.sections, self.peaks["charge_acc"]["t_s"],
+                                              figures=figures)
             self.charge = run.comm.bcast(report, root=0)
         if getattr(run, "safety", None) is not None:
             self.safety = run.safety.summary(self.peaks.get("charge_acc"))
         s = run.solver
         if run.fields is not None:  # the cut planes at peak load and at the end, and the shot (Figs. 18, 20-21)
             name, out = run.shot.experiment, run.out
-            shared(run.comm, out, [
-                (lambda: slices.stress_maps(out, out / "stress_maps_peak.png", self.peaks["decel"]["t_s"]),
-                 ("stress_maps_peak.png", "stress_maps_peak.vtu")),
-                (lambda: slices.stress_maps(out, out / "stress_maps_end.png"),
-                 ("stress_maps_end.png", "stress_maps_end.vtu")),
-                (lambda: slices.trajectory_figure(out, out / "trajectory.png", table1_shot(name) if name else None),
-                 ("trajectory.png",))])
-        else:
+            png = (lambda stem: (f"{stem}.png",)) if figures else (lambda stem: ())
+            peak = self.peaks["decel"]["t_s"]
+            jobs = [(lambda: slices.stress_maps(out, out / "stress_maps_peak.png", peak, figures),
+                     (*png("stress_maps_peak"), "stress_maps_peak.vtu")),
+                    (lambda: slices.stress_maps(out, out / "stress_maps_end.png", None, figures),
+                     (*png("stress_maps_end"), "stress_maps_end.vtu"))]
+            if figures:
+                test = table1_shot(name) if name else None
+                jobs.append((lambda: slices.trajectory_figure(out, out / "trajectory.png", test), ("trajectory.png",)))
+            shared(run.comm, out, jobs)
+        elif figures:
             analyses.deformed_picture(s, run.out / "deformed.png", f"t = {s.t * 1e6:.0f} µs, max PEEQ "
                                       f"{diagnostics.max_peeq(s):.3g}", run.gauges.peak_von_mises)
         m = run.model
         if m.surface is not None:
-            self.profile = analyses.nose_profile(s, run.pm.shape, m.tip, m.tail, m.surface.tri, run.out)
+            self.profile = analyses.nose_profile(s, run.pm.shape, m.tip, m.tail, m.surface.tri, run.out, figures)
 
     def summary(self) -> dict:
         """The summary keys of the closing analyses (None where they were not written)."""

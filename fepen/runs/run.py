@@ -302,8 +302,9 @@ class Run:
         if self.out is not None:  # the figure first: summary.json is the last file of a run that ended well
             from fepen.post import figures
 
-            files.agree(self.comm, "history.png",
-                        lambda: figures.history_figure(self.out, self.shot.experiment, MPI.COMM_SELF))
+            if self.shot.outputs.figures:
+                files.agree(self.comm, "history.png",
+                            lambda: figures.history_figure(self.out, self.shot.experiment, MPI.COMM_SELF))
             results.write_summary(self.out, summary, self.comm)
         return summary
 

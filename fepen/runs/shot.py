@@ -58,6 +58,7 @@ class OutputSettings:
     field_names: tuple[str, ...]
     checkpoint_interval: float
     acceleration_filter_hz: float
+    figures: bool = True  #: run.figures: the PNG figures drawn
 
 
 @dataclass(frozen=True)
@@ -230,7 +231,7 @@ def _outputs(scene) -> OutputSettings:
             names.append("temperature_K")
     names.append("cell_tag")  # 1 shell, 2 charge, 0 eroded: for ParaView's Threshold
     return OutputSettings(min(r.output_interval / 10.0, 1e-6), r.output_interval, bool(r.fields), tuple(names),
-                          r.checkpoint_interval, r.acceleration_filter_hz)
+                          r.checkpoint_interval, r.acceleration_filter_hz, bool(r.figures))
 
 
 def resolve(scene, toml: bool = True) -> Shot:

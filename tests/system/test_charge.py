@@ -15,7 +15,8 @@ from fepen.runs.deformable import DeformableRun
 pytestmark = pytest.mark.xdist_group("test_charge")
 
 TIED = ["effects.charge=true", "charge.contact=tied", "mesh.size=0.004", "impact.velocity=800",
-        "impact.obliquity_deg=0", "impact.attack_deg=0", "run.fields=false", "run.checkpoint_interval=0"]
+        "impact.obliquity_deg=0", "impact.attack_deg=0", "run.fields=false", "run.checkpoint_interval=0",
+        "run.figures=false"]
 
 
 def charged_run(comm, end="1.5e-4"):
@@ -68,7 +69,7 @@ def test_tied_charge_is_the_same_on_any_rank_count():
 #: the oblique C3 shot (both momentum components move), a row at every step: the history interval is
 #: run.output_interval / 10 (fepen.runs.shot.outputs), far below the step
 EVERY_STEP = ["effects.charge=true", "mesh.size=0.005", "run.fields=false", "run.checkpoint_interval=0",
-              "run.output_interval=1e-10", "run.end_time=6e-5"]
+              "run.output_interval=1e-10", "run.end_time=6e-5", "run.figures=false"]
 
 
 @pytest.fixture(scope="module", params=["tied", "frictional"])

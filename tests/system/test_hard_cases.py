@@ -19,7 +19,7 @@ from fepen.errors import SimulationError
 from fepen.runs.deformable import DeformableRun
 
 CASES = ROOT / "demos" / "hard_cases"
-COARSE = ["mesh.size=0.006", "run.fields=false", "run.checkpoint_interval=0"]
+COARSE = ["mesh.size=0.006", "run.fields=false", "run.checkpoint_interval=0", "run.figures=false"]
 
 #: case -> (extra settings for the suite, expected outcome)
 SUITE = {

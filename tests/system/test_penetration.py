@@ -127,3 +127,27 @@ def test_switched_off_physics_writes_no_field(tmp_path):
         with h5py.File(tmp_path / fid / "fields.h5", "r") as h5:
             names = set(h5["Function"].keys())
         assert not (absent & names) and present <= names and "von_mises_Pa" in names
+
+
+def test_without_figures_a_run_writes_every_number_and_no_picture(tmp_path):
+    """run.figures = false: no PNG anywhere (nor in the manifest), and every other file and figure the same:
+    history.csv to the byte, the same tables, the stress maps' .vtu, and the same summary numbers."""
+    sets = ["mesh.size=0.006", "run.end_time=1e-4", "run.output_interval=5e-5", "run.checkpoint_interval=0"]
+    runs = {}
+    for figures in ("true", "false"):
+        out = tmp_path / figures
+        import fepen
+
+        result = fepen.run(fepen.Scene(None, sets=[*sets, f"run.figures={figures}"]), out=out, comm=MPI.COMM_SELF)
+        runs[figures] = out, result.summary
+    (on, s_on), (off, s_off) = runs["true"], runs["false"]
+    pngs = {p.name for p in on.glob("*.png")}
+    assert {"history.png", "hazard.png", "nose_profile.png", "stress_maps_peak.png", "trajectory.png"} <= pngs
+    assert not list(off.glob("*.png"))
+    manifest = json.loads((off / "run.json").read_text())["files"]
+    assert manifest and not [f for f in manifest if str(f).endswith(".png")], manifest
+    assert {p.name for p in on.iterdir()} - pngs == {p.name for p in off.iterdir()}
+    for name in ("history.csv", "hazard.csv", "strains.csv", "nose_profile.csv", "accelerations.csv"):
+        assert (on / name).read_bytes() == (off / name).read_bytes(), name
+    for key in ("Hx_mm", "Hy_mm", "final_axis_angle_deg", "energy_error", "nose_profile", "peak_accelerations"):
+        assert s_on[key] == s_off[key], key

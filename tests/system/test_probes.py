@@ -23,7 +23,7 @@ PROBES = [{"name": "tail", "point": [0.0, LENGTH, 0.0]},
           {"name": "side", "point": [0.0105, 0.1, 0.003]},
           {"name": "gauge", "point": [0.0, LENGTH, 0.0], "kind": "accelerometer"}]
 SETS = ["mesh.size=0.005", "run.end_time=3.05e-5", "run.output_interval=1e-5", "run.checkpoint_interval=0",
-        "run.fields=false"]
+        "run.fields=false", "run.figures=false"]
 
 
 def deformable(comm, probes=PROBES, sets=SETS):

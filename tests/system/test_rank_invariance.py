@@ -14,7 +14,7 @@ from fepen import scene
 from fepen.io import results
 from fepen.runs.deformable import DeformableRun
 
-QUIET = ["run.fields=false", "run.checkpoint_interval=0"]
+QUIET = ["run.fields=false", "run.checkpoint_interval=0", "run.figures=false"]
 #: name -> (scene file or None for the default shot, settings)
 CASES = {
     "C3_plastic_4mm": (ROOT / "scenes" / "default.toml", ["mesh.size=0.004"]),

@@ -117,7 +117,8 @@ material = "6061-T6511"
 
 def layered_history(comm):
     sc = scene.Scene(LAYERED_METAL, ["effects.fidelity=plastic", "impact.velocity=800", "impact.obliquity_deg=5",
-                                     "mesh.size=0.004", "run.fields=false", "run.end_time=6e-5"])
+                                     "mesh.size=0.004", "run.fields=false", "run.end_time=6e-5",
+                                     "run.figures=false"])
     out = comm.bcast(tempfile.mkdtemp(prefix="fepen-") if comm.rank == 0 else None, root=0)
     sim = DeformableRun(sc, out, comm)
     summary = sim.run()
