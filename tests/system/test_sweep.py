@@ -90,6 +90,7 @@ GRID = """scene = "{root}/scenes/default.toml"
 mesh.size = 0.004
 run.end_time = 4e-5
 run.fields = false
+run.figures = false
 run.checkpoint_interval = 0.0
 [grid]
 "impact.shot" = ["C1", "C7"]
