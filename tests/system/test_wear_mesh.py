@@ -50,7 +50,8 @@ def test_a_soft_nose_that_mushrooms_keeps_running_with_erosion(tmp_path):
     """The soft projectile whose flattening cells stop the run without erosion runs to its end time with
     erosion on: cells are removed, mass and energy stay balanced."""
     summary, rows, sim = run_case("soft_breaks", [*WEAR_EROSION, "projectile.failure_strain=100",
-                                                  "run.end_time=3e-4", "mesh.size=0.005"], out=tmp_path)
+                                                  "run.end_time=3e-4", "mesh.size=0.005", "run.figures=true"],
+                                  out=tmp_path)
     s = sim.solver
     assert summary["outcome"] == "ended" and summary["end_time_s"] >= 3e-4 * (1 - 1e-9)
     assert summary["eroded_cells"] > 0
