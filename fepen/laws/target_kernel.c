@@ -196,12 +196,8 @@ int32_t point_forces(int32_t k, const double *x, const double *v, const double *
 void tunnel_sectors(int32_t k, const double *r, const double *t, int32_t S, int32_t *q, int32_t *q_exact) {
     for (int32_t i = 0; i < k; ++i) {
         const double *ti = t + 3 * i, *ri = r + 3 * i;
-        double e1[3] = {-ti[2] * ti[0], -ti[2] * ti[1], 1.0 - ti[2] * ti[2]};
-        double n1sq = tdot(e1, e1);
-        if (n1sq < 1.0000001e-12 && sqrt(n1sq) < 1e-6) {
-            e1[0] = 1.0 - ti[0] * ti[0]; e1[1] = -ti[0] * ti[1]; e1[2] = -ti[0] * ti[2];
-            n1sq = tdot(e1, e1);
-        }
+        double e1[3];
+        const double n1sq = tunnel_e1(ti, e1);
         double u1[3] = {e1[0], e1[1], e1[2]};
         q[i] = tunnel_sector(ri, ti, e1, n1sq, S);
         const double n1 = sqrt(n1sq);

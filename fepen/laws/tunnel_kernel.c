@@ -142,6 +142,18 @@ static inline int32_t tunnel_sector_exact(double y, double x, int32_t S) {
     return q < 0 ? 0 : (q >= S ? S - 1 : q);
 }
 
+/* e1 of the sector's angle about the unit axis t: the world z axis's part across t (x when t is along z), not
+ * yet of unit length; returns e1 . e1 */
+static inline double tunnel_e1(const double *t, double *e1) {
+    e1[0] = -t[2] * t[0]; e1[1] = -t[2] * t[1]; e1[2] = 1.0 - t[2] * t[2];
+    double n1sq = tdot(e1, e1);
+    if (n1sq < 1.0000001e-12 && sqrt(n1sq) < 1e-6) {
+        e1[0] = 1.0 - t[0] * t[0]; e1[1] = -t[0] * t[1]; e1[2] = -t[0] * t[2];
+        n1sq = tdot(e1, e1);
+    }
+    return n1sq;
+}
+
 /* r's sector about the unit axis t from e1 (not yet of unit length: e1 . e1 = n1sq). The polynomial takes r's
  * components along e1 and t x e1 as they are (a common positive scale leaves the angle as it is); the exact path
  * makes e1 a unit vector first, as it always did. */
@@ -199,13 +211,8 @@ static int tunnel_locate(const double *T, TunnelEnd *e, const double *p, double 
     double rr = sqrt(tdot(r, r));
     if (!(rr > 1e-12)) return 0;
     for (int j = 0; j < 3; ++j) er[j] = r[j] / rr;
-    /* the sector: the angle of r about t from e1, the world z axis's part across t (x when t is along z) */
-    double e1[3] = {-at.t[2] * at.t[0], -at.t[2] * at.t[1], 1.0 - at.t[2] * at.t[2]};
-    double n1sq = tdot(e1, e1);
-    if (n1sq < 1.0000001e-12 && sqrt(n1sq) < 1e-6) {
-        e1[0] = 1.0 - at.t[0] * at.t[0]; e1[1] = -at.t[0] * at.t[1]; e1[2] = -at.t[0] * at.t[2];
-        n1sq = tdot(e1, e1);
-    }
+    double e1[3]; /* the sector: the angle of r about t from e1 */
+    const double n1sq = tunnel_e1(at.t, e1);
     const int32_t q = tunnel_sector(r, at.t, e1, n1sq, S);
     double a_lo = tunnel_station((double *)T, at.ia)[T_STATION + q];
     double a_hi = at.ib < m ? tunnel_station((double *)T, at.ib)[T_STATION + q] : T[T_A0];

@@ -43,12 +43,9 @@ class Closing:
         s = run.solver
         if run.fields is not None:  # the cut planes at peak load and at the end, and the shot (Figs. 18, 20-21)
             name, out = run.shot.experiment, run.out
-            png = (lambda stem: (f"{stem}.png",)) if figures else (lambda stem: ())
-            peak = self.peaks["decel"]["t_s"]
-            jobs = [(lambda: slices.stress_maps(out, out / "stress_maps_peak.png", peak, figures),
-                     (*png("stress_maps_peak"), "stress_maps_peak.vtu")),
-                    (lambda: slices.stress_maps(out, out / "stress_maps_end.png", None, figures),
-                     (*png("stress_maps_end"), "stress_maps_end.vtu"))]
+            jobs = [(lambda stem=stem, t=t: slices.stress_maps(out, out / f"{stem}.png", t, figures),
+                     ((f"{stem}.png",) if figures else ()) + (f"{stem}.vtu",))
+                    for stem, t in (("stress_maps_peak", self.peaks["decel"]["t_s"]), ("stress_maps_end", None))]
             if figures:
                 test = table1_shot(name) if name else None
                 jobs.append((lambda: slices.trajectory_figure(out, out / "trajectory.png", test), ("trajectory.png",)))
