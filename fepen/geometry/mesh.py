@@ -1,6 +1,6 @@
-"""The projectile mesh in dolfinx: built on rank 0 with gmsh (cached), distributed in deterministic bands
-along the projectile, its cavity sized to a mass on the mesh, its wall split for a sliding charge
-(docs/theory.md §2, §11, §13).
+"""The projectile mesh in dolfinx: built on rank 0 with gmsh (cached), distributed in deterministic parts
+(bands along the projectile, halved across the plane of the shot), its cavity sized to a mass on the mesh, its
+wall split for a sliding charge (docs/theory.md §2, §11, §13).
 """
 
 from __future__ import annotations
@@ -537,8 +537,9 @@ def _model_to_mesh(comm, split: bool):
         cell_values = np.zeros(0, dtype=np.int32)
         facets = np.zeros((0, 3), dtype=np.int64)
         facet_values = np.zeros(0, dtype=np.int32)
+    parts = mirror_parts(x, cells, comm.size) if comm.rank == 0 else None
     cells = cells[:, dx.cell_perm("tetrahedron", 4)]
-    partitioner = functools.partial(band_partitioner, extra_links=links)
+    partitioner = functools.partial(band_partitioner, extra_links=links, parts=parts)
     mesh = dx.tet_mesh(comm, cells, x, partitioner)
     tdim = 3
     ct = dx.entity_tags(mesh, tdim, cells, cell_values)
@@ -550,21 +551,55 @@ def _model_to_mesh(comm, split: bool):
     return mesh, ct, ft
 
 
-def band_partitioner(comm, nparts: int, graph, ghosting: bool, extra_links=None):
-    """A deterministic partition of the cells' dual graph into nparts bands along the projectile.
+def mirror_parts(x: np.ndarray, cells: np.ndarray, nparts: int) -> np.ndarray:
+    """The part of each cell (rank 0, before distribution): bands across the axis (y), each band cut in two
+    halves of equal cell count across the plane of the shot (z = 0: the impact's plane, the body turns about z)
+    when nparts is even.
+
+    The target's load and the plastic flow gather at the nose, and a band partition left both to the rank
+    holding the nose, the other ranks waiting for it at every step (docs/theory.md §3.4). Two halves mirrored
+    across the plane of the shot carry mirrored loads: for a shot in that plane the two ranks of a band do the
+    same work. The numbers do not depend on the partition (the sums are exact), only the time does.
+
+    Args:
+        x: (n_nodes, 3) node coordinates; cells: (n_cells, 4) node indices; nparts: the number of ranks.
+
+    Returns:
+        (n_cells,) int32 parts: band b's halves are parts 2b and 2b + 1 (b alone when nparts is odd).
+    """
+    n = len(cells)
+    halves = 2 if nparts % 2 == 0 else 1
+    bands = nparts // halves
+    c = x[cells].mean(axis=1)
+    part = np.zeros(n, dtype=np.int32)
+    order = np.argsort(c[:, 1], kind="stable")  # along the axis
+    band = np.empty(n, dtype=np.int64)
+    band[order] = np.arange(n, dtype=np.int64) * bands // max(n, 1)
+    for b in range(bands):
+        mine = np.flatnonzero(band == b)
+        side = np.empty(len(mine), dtype=np.int64)
+        side[np.argsort(c[mine, 2], kind="stable")] = np.arange(len(mine), dtype=np.int64) * halves // max(len(mine), 1)
+        part[mine] = (b * halves + side).astype(np.int32)
+    return part
+
+
+def band_partitioner(comm, nparts: int, graph, ghosting: bool, extra_links=None, parts=None):
+    """A deterministic partition of the cells' dual graph into nparts bands along the projectile, or the
+    parts given (mirror_parts).
 
     SCOTCH, dolfinx's default, gives a different partition from run to run on the same input, so that
     two runs on the same number of ranks differ in the last bits (and a checkpoint could not be matched
-    cell for cell). Here: cells in breadth-first order from a pseudo-peripheral cell (the end of a
-    breadth-first sweep from cell 0: the nose tip or the tail of a slender body), cut into nparts runs of
+    cell for cell). Here, without parts: cells in breadth-first order from a pseudo-peripheral cell (the end of
+    a breadth-first sweep from cell 0: the nose tip or the tail of a slender body), cut into nparts runs of
     equal length; each rank gets a band of the projectile, whose interfaces are cross-sections. With
     ghosting, a cell is also sent to the ranks owning its facet neighbours. A split wall (split_wall) adds
-    its links to the graph: the bands cross both bodies, and a cell is also ghosted where its links are.
+    its links to the graph: the parts cross both bodies, and a cell is also ghosted where its links are.
 
     Args:
         comm: communicator; graph: this rank's rows of the dual graph (global cell indices);
         nparts: number of parts; ghosting: return ghost destinations too.
         extra_links: rank 0, a split wall's cell links (scipy sparse, n x n), or None.
+        parts: rank 0, the part of every cell in the global order (mirror_parts), or None: the bands.
 
     Returns:
         AdjacencyList_int32: per local row, the owner rank then the ghost ranks.
@@ -590,12 +625,15 @@ def band_partitioner(comm, nparts: int, graph, ghosting: bool, extra_links=None)
                 g = (g + extra_links).tocsr()
                 g.sort_indices()
                 indptr, indices = g.indptr.astype(np.int64), g.indices.astype(np.int64)
-            start = int(breadth_first_order(g, 0, directed=False, return_predecessors=False)[-1])
-            order = breadth_first_order(g, start, directed=False, return_predecessors=False)
-            if len(order) < n:  # a disconnected mesh: the rest in index order
-                rest = np.setdiff1d(np.arange(n), order)
-                order = np.concatenate([order, rest])
-            part[order] = (np.arange(n, dtype=np.int64) * nparts // n).astype(np.int32)
+            if parts is not None and len(parts) == n:
+                part[:] = parts
+            else:
+                start = int(breadth_first_order(g, 0, directed=False, return_predecessors=False)[-1])
+                order = breadth_first_order(g, start, directed=False, return_predecessors=False)
+                if len(order) < n:  # a disconnected mesh: the rest in index order
+                    rest = np.setdiff1d(np.arange(n), order)
+                    order = np.concatenate([order, rest])
+                part[order] = (np.arange(n, dtype=np.int64) * nparts // n).astype(np.int32)
         dest = []
         lo = 0
         for size in sizes:

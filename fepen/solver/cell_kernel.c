@@ -3,14 +3,14 @@
 
    Passes of one step (fepen/solver/explicit.py calls them in this order):
      update_begin     nodes: v += (dt_prev + dt)/2 a, du = dt v, u += du, x = X + u; the work of the old forces
-     kinematics_pass  cells: current volume cvol (the nodal volumes are summed from it by the solver), the
+     kinematics_pass  cells: current volume cvol and the nodal volumes per material summed from it, the
                       smallest J (inverted or NaN cells), and every STEP_EVERY steps h/c per cell
-     scatter_volumes  cells -> nodes: nodal volume per material (terms on a grid: exact sums, any order)
      nodal_pressure   nodes: p_a = K ln(J_a) / J_a per material
      cell_pass        cells, ONE fused pass: elastic trial stress (Hughes-Winget), the radial return of the
                       cells over their flow stress (inline, in the same block), and the cell's internal force
-                      on its four nodes, Fc
-     scatter_forces   cells -> nodes: f_int = sum of Fc (terms on a grid: exact sums, any order)
+                      on its four nodes summed into f_int block by block (terms on a grid: exact sums, any
+                      order; the kinematics pass sums the nodal volumes so too)
+     scatter_*        cells -> nodes apart (the tests' and the numba path's)
      update_end       nodes: a = (f_ext - f_int) / m, the work of the new forces
 
    The arithmetic is that of the numba reference, fepen.solver.kernels.stress_update (the return: the one
@@ -191,17 +191,23 @@ kinematics_block(int32_t e0, int32_t nb, const double *restrict x, const int32_t
 }
 
 /* Current volume of every cell into cvol (0 for eroded cells); with_step: each live cell's shortest altitude
-   over its dilatational speed into cell_dt (left as it was where the volume or the faces vanish).
+   over its dilatational speed into cell_dt (left as it was where the volume or the faces vanish). vol (n_rows,
+   nmat), unless NULL: the nodal volumes per material, zeroed and summed as scatter_volumes sums them (quantum
+   vq), block by block while the block's cells are in cache.
    out: [smallest J = V / V0 over live cells (a NaN wins), its cell, smallest h/c (inf if not with_step), its
    cell] (cells as doubles, -1 for none): the first of equal minima, the first NaN. */
 void kinematics_pass(int32_t n, const double *restrict x, const int32_t *restrict dofs,
                      const int64_t *restrict mat, const double *restrict orient, const double *restrict vol0,
                      const double *restrict speed, int32_t with_step, double *restrict cvol,
-                     double *restrict cell_dt, double *restrict out)
+                     double *restrict cell_dt, double *restrict out, double vq, int32_t nmat, int32_t n_rows,
+                     double *restrict vol)
 {
     double Jb[BLOCK], tb[BLOCK];
     double jmin = INFINITY, dtmin = INFINITY;
     int32_t worst = -1, dtcell = -1;
+    double ivq = vol ? 1.0 / vq : 0.0;
+    if (vol)
+        for (int32_t i = 0; i < n_rows * nmat; i++) vol[i] = 0.0;
     for (int32_t e0 = 0; e0 < n; e0 += BLOCK) {
         int32_t nb = n - e0 < BLOCK ? n - e0 : BLOCK;
         if (with_step)
@@ -219,6 +225,13 @@ void kinematics_pass(int32_t n, const double *restrict x, const int32_t *restric
                 dtcell = e0 + k;
             }
         }
+        if (vol)  /* the block's nodal volumes while its cells are in cache: scatter_volumes' terms */
+            for (int32_t e = e0; e < e0 + nb; e++) {
+                int64_t m = mat[e];
+                if (m < 0) continue;
+                double c = nearbyint(0.25 * cvol[e] * ivq) * vq;
+                for (int32_t j = 0; j < 4; j++) vol[dofs[4 * e + j] * nmat + m] += c;
+            }
     }
     out[0] = jmin;
     out[1] = worst;
@@ -232,19 +245,25 @@ void kinematics_pass(int32_t n, const double *restrict x, const int32_t *restric
         to the flow stress, eps_p, temp, sy0 updated, plastic work, heat and the largest increment summed
         into totals (kernels.stress_update's bookkeeping);
      3. (vectorised) s stored, the cell's four nodal forces into Fc.
-   s (6, n) in/out; Fc (n, 4, 3) out (zero for eroded cells); totals (4,) out: plastic work, heat, 0, the
+     4. f (n_rows, 3), unless NULL: zeroed, then each cell's four forces summed at its nodes as scatter_forces
+        sums them (quantum fq), while the block is in cache: Fc need not be stored nor read back.
+   s (6, n) in/out; Fc (n, 4, 3) out (zero for eroded cells), unless NULL; totals (4,) out: plastic work, heat, 0, the
    largest plastic increment. params (nmat, N_PARAMS); G_m shear modulus per material; nodal_p
    (n_nodes, nmat). Returns the number of cells that yielded. */
 int32_t cell_pass(int32_t n, const double *restrict x, const double *restrict v, double dt,
                   const int32_t *restrict dofs, const int64_t *restrict mat, const double *restrict orient,
                   int32_t nmat, const double *restrict params, const double *restrict G_m,
                   const double *restrict nodal_p, double *restrict s, double *restrict eps_p,
-                  double *restrict temp, double *restrict sy0, double *restrict Fc, double *restrict totals)
+                  double *restrict temp, double *restrict sy0, double *restrict Fc, double fq, int32_t n_rows,
+                  double *restrict f, double *restrict totals)
 {
     double sb[6][BLOCK], kb[9][BLOCK], pb[BLOCK], qb[BLOCK], vb[BLOCK], wb[BLOCK], Fb[12][BLOCK];
     int32_t yb[BLOCK];
     int32_t n_yield = 0;
     double plastic = 0.0, heat = 0.0, dmax = 0.0;
+    double ifq = f ? 1.0 / fq : 0.0;
+    if (f)
+        for (int32_t i = 0; i < 3 * n_rows; i++) f[i] = 0.0;
     for (int32_t e0 = 0; e0 < n; e0 += BLOCK) {
         int32_t nb = n - e0 < BLOCK ? n - e0 : BLOCK;
         /* 1. trial state */
@@ -383,9 +402,21 @@ int32_t cell_pass(int32_t n, const double *restrict x, const double *restrict v,
             Fb[6][k] = live ? f20 : 0.0; Fb[7][k] = live ? f21 : 0.0; Fb[8][k] = live ? f22 : 0.0;
             Fb[9][k] = live ? f30 : 0.0; Fb[10][k] = live ? f31 : 0.0; Fb[11][k] = live ? f32 : 0.0;
         }
-        for (int32_t k = 0; k < nb; k++)
-            for (int32_t i = 0; i < 12; i++)
-                Fc[12 * (e0 + k) + i] = Fb[i][k];
+        if (Fc)
+            for (int32_t k = 0; k < nb; k++)
+                for (int32_t i = 0; i < 12; i++)
+                    Fc[12 * (e0 + k) + i] = Fb[i][k];
+        if (f) {  /* 4. the block's forces summed at the nodes as scatter_forces sums them (quantum fq) */
+            for (int32_t k = 0; k < nb; k++) {
+                const int32_t *d = dofs + 4 * (e0 + k);
+                for (int32_t j = 0; j < 4; j++) {
+                    double *fn = f + 3 * d[j];
+                    fn[0] += nearbyint(Fb[3 * j][k] * ifq) * fq;
+                    fn[1] += nearbyint(Fb[3 * j + 1][k] * ifq) * fq;
+                    fn[2] += nearbyint(Fb[3 * j + 2][k] * ifq) * fq;
+                }
+            }
+        }
     }
     totals[0] = plastic;
     totals[1] = heat;

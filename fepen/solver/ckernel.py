@@ -40,46 +40,59 @@ class CellPasses:
         nodal_p: (n_nodes, n_materials) nodal mean stress.
         sT: (6, n_cells) deviatoric stress, component-major; eps_p, temp, sy0: (n_cells,) cell state.
         cvol: (n_cells,) output of the current cell volumes; cell_dt: (n_cells,) output of h/c per cell.
-        Fc: (n_cells, 4, 3) output of each cell's internal force on its four nodes.
+        Fc: (n_cells, 4, 3) output of each cell's internal force on its four nodes, or None (not stored).
         totals: (4,) output: plastic work, heat, 0, largest plastic increment of the last cell pass.
+        nvol: (n_nodes, n_materials) output of the nodal volumes per material, summed by the kinematics pass
+            (before ghosts are summed), or None. fint: (n_nodes, 3) output of the internal forces, summed by the
+            cell pass (before ghosts are summed), or None. Both sums are those of NodePasses.scatter_volumes and
+            scatter_forces, on the grids given at each call, made while each block of cells is in cache.
 
     All float arrays float64 and C-contiguous.
     """
 
     def __init__(self, x, v, dofs, mat, orient, vol0, speed, params, G_m, nodal_p, sT, eps_p, temp, sy0,
-                 cvol, cell_dt, Fc, totals):
+                 cvol, cell_dt, Fc, totals, nvol=None, fint=None):
         lib = library()
         if lib is None:
             raise RuntimeError(why_not())
         n = len(mat)
         self.n = n
         self.dofs32 = np.ascontiguousarray(dofs, dtype=np.int32)
-        assert sT.shape == (6, n) and Fc.shape == (n, 4, 3) and x.shape == v.shape
+        assert sT.shape == (6, n) and x.shape == v.shape and (Fc is None or Fc.shape == (n, 4, 3))
+        assert nvol is None or (nvol.ndim == 2 and len(nvol) == len(x)) and (fint is None or fint.shape == x.shape)
         self._out = np.zeros(4)
         self._keep = (x, v, mat, orient, vol0, speed, params, G_m, nodal_p, sT, eps_p, temp, sy0, cvol,
-                      cell_dt, Fc, totals)
+                      cell_dt, Fc, totals, nvol, fint)
         a = _addr
+
+        def a_or_null(arr):
+            return None if arr is None else a(arr)
+
         self._kin = (n, a(x), a(self.dofs32, np.int32), a(mat, np.int64), a(orient), a(vol0), a(speed))
         self._kin_out = (a(cvol), a(cell_dt), a(self._out))
+        self._kin_sum = (0 if nvol is None else nvol.shape[1], len(x), a_or_null(nvol))
         self._cell_x = (n, a(x), a(v))
         self._cell_rest = (a(self.dofs32, np.int32), a(mat, np.int64), a(orient), params.shape[0], a(params), a(G_m),
-                           a(nodal_p), a(sT), a(eps_p), a(temp), a(sy0), a(Fc), a(totals))
+                           a(nodal_p), a(sT), a(eps_p), a(temp), a(sy0), a_or_null(Fc))
+        self._cell_sum = (len(x), a_or_null(fint), a(totals))
         self._lib = lib
 
-    def kinematics(self, with_step: bool) -> tuple[float, int, float, int]:
-        """Current volumes into cvol (and, with_step, h/c per cell into cell_dt).
+    def kinematics(self, with_step: bool, quantum: float = 1.0) -> tuple[float, int, float, int]:
+        """Current volumes into cvol (and, with_step, h/c per cell into cell_dt); the nodal volumes into nvol on
+        the grid ``quantum`` (a power of two), if nvol was given.
 
         Returns:
             (smallest J over live cells (NaN if any is NaN), its cell, smallest h/c (inf unless with_step),
             its cell); cells −1 for none.
         """
-        self._lib.kinematics_pass(*self._kin, int(with_step), *self._kin_out)
+        self._lib.kinematics_pass(*self._kin, int(with_step), *self._kin_out, quantum, *self._kin_sum)
         o = self._out
         return float(o[0]), int(o[1]), float(o[2]), int(o[3])
 
-    def cells(self, dt: float) -> int:
-        """The fused pass over a step dt: stress, return, plastic work, Fc. Returns how many cells yielded."""
-        return self._lib.cell_pass(*self._cell_x, dt, *self._cell_rest)
+    def cells(self, dt: float, quantum: float = 1.0) -> int:
+        """The fused pass over a step dt: stress, return, plastic work, Fc (if given), the internal forces into
+        fint on the grid ``quantum`` (a power of two; if fint was given). Returns how many cells yielded."""
+        return self._lib.cell_pass(*self._cell_x, dt, *self._cell_rest, quantum, *self._cell_sum)
 
 
 class NodePasses:

@@ -252,27 +252,29 @@ class ExplicitSolver:
         return h_c
 
     def _forces_c(self, dt: float, x_ready: bool) -> float:
-        """_forces through the C passes (fepen/solver/cell_kernel.c): the kinematics pass (cvol, J, h/c),
-        the nodal volumes and pressures, the fused stress-and-force pass (Fc), the nodal forces."""
+        """_forces through the C passes (fepen/solver/cell_kernel.c): the kinematics pass (cvol, J, h/c and
+        the nodal volumes), the nodal pressures, the fused stress-and-force pass (the nodal forces summed in it
+        block by block), the ghosts' sums."""
         t0 = perf_counter()
         x = self.node.x if x_ready else np.add(self.X, self.U, out=self.node.x)
         with_step = self.step_count % STEP_EVERY == 0
         cells = self.passes.cells
-        jmin, worst, h_c, self.cell.step_cell = cells.kinematics(with_step)
+        q_vol, q_force = self.internal.volume_quantum, self.internal.force_quantum
+        jmin, worst, h_c, self.cell.step_cell = cells.kinematics(with_step, q_vol)  # and the nodal volumes
         if self._any_inverted(jmin):
             if self.on_inverted is None or not self.on_inverted(x):
                 failures.inverted(self, x, jmin, worst)
-            jmin, worst, h_c, self.cell.step_cell = cells.kinematics(with_step)  # the inverted cells eroded
+            jmin, worst, h_c, self.cell.step_cell = cells.kinematics(with_step, q_vol)  # the inverted cells eroded
             if self._any_inverted(jmin):
                 failures.inverted(self, x, jmin, worst)
-        self.volumes_to_nodes(self.cell.vol, self.node.nvol)
+        self._ghost_sum(self.node.nvol)
         t1 = perf_counter()
         self.passes.nodes.nodal_pressure(self.node.vol, self.node.vol0, self.cell.bulk, self.nodal_p)
-        cells.cells(dt)
+        cells.cells(dt, q_force)  # and the cells' forces summed at the nodes
         self.sums.plastic += self.sums.totals[0]
         self.sums.heat += self.sums.totals[1]
         t2 = perf_counter()
-        self._cells_to_nodes(self.cell.Fc, self.node.fint)
+        dx.scatter_reverse_add(self.node.fint_fn.x)  # ghost terms to their owners (ghost rows stale)
         t3 = perf_counter()
         self._external_forces()
         self.clock.times.add(t0, t1, t2, t3, perf_counter())
@@ -638,6 +640,7 @@ def _stress_kernel(s: ExplicitSolver, kernel: str | None) -> None:
         s.cell.G_m = np.array([m.shear_modulus for m in materials])
         c = s.cell
         s.passes.cells = ckernel.CellPasses(s.node.x, s.Vel, s.dofs, s.mat, s.orient, s.vol0, c.speed, c.params, c.G_m,
-                                            s.nodal_p, c.sT, s.eps_p, s.temp, c.sy0, c.vol, c.dt, c.Fc, s.sums.totals)
+                                            s.nodal_p, c.sT, s.eps_p, s.temp, c.sy0, c.vol, c.dt, None, s.sums.totals,
+                                            nvol=s.node.vol, fint=s.node.fint)
         s.passes.nodes = ckernel.NodePasses()
     s.kernel = "C" if s.passes.cells is not None else "numba"

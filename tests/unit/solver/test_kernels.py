@@ -293,6 +293,17 @@ def test_fused_pass_matches_the_numba_kernels_on_mixed_cells(seed):
     nodes.scatter_forces(cells.dofs32, Fc, FINE, f)
     assert np.max(np.abs(f - f_ref)) <= 1e-11 * np.max(np.abs(f_ref))
     assert np.allclose(Fc.sum(axis=1), 0.0, atol=1e-12 * np.abs(Fc).max())  # each cell's forces balance
+    # the step's own passes sum the nodal volumes and forces in their blocks, without Fc: the same bits as the
+    # passes apart (stale values in the outputs are overwritten)
+    sT, ep, T, sy0 = state()
+    nv_f, f_f = np.full_like(nv, np.nan), np.full_like(X, np.nan)
+    fused = ckernel.CellPasses(x, v, dofs, mat, orient, v0, speed, params, G_m, npres, sT, ep, T, sy0, np.zeros(n),
+                               np.full(n, np.inf), None, np.zeros(4), nvol=nv_f, fint=f_f)
+    assert fused.kinematics(True, FINE) == kin
+    assert np.array_equal(nv_f, nv_c)
+    assert fused.cells(dt, FINE) == yielded
+    assert np.array_equal(f_f, f)
+    assert all(np.array_equal(a, b) for a, b in zip(got, (sT, ep, T, sy0)))
 
 
 @pytest.mark.skipif(ckernel.library() is None, reason=str(ckernel.why_not()))
