@@ -31,7 +31,7 @@ __all__ = ["NodalSum", "exact_sum", "ExactAccumulator", "input_keys"]
 #: LIMB_BITS bits each (the top one signed), so |term| < 2^(LIMBS * LIMB_BITS - GRID_BITS - 10) = 2^70
 GRID_BITS = 100
 LIMB_BITS = 30
-LIMBS = 6
+LIMBS = 6  # _to_limbs writes its six limbs out
 
 
 def input_keys(conn: np.ndarray, input_index: np.ndarray) -> np.ndarray:
@@ -167,12 +167,22 @@ def _displs(counts: np.ndarray) -> np.ndarray:
 @numba.njit(cache=True)
 def _sorted_scatter(order, conn, values, per_node, n_owned, out):
     """out[:n_owned] = Σ over the contributors c in ``order`` of their values at their owned nodes (values
-    (n_c k, bs) per node if per_node, else (n_c, bs) per contributor); ghost rows untouched."""
+    (n_c k, bs) per node if per_node, else (n_c, bs) per contributor); ghost rows untouched. A contributor whose
+    values are all zero is passed over (the target's unloaded facets, most of the surface): adding a zero
+    leaves a sum's bits as they are (a sum that starts at +0 never becomes −0)."""
     bs = values.shape[1]
     k = conn.shape[1]
     out[:n_owned] = 0.0
     for i in range(len(order)):
         c = order[i]
+        if not per_node:
+            zero = True
+            for q in range(bs):
+                if values[c, q] != 0.0:
+                    zero = False
+                    break
+            if zero:
+                continue
         for j in range(k):
             a = conn[c, j]
             if a >= n_owned:
@@ -240,23 +250,44 @@ def _run_sums(ptr, run_node, terms, out):
 @numba.njit(cache=True)
 def _to_limbs(values, limbs, bad):
     """Add each column's terms, rounded to the grid, into limbs (m, LIMBS) int64 (not normalised); terms
-    that are not finite or not below 2^70 are counted in bad (m,) instead (their sum is then NaN)."""
+    that are not finite or not below 2^70 are counted in bad (m,) instead (their sum is then NaN). A column
+    at a time, its limbs held in registers (the pieces are exact: scaling by powers of two, floor)."""
     scale = 2.0 ** GRID_BITS
     base = 2.0 ** LIMB_BITS
+    ibase = 1.0 / base
     top = 2.0 ** (LIMBS * LIMB_BITS - GRID_BITS - 10)
     n, m = values.shape
-    for i in range(n):
-        for j in range(m):
+    for j in range(m):
+        l0 = l1 = l2 = l3 = l4 = l5 = 0
+        nb = 0
+        for i in range(n):
             v = values[i, j]
             if not (abs(v) < top):
-                bad[j] += 1
+                nb += 1
                 continue
             y = np.rint(v * scale)  # exact scaling by a power of two, one rounding
-            for k in range(LIMBS - 1):
-                q = np.floor(y / base)
-                limbs[j, k] += np.int64(y - q * base)  # in [0, 2^30): exact
-                y = q
-            limbs[j, LIMBS - 1] += np.int64(y)
+            q = np.floor(y * ibase)
+            l0 += np.int64(y - q * base)  # in [0, 2^30): exact
+            y = q
+            q = np.floor(y * ibase)
+            l1 += np.int64(y - q * base)
+            y = q
+            q = np.floor(y * ibase)
+            l2 += np.int64(y - q * base)
+            y = q
+            q = np.floor(y * ibase)
+            l3 += np.int64(y - q * base)
+            y = q
+            q = np.floor(y * ibase)
+            l4 += np.int64(y - q * base)
+            l5 += np.int64(q)
+        limbs[j, 0] += l0
+        limbs[j, 1] += l1
+        limbs[j, 2] += l2
+        limbs[j, 3] += l3
+        limbs[j, 4] += l4
+        limbs[j, 5] += l5
+        bad[j] += nb
 
 
 @numba.njit(cache=True)

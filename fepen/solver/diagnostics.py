@@ -7,6 +7,7 @@ from __future__ import annotations
 
 from dataclasses import dataclass
 
+import numba
 import numpy as np
 from mpi4py import MPI
 
@@ -98,20 +99,33 @@ def _elastic_by_material(solver) -> np.ndarray:
     mat = s.mat
     live = mat >= 0
     J = _cell_J(s)
-    G = np.array([m.shear_modulus for m in s.materials])[mat]  # eroded cells (−1): weighed 0 below
-    sd = s.s  # column-major: whole columns are cheap, rows are not
-    ss = sd[:, 0] ** 2 + sd[:, 1] ** 2 + sd[:, 2] ** 2 + 2.0 * (sd[:, 3] ** 2 + sd[:, 4] ** 2 + sd[:, 5] ** 2)
-    per_cell = J * s.vol0 * ss / (4.0 * G)
+    G = np.array([m.shear_modulus for m in s.materials])
     if s.passes.nodal:
         v0, v = s.node.vol0[:n], s.node.vol[:n]
         has = v0 > 0.0
         lj = np.log(np.where(has, v, 1.0) / np.where(has, v0, 1.0))
         out = 0.5 * s.cell.bulk * np.sum(v0 * lj * lj, axis=0)
-    else:
-        lj = np.log(np.where(live, J, 1.0))
-        per_cell += s.vol0 * 0.5 * s.cell.bulk[mat] * lj * lj
-        out = np.zeros(nm)
-    return out + np.bincount(np.where(live, mat, 0), weights=np.where(live, per_cell, 0.0), minlength=nm)
+        return out + _deviatoric_by_material(J, s.vol0, np.ascontiguousarray(s.s.T), mat, G, nm)
+    sd = s.s  # column-major: whole columns are cheap, rows are not
+    ss = sd[:, 0] ** 2 + sd[:, 1] ** 2 + sd[:, 2] ** 2 + 2.0 * (sd[:, 3] ** 2 + sd[:, 4] ** 2 + sd[:, 5] ** 2)
+    per_cell = J * s.vol0 * ss / (4.0 * G[mat])  # eroded cells (−1): weighed 0 below
+    lj = np.log(np.where(live, J, 1.0))
+    per_cell += s.vol0 * 0.5 * s.cell.bulk[mat] * lj * lj
+    return np.bincount(np.where(live, mat, 0), weights=np.where(live, per_cell, 0.0), minlength=nm)
+
+
+@numba.njit(cache=True)
+def _deviatoric_by_material(J, vol0, sT, mat, G, nm):
+    """Σ V s:s / (4G) over the live cells of each material (J), in cell order: V = J V0, s:s = s_xx² + s_yy² +
+    s_zz² + 2 (s_xy² + s_yz² + s_xz²) from the component-major stress sT (6, n)."""
+    out = np.zeros(nm)
+    for e in range(len(mat)):
+        k = mat[e]
+        if k < 0:
+            continue
+        ss = sT[0, e] ** 2 + sT[1, e] ** 2 + sT[2, e] ** 2 + 2.0 * (sT[3, e] ** 2 + sT[4, e] ** 2 + sT[5, e] ** 2)
+        out[k] += J[e] * vol0[e] * ss / (4.0 * G[k])
+    return out
 
 
 def _bilinear_plastic(solver) -> np.ndarray:
@@ -182,16 +196,45 @@ def rotation(solver, x: np.ndarray, f_target: np.ndarray | None):
     n = solver.n_owned
     m = solver.mass[:n]
     v = solver.velocity_at_step()[:n]
-    first = assembly.exact_sum(np.concatenate([m[:, None] * x[:n], m[:, None] * v], axis=1), solver.comm)
+    terms = np.empty((n, 15))
+    _first_moments(m, x, v, terms)
+    first = assembly.exact_sum(terms[:, :6], solver.comm)
     xc, vc = first[:3] / solver.total_mass, first[3:] / solver.total_mass
-    r, u = x[:n] - xc, v - vc
-    f = np.zeros((n, 3)) if f_target is None else f_target[:n]
-    H = m[:, None] * np.cross(r, u)
-    M = np.cross(r, f)
-    rr = m[:, None, None] * (np.einsum("ij,ij->i", r, r)[:, None, None] * np.eye(3) - r[:, :, None] * r[:, None, :])
-    sums = assembly.exact_sum(np.concatenate([H, M, rr.reshape(n, 9)], axis=1), solver.comm)
+    f = np.zeros((n, 3)) if f_target is None else f_target
+    _rotation_terms(m, x, v, f, xc, vc, terms)
+    sums = assembly.exact_sum(terms, solver.comm)
     H, M, inertia = sums[:3], sums[3:6], sums[6:].reshape(3, 3)
     return xc, np.linalg.solve(inertia, H), M, H
+
+
+@numba.njit(cache=True)
+def _first_moments(m, x, v, out):
+    """out[:, :6] = m x, m v over the rows of m."""
+    for i in range(len(m)):
+        for j in range(3):
+            out[i, j] = m[i] * x[i, j]
+            out[i, 3 + j] = m[i] * v[i, j]
+
+
+@numba.njit(cache=True)
+def _rotation_terms(m, x, v, f, xc, vc, out):
+    """Each node's terms of rotation's sums into out (n, 15): m r × u, r × f, m (|r|² 1 − r rᵀ) (row-major),
+    r = x − x_c, u = v − v_c (the products in numpy.cross's order)."""
+    for i in range(len(m)):
+        r0, r1, r2 = x[i, 0] - xc[0], x[i, 1] - xc[1], x[i, 2] - xc[2]
+        u0, u1, u2 = v[i, 0] - vc[0], v[i, 1] - vc[1], v[i, 2] - vc[2]
+        mi = m[i]
+        out[i, 0] = mi * (r1 * u2 - r2 * u1)
+        out[i, 1] = mi * (r2 * u0 - r0 * u2)
+        out[i, 2] = mi * (r0 * u1 - r1 * u0)
+        out[i, 3] = r1 * f[i, 2] - r2 * f[i, 1]
+        out[i, 4] = r2 * f[i, 0] - r0 * f[i, 2]
+        out[i, 5] = r0 * f[i, 1] - r1 * f[i, 0]
+        rr = (r0 * r0 + r2 * r2) + r1 * r1  # |r|² as numpy 1.24's einsum added it (the rows' bits kept)
+        r = (r0, r1, r2)
+        for a in range(3):
+            for b in range(3):
+                out[i, 6 + 3 * a + b] = mi * ((rr if a == b else 0.0) - r[a] * r[b])
 
 
 def body_accelerations(solver, axis: np.ndarray) -> np.ndarray:

@@ -10,6 +10,7 @@ from __future__ import annotations
 
 from time import perf_counter
 
+import numba
 import numpy as np
 from mpi4py import MPI
 
@@ -89,11 +90,13 @@ class TargetLoad:
         axis = unit_axis(tip, tail)
         comm = solver.comm
 
+        hit = None  # the loaded points (whose force is not zero)
+
         def reduce(f, sums):
             """All ranks' totals in one reduction: the force exactly, the loaded count and area."""
-            nonlocal comm_s
+            nonlocal comm_s, hit
             t1 = perf_counter()
-            hit = np.flatnonzero(np.any(f != 0.0, axis=1))
+            hit = _loaded_rows(f)
             terms = np.zeros((len(hit) + 1, 5))
             terms[:-1, :3] = f[hit]
             terms[-1, 3:] = sums[3:]
@@ -112,7 +115,7 @@ class TargetLoad:
                                  -tip[1], reduce, tunnel=self.tunnel, body_xi=xi)
         # the target's moment about O on this rank's points (Σ x × f: a facet's thirds at its corners have its
         # centroid's moment), integrated by the trapezoid rule, whose weights are the central difference's
-        m_o = np.cross(x, load.force).sum(axis=0) if len(x) else np.zeros(3)
+        m_o = _moment(x, load.force, _loaded_rows(load.force) if hit is None else hit)
         self.angular_since += 0.5 * dt * (self.moment_o + m_o)
         self.moment_o = m_o
         if self.tunnel is not None and comm.size > 1:  # every rank's pushes of the wall
@@ -205,3 +208,26 @@ class TargetLoad:
             self.angular_impulse, self.angular_since, self.moment_o = a[:3].copy(), a[3:6].copy(), a[6:9].copy()
         if self.tunnel is not None and "tunnel" in state:
             self.tunnel.restore(np.asarray(state["tunnel"]))
+
+
+@numba.njit(cache=True)
+def _loaded_rows(f):
+    """The rows of f (k, 3) with a component that is not zero."""
+    out = np.empty(len(f), dtype=np.int64)
+    n = 0
+    for i in range(len(f)):
+        if f[i, 0] != 0.0 or f[i, 1] != 0.0 or f[i, 2] != 0.0:
+            out[n] = i
+            n += 1
+    return out[:n]
+
+
+@numba.njit(cache=True)
+def _moment(x, f, rows):
+    """Σ x × f over the given rows (the loaded points: the others add nothing), in row order."""
+    m = np.zeros(3)
+    for i in rows:
+        m[0] += x[i, 1] * f[i, 2] - x[i, 2] * f[i, 1]
+        m[1] += x[i, 2] * f[i, 0] - x[i, 0] * f[i, 2]
+        m[2] += x[i, 0] * f[i, 1] - x[i, 1] * f[i, 0]
+    return m
