@@ -40,6 +40,11 @@ double cavity_wall_stress(double Y, double lam, double ca) {
 
 static double cavity_stress(const double *p, double ca) { return cavity_wall_stress(p[P_Y], p[P_LAM], ca); }
 
+/* a point's speed along its outward normal, v . n (the one expression law_at_point and the loops' skip share) */
+static inline double normal_speed(const double *vi, const double *ni) {
+    return vi[0] * ni[0] + vi[1] * ni[1] + vi[2] * ni[2];
+}
+
 /* What the law needs beyond p[] that is the same at every point: computed once per call by law_constants */
 typedef struct {
     double thk, sin_min, sin_onset, ref, whole, mu_s, mu_d, decay;
@@ -73,7 +78,7 @@ static inline int law_at_point(const double *p, const LawConstants *c, const dou
     if (p[P_LOWER] >= 0.0) frac *= clip01(0.5 + (y + p[P_LOWER]) / ell);
     if (wall) frac *= clip01(1.0 + wall->delta / ell); /* in the tunnel: the part of the patch at its wall */
     if (!(frac > 0.0)) return 0;
-    double vn = vi[0] * ni[0] + vi[1] * ni[1] + vi[2] * ni[2];
+    double vn = normal_speed(vi, ni);
     double speed = sqrt(vi[0] * vi[0] + vi[1] * vi[1] + vi[2] * vi[2]);
     double sin_phi = speed > 0.0 ? vn / fmax(speed, 1e-300) : 0.0, u = 0.0;
     int loaded;
@@ -138,6 +143,12 @@ static inline int above_face(const double *p, const double *xi, double ell) {
     return !(clip01(0.5 - (xi[1] + p[P_TOP]) / ell) > 0.0);
 }
 
+/* 1 when the point moves into its surface's outside (law_at_point's vn > 0, the same function): no other point
+ * is loaded, in the tunnel or not, so the loops skip the others before locating them in the tunnel (half of a
+ * shank's points; the station a point is located at does not depend on which points were located before it: no
+ * bit changes) */
+static inline int moving_into(const double *vi, const double *ni) { return normal_speed(vi, ni) > 0.0; }
+
 /* The point's wall, when it is in the tunnel T (NULL: no tunnel): the WallHit, or NULL */
 static inline const WallHit *wall_of(const double *T, TunnelEnd *e, const double *xi_point, double xi,
                                      WallHit *hit) {
@@ -169,7 +180,7 @@ int32_t point_forces(int32_t k, const double *x, const double *v, const double *
         fi[0] = fi[1] = fi[2] = 0.0;
         sig[i] = 0.0;
         const double ell = sqrt(area[i]);
-        if (above_face(p, x + 3 * i, ell)) continue;
+        if (above_face(p, x + 3 * i, ell) || !moving_into(v + 3 * i, n + 3 * i)) continue;
         WallHit hit;
         const WallHit *wall = wall_of(T, &end, x + 3 * i, T ? body_xi[i] : 0.0, &hit);
         if (law_at_point(p, &c, x + 3 * i, v + 3 * i, n + 3 * i, area[i], ell, radius[i], Rm[i], sphi0[i],

@@ -40,7 +40,7 @@ __attribute__((noinline)) static int32_t law_points(int32_t k, const double *x, 
     for (int j = 0; j < 5; ++j) sums[j] = 0.0;
     for (int32_t i = 0; i < k; ++i) {
         double sg = 0.0;
-        if (above_face(p, x + 3 * i, ell[i])) continue;
+        if (above_face(p, x + 3 * i, ell[i]) || !moving_into(v + 3 * i, n + 3 * i)) continue;
         WallHit hit;
         const WallHit *wall = wall_of(T, &end, x + 3 * i, T ? body_xi[i] : 0.0, &hit);
         if (!law_at_point(p, &c, x + 3 * i, v + 3 * i, n + 3 * i, area[i], ell[i], radius[i], Rm[i], sphi0[i], axis,
