@@ -14,14 +14,16 @@
 
 from __future__ import annotations
 
+import math
 from pathlib import Path
 
+import numba
 import numpy as np
 from mpi4py import MPI
 
 from fepen.geometry import tags
 from fepen.geometry.frames import unit_axis
-from fepen.solver import diagnostics, probes
+from fepen.solver import probes
 
 GAUGE_NAMES = ["top", "bottom", "side+", "side-"]
 GAUGE_DIRECTIONS = np.array([[1.0, 0.0, 0.0], [-1.0, 0.0, 0.0], [0.0, 0.0, 1.0], [0.0, 0.0, -1.0]])
@@ -107,13 +109,9 @@ class Gauges:
 
     def record(self) -> None:
         """One gauge row, and every cell's von Mises stress into its peak (collective)."""
-        self.rows.append([self.solver.t, *self.axial_strains()])
-        vm = diagnostics.von_mises(self.solver)
-        live = self.solver.mat >= 0  # an eroded cell's stress is gone, its peak kept
-        np.maximum(self.peak_von_mises, np.where(live, vm, 0.0), out=self.peak_von_mises)
-        n = len(self.first_yield_t)
-        newly = (self.solver.eps_p[:n] > 0.0) & np.isinf(self.first_yield_t)
-        self.first_yield_t[newly] = self.solver.t
+        s = self.solver
+        self.rows.append([s.t, *self.axial_strains()])
+        _peaks(np.ascontiguousarray(s.s.T), s.mat, s.eps_p, s.t, self.peak_von_mises, self.first_yield_t)
 
     def first_yield(self) -> dict | None:
         """Where and when the projectile first yielded (collective, the same on every rank): the earliest
@@ -480,3 +478,22 @@ class ChargeSections:
         """charge_sections.csv (rank 0)."""
         if self.comm.rank == 0:
             save_table(Path(out) / "charge_sections.csv", np.array(self.rows), ",".join(self.columns), "%.9g")
+
+
+@numba.njit(cache=True)
+def _peaks(sT, mat, eps_p, t, peak, first):
+    """Each owned cell's von Mises stress (diagnostics.von_mises: the same products, in the same order) into its
+    peak (NaN kept, as numpy.maximum keeps it; an eroded cell's stress is gone, its peak kept), and the time t
+    into first where the cell has plastic strain for the first time."""
+    for e in range(len(peak)):
+        vm = 0.0
+        if mat[e] >= 0:
+            vm = math.sqrt(1.5 * (sT[0, e] ** 2 + sT[1, e] ** 2 + sT[2, e] ** 2
+                                  + 2.0 * (sT[3, e] ** 2 + sT[4, e] ** 2 + sT[5, e] ** 2)))
+        p = peak[e]
+        if p != p or vm != vm:
+            peak[e] = np.nan
+        elif vm > p:
+            peak[e] = vm
+        if eps_p[e] > 0.0 and math.isinf(first[e]):
+            first[e] = t

@@ -199,8 +199,8 @@ class DeformableRun(Run):
                       i["sliding_fraction"]]
         self.gauges.record()
         rear = -self._y_extent(x)[1] if self.crossings is not None else np.nan
-        xc, w, M, H = diagnostics.rotation(s, x, getattr(self.load, "nodal_force", None))  # a rigid wall: none
-        return Snapshot(tip, tail, diagnostics.momentum_velocity(s), self.load.force, s.total_mass, en,
+        xc, w, M, H, vc = diagnostics.rotation(s, x, getattr(self.load, "nodal_force", None))  # a rigid wall: none
+        return Snapshot(tip, tail, vc, self.load.force, s.total_mass, en,
                         self.load.contact_nodes, s.dt, diagnostics.max_peeq(s), self.load.area, rear, extra,
                         self._removal(e) if self.removing else None, w, M, H,
                         self.load.angular_impulse_now(self.comm) if m.law is not None else np.zeros(3), xc)

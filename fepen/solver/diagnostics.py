@@ -187,7 +187,8 @@ def momentum_velocity(solver) -> np.ndarray:
 def rotation(solver, x: np.ndarray, f_target: np.ndarray | None):
     """The body's centre of mass x_c (m) and its rotation about it, all ranks (exact sums over the owned nodes:
     the same on any partition): the angular velocity ω = I⁻¹ H (rad/s), the target's moment Σ r × f (N m)
-    and the angular momentum H = Σ m r × (v − v_c) (N m s), r = x − x_c, world frame; I = Σ m (|r|² 1 − r rᵀ).
+    and the angular momentum H = Σ m r × (v − v_c) (N m s), r = x − x_c, world frame; I = Σ m (|r|² 1 − r rᵀ);
+    and the centre's velocity v_c (m/s: momentum_velocity's, from the same sum).
 
     Args:
         solver: the ExplicitSolver. x: its node positions now (m). f_target: the target's nodal forces of the
@@ -204,7 +205,7 @@ def rotation(solver, x: np.ndarray, f_target: np.ndarray | None):
     _rotation_terms(m, x, v, f, xc, vc, terms)
     sums = assembly.exact_sum(terms, solver.comm)
     H, M, inertia = sums[:3], sums[3:6], sums[6:].reshape(3, 3)
-    return xc, np.linalg.solve(inertia, H), M, H
+    return xc, np.linalg.solve(inertia, H), M, H, vc
 
 
 @numba.njit(cache=True)
