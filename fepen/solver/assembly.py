@@ -302,8 +302,10 @@ def _carry(limbs):
 
 def _from_limbs(limbs: np.ndarray, bad: np.ndarray) -> np.ndarray:
     out = np.empty(limbs.shape[0])
-    for j, row in enumerate(limbs):
-        total = sum(int(v) << (LIMB_BITS * k) for k, v in enumerate(row))
+    for j, row in enumerate(limbs.tolist()):  # Python integers: Σ row[k] 2^(LIMB_BITS k), exactly
+        total = 0
+        for v in reversed(row):
+            total = (total << LIMB_BITS) + v
         out[j] = math.ldexp(float(total), -GRID_BITS) if total else 0.0  # one correct rounding
     out[bad > 0] = np.nan
     return out

@@ -97,30 +97,45 @@ class CellPasses:
 
 class NodePasses:
     """The C node passes (central-difference update, nodal pressure, the plain cell-to-node sums), on
-    arrays passed at each call (addresses checked and taken each time: a few microseconds)."""
+    arrays passed at each call (addresses checked and taken once per array: an array is remembered with its
+    address while it is passed; one that is replaced is checked and taken anew)."""
 
     def __init__(self):
         lib = library()
         if lib is None:
             raise RuntimeError(why_not())
         self._lib = lib
+        self._known: dict[int, tuple[np.ndarray, int]] = {}
+
+    def _a(self, a: np.ndarray, dtype=np.float64) -> int:
+        """_addr of an array, remembered (the array is held, so its id is not reused while remembered)."""
+        hit = self._known.get(id(a))
+        if hit is not None and hit[0] is a:
+            return hit[1]
+        if len(self._known) > 64:
+            self._known.clear()
+        address = _addr(a, dtype)
+        self._known[id(a)] = (a, address)
+        return address
 
     def update_begin(self, h: float, dt: float, n_owned: int, acc, vel, u, X, x, du, fint, fext, work) -> None:
         """v += h a, du = dt v, u += du, x = X + u (all rows); each owned node's du·f_int / 2 and du·f_ext / 2
         added into work (n_nodes, 2)."""
-        self._lib.update_begin(len(u), n_owned, h, dt, _addr(acc), _addr(vel), _addr(u), _addr(X), _addr(x),
-                               _addr(du), _addr(fint), _addr(fext), _addr(work))
+        a = self._a
+        self._lib.update_begin(len(u), n_owned, h, dt, a(acc), a(vel), a(u), a(X), a(x), a(du), a(fint), a(fext),
+                               a(work))
 
     def update_end(self, n_owned: int, fint, fext, mass, fixed, du, acc, work) -> None:
         """a = (f_ext − f_int) / m on owned rows (0 where fixed: (n, 3) bool or None); each owned node's half
         of the new forces' work added into work (n_nodes, 2)."""
-        fx = None if fixed is None else _addr(fixed, np.bool_)
-        self._lib.update_end(n_owned, _addr(fint), _addr(fext), _addr(mass), fx, _addr(du), _addr(acc),
-                             _addr(work))
+        a = self._a
+        fx = None if fixed is None else a(fixed, np.bool_)
+        self._lib.update_end(n_owned, a(fint), a(fext), a(mass), fx, a(du), a(acc), a(work))
 
     def nodal_pressure(self, vol, vol0, bulk, out) -> None:
         """p = K ln J / J per node and material (0 where no reference volume)."""
-        self._lib.nodal_pressure(vol.shape[0], _addr(vol), _addr(vol0), _addr(bulk), vol.shape[1], _addr(out))
+        a = self._a
+        self._lib.nodal_pressure(vol.shape[0], a(vol), a(vol0), a(bulk), vol.shape[1], a(out))
 
     def scatter_volumes(self, dofs32, mat, cvol, quantum: float, out) -> None:
         """out (n_rows, n_materials) = Σ over live cells of cvol / 4 on each node, each term rounded to a

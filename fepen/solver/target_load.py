@@ -66,6 +66,9 @@ class TargetLoad:
             from fepen.laws.tunnel import Tunnel
 
             self.tunnel = Tunnel(xi_sh, a0)
+        self._pending = None  # the last step's totals left to their readers (_settle)
+        self._x_all = None  # the node positions of the last call
+        self._xi = self._xi_of = None  # the points' body-axial distances, and the positions they were taken from
         self.force = np.zeros(3)
         self.contact_nodes = 0
         self.area = 0.0
@@ -83,7 +86,10 @@ class TargetLoad:
         return self._sum
 
     def __call__(self, solver, dt: float) -> None:
-        x_all = solver.positions()  # from X and U: a load may be evaluated on a state set by hand (wear playback)
+        # from X and U (a load may be evaluated on a state set by hand: wear playback), into a kept buffer
+        if self._x_all is None or self._x_all.shape != solver.X.shape:
+            self._x_all = np.empty_like(solver.X)
+        x_all = np.add(solver.X, solver.U, out=self._x_all)
         t0 = perf_counter()
         tip, tail = probes.node_values(solver, (self.tip, self.tail), x_all)  # one reduction for both
         comm_s = perf_counter() - t0
@@ -91,16 +97,19 @@ class TargetLoad:
         comm = solver.comm
 
         hit = None  # the loaded points (whose force is not zero)
+        # without a linear crater nothing in the step needs the totals over the ranks: the history rows and
+        # checkpoints take them when they read them (force, contact_nodes, area), from the same terms
+        deferred = self.crater is None
 
         def reduce(f, sums):
-            """All ranks' totals in one reduction: the force exactly, the loaded count and area."""
+            """All ranks' totals in one reduction: the force exactly, the loaded count and area (deferred: this
+            rank's, the reduction left to _settle)."""
             nonlocal comm_s, hit
-            t1 = perf_counter()
             hit = _loaded_rows(f)
-            terms = np.zeros((len(hit) + 1, 5))
-            terms[:-1, :3] = f[hit]
-            terms[-1, 3:] = sums[3:]
-            out = assembly.exact_sum(terms, comm)
+            if deferred:
+                return sums
+            t1 = perf_counter()
+            out = _totals(f, hit, sums[3:], comm)
             comm_s += perf_counter() - t1
             return out
 
@@ -110,7 +119,9 @@ class TargetLoad:
         if self.tunnel is not None:  # the shoulder on the deformed axis, tip to tail
             self.tunnel.at(tip - self.tunnel.xi_sh * axis, axis)
             self.tunnel.commit = True
-            xi = np.ascontiguousarray(s.X[:, 1])
+            if self._xi_of is not s.X:  # the points' distances behind the tip (a rebuilt surface: new arrays)
+                self._xi, self._xi_of = np.ascontiguousarray(s.X[:, 1]), s.X
+            xi = self._xi
         load = tg.load_on_points(self.law, x, v, n, area, s.radius, s.R_meridian, s.sin_phi0, axis, self.crater,
                                  -tip[1], reduce, tunnel=self.tunnel, body_xi=xi)
         # the target's moment about O on this rank's points (Σ x × f: a facet's thirds at its corners have its
@@ -132,11 +143,53 @@ class TargetLoad:
         comm_s += perf_counter() - t1
         n_own = solver.n_owned
         solver.fext[:n_own] += self._nodes[:n_own]
-        self.force, self.contact_nodes, self.area = load.total, load.loaded, load.area
+        if deferred:
+            self._pending = (hit, np.array([load.loaded, load.area], dtype=float), comm)
+        else:
+            self.force, self.contact_nodes, self.area = load.total, load.loaded, load.area
         self.last_force, self.last_area, self.last_n = load.force, area, n
         # the points it acted on: an erosion may rebuild the surface before the history row splits it
         self.last_X = (self.surf if self.nodal is None else self.nodal).X
         solver.clock.times.target_comm += comm_s
+
+    def _settle(self) -> None:
+        """The last step's totals over the ranks, if the step left them to its readers (collective then: the
+        history rows and checkpoints read them on every rank)."""
+        if self._pending is not None:
+            hit, local, comm = self._pending
+            self._pending = None
+            out = _totals(self.last_force, hit, local, comm)
+            self._force, self._contact_nodes, self._area = out[:3], int(out[3]), float(out[4])
+
+    @property
+    def force(self) -> np.ndarray:
+        """The target's total force on the body at the last step (N, all ranks; collective when pending)."""
+        self._settle()
+        return self._force
+
+    @force.setter
+    def force(self, value) -> None:
+        self._force, self._pending = value, None
+
+    @property
+    def contact_nodes(self) -> int:
+        """The loaded points at the last step (all ranks; collective when pending)."""
+        self._settle()
+        return self._contact_nodes
+
+    @contact_nodes.setter
+    def contact_nodes(self, value) -> None:
+        self._contact_nodes, self._pending = value, None
+
+    @property
+    def area(self) -> float:
+        """Their area (m², all ranks; collective when pending)."""
+        self._settle()
+        return self._area
+
+    @area.setter
+    def area(self, value) -> None:
+        self._area, self._pending = value, None
 
     def surface_fields(self, solver) -> dict[str, np.ndarray]:
         """The load the last step applied, as nodal fields (fields.xdmf; collective): ``target_force_N`` the
@@ -208,6 +261,15 @@ class TargetLoad:
             self.angular_impulse, self.angular_since, self.moment_o = a[:3].copy(), a[3:6].copy(), a[6:9].copy()
         if self.tunnel is not None and "tunnel" in state:
             self.tunnel.restore(np.asarray(state["tunnel"]))
+
+
+def _totals(f: np.ndarray, hit: np.ndarray, local, comm) -> np.ndarray:
+    """(force (3), loaded points, loaded area) over the ranks: the loaded points' forces f[hit] summed exactly
+    with each rank's count and area (local (2,)), in one reduction (the same on any partition)."""
+    terms = np.zeros((len(hit) + 1, 5))
+    terms[:-1, :3] = f[hit]
+    terms[-1, 3:] = local
+    return assembly.exact_sum(terms, comm)
 
 
 @numba.njit(cache=True)
