@@ -162,18 +162,21 @@ class Gauges:
                 out.append(peak)
         return tuple(out)
 
-    def write(self, out: Path, figures: bool = True) -> None:
-        """strains.csv, hazard.csv and hazard.png (collective; rank 0 writes); figures: False, no hazard.png."""
+    def write(self, out: Path, figures: bool = True):
+        """strains.csv and hazard.csv (collective; rank 0 writes). Returns hazard.png's drawing, a callable
+        any rank can run (the map sent to every rank), or None when figures is False."""
         haz = self.hazard()
-        if self.comm.rank:
-            return
         out = Path(out)
-        save_table(out / "strains.csv", np.array(self.rows), ",".join(self.columns), "%.9g")
-        save_table(out / "hazard.csv", np.column_stack(haz),
-                   "axial_from_nose_mm,max_surface_peeq,peak_surface_von_mises_Pa,max_peeq,peak_von_mises_Pa",
-                   "%.6g")
-        if figures:
-            hazard_figure(out, haz, np.array(self.rows), self.columns)
+        if self.comm.rank == 0:
+            save_table(out / "strains.csv", np.array(self.rows), ",".join(self.columns), "%.9g")
+            save_table(out / "hazard.csv", np.column_stack(haz),
+                       "axial_from_nose_mm,max_surface_peeq,peak_surface_von_mises_Pa,max_peeq,peak_von_mises_Pa",
+                       "%.6g")
+        if not figures:
+            return None
+        haz = self.comm.bcast(haz[:3] if self.comm.rank == 0 else None, root=0)
+        rows, columns = np.array(self.rows), list(self.columns)  # the same rows on every rank
+        return lambda: hazard_figure(out, haz, rows, columns)
 
 
 def save_table(path: Path, rows: np.ndarray, header: str, fmt: str) -> None:

@@ -7,6 +7,7 @@ charge report and the nose profile to the summary.
 from __future__ import annotations
 
 import numpy as np
+from mpi4py import MPI
 
 from fepen.data.experiments import shot as table1_shot
 from fepen.io import files, results
@@ -27,7 +28,7 @@ class Closing:
     def write(self, run) -> None:
         """Write the closing analyses of ``run`` (a fepen.runs.deformable.DeformableRun; collective)."""
         figures = run.shot.outputs.figures
-        run.gauges.write(run.out, figures)
+        hazard = run.gauges.write(run.out, figures)
         self.first_yield = run.gauges.first_yield()
         if run.sections is not None:
             run.sections.write(run.out)
@@ -41,16 +42,24 @@ class Closing:
         if getattr(run, "safety", None) is not None:
             self.safety = run.safety.summary(self.peaks.get("charge_acc"))
         s = run.solver
+        name, out = run.shot.experiment, run.out
+        jobs = []  # the figures (and stress maps' .vtu), drawn by the ranks at once: (draw, names, weight)
         if run.fields is not None:  # the cut planes at peak load and at the end, and the shot (Figs. 18, 20-21)
-            name, out = run.shot.experiment, run.out
-            jobs = [(lambda stem=stem, t=t: slices.stress_maps(out, out / f"{stem}.png", t, figures),
-                     ((f"{stem}.png",) if figures else ()) + (f"{stem}.vtu",))
-                    for stem, t in (("stress_maps_peak", self.peaks["decel"]["t_s"]), ("stress_maps_end", None))]
+            jobs += [(lambda stem=stem, t=t: slices.stress_maps(out, out / f"{stem}.png", t, figures),
+                      ((f"{stem}.png",) if figures else ()) + (f"{stem}.vtu",), 4.0)
+                     for stem, t in (("stress_maps_peak", self.peaks["decel"]["t_s"]), ("stress_maps_end", None))]
             if figures:
                 test = table1_shot(name) if name else None
-                jobs.append((lambda: slices.trajectory_figure(out, out / "trajectory.png", test), ("trajectory.png",)))
-            shared(run.comm, out, jobs)
-        elif figures:
+                jobs.append((lambda: slices.trajectory_figure(out, out / "trajectory.png", test), ("trajectory.png",),
+                             1.0))
+        if figures:  # history.csv is whole: closed before the closing analyses
+            from fepen.post import figures as figs
+
+            jobs += [(hazard, ("hazard.png",), 2.0),
+                     (lambda: figs.history_figure(out, name, MPI.COMM_SELF), ("history.png",), 1.5)]
+            run.history_drawn = True
+        shared(run.comm, out, jobs)
+        if run.fields is None and figures:
             analyses.deformed_picture(s, run.out / "deformed.png", f"t = {s.t * 1e6:.0f} µs, max PEEQ "
                                       f"{diagnostics.max_peeq(s):.3g}", run.gauges.peak_von_mises)
         m = run.model
@@ -65,13 +74,15 @@ class Closing:
 
 def shared(comm, out, jobs: list) -> None:
     """Jobs that read the run's files and write files of their own (the figures), shared out over the ranks:
-    job k on rank k mod size, so that on 2 ranks the two stress maps are drawn at once (collective). Rank 0
-    first records in the run's manifest the names the other ranks are about to write (its claim on the
-    directory, fepen.atomic: the manifest lists every file a run writes, whichever rank wrote it).
+    the heaviest first, each to the rank with the least weight so far (on 2 ranks the two stress maps are drawn
+    at once, the lighter figures beside them; collective). Rank 0 first records in the run's manifest the names
+    the other ranks are about to write (its claim on the directory, fepen.atomic: the manifest lists every file
+    a run writes, whichever rank wrote it).
 
     Args:
         comm: the run's communicator. out: the run's directory.
-        jobs: (callable without arguments, the names it writes in ``out``) pairs.
+        jobs: (callable without arguments, the names it writes in ``out``, its weight: the time it takes,
+            in any unit) triples.
 
     Raises:
         On every rank, when a job failed on any: the job's own exception on its rank, a RuntimeError naming the
@@ -79,14 +90,19 @@ def shared(comm, out, jobs: list) -> None:
     """
     from fepen import atomic
 
+    load, rank_of = [0.0] * comm.size, {}
+    for k in sorted(range(len(jobs)), key=lambda k: (-jobs[k][2], k)):  # the same plan on every rank
+        r = min(range(comm.size), key=lambda r: (load[r], r))
+        rank_of[k] = r
+        load[r] += jobs[k][2]
     claim = atomic.claim_of(out) if comm.rank == 0 and comm.size > 1 and out is not None else None
-    for k, (_, names) in enumerate(jobs):
-        if claim is not None and k % comm.size:
+    for k, (_, names, _) in enumerate(jobs):
+        if claim is not None and rank_of[k]:
             for name in names:
                 claim.own(name)
     error = None
-    for k, (job, _) in enumerate(jobs):
-        if k % comm.size == comm.rank and error is None:
+    for k, (job, _, _) in enumerate(jobs):
+        if rank_of[k] == comm.rank and error is None:
             try:
                 job()
             except Exception as e:  # raised below, once every rank knows

@@ -286,6 +286,8 @@ class Run:
                 "wear_heat_J": r.heat_J, "removed_kinetic_J": r.kinetic_J, "removed_elastic_J": r.elastic_J}
 
     initial_mass: float
+    #: history.png drawn by the closing analyses (beside the other figures), not again by write_summary
+    history_drawn: bool = False
 
     def write_summary(self, outcome: str, loop_s: float) -> dict:
         """The summary (summary.json when the run has a directory)."""
@@ -302,7 +304,7 @@ class Run:
         if self.out is not None:  # the figure first: summary.json is the last file of a run that ended well
             from fepen.post import figures
 
-            if self.shot.outputs.figures:
+            if self.shot.outputs.figures and not self.history_drawn:  # a closing that drew it (closing.shared)
                 files.agree(self.comm, "history.png",
                             lambda: figures.history_figure(self.out, self.shot.experiment, MPI.COMM_SELF))
             results.write_summary(self.out, summary, self.comm)
