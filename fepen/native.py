@@ -77,7 +77,8 @@ KERNELS = {
         "scatter_volumes": ([_i32, _vp, _vp, _vp, _dbl, _i32, _i32, _vp], None),
         "scatter_forces": ([_i32, _vp, _vp, _dbl, _i32, _vp], None),
         "kinematics_pass": ([_i32, *[_vp] * 6, _i32, _vp, _vp, _vp, _dbl, _i32, _i32, _vp], None),
-        "cell_pass": ([_i32, _vp, _vp, _dbl, _vp, _vp, _vp, _i32, *[_vp] * 8, _dbl, _i32, _vp, _vp], _i32)}),
+        "cell_pass": ([_i32, _vp, _vp, _dbl, _vp, _vp, _vp, _i32, *[_vp] * 8, _dbl, _i32, _vp, _vp], _i32),
+        "facet_kinematics": ([_i32, *[_vp] * 11], None)}),
 }
 PACKAGE = Path(__file__).resolve().parent
 _LOADED: dict[str, ctypes.CDLL | None] = {}

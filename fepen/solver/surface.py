@@ -13,6 +13,7 @@ from mpi4py import MPI
 
 from fepen import dolfinx_api as dx
 from fepen.geometry import projection, tags
+from fepen.solver import ckernel
 
 SUBDIVISION = 4  # facet patch areas: 4 x 4 sub-triangles projected on the exact surface
 
@@ -198,7 +199,14 @@ class Surface:
         """
         f = len(self.tri)
         x, v, n, area = np.empty((f, 3)), np.empty((f, 3)), np.empty((f, 3)), np.empty(f)
-        _facet_kinematics(x_all, v_all, self.tri, self.n_flat0, self.N0, self.area0, self.flat0, x, v, area, n)
+        lib = ckernel.library()
+        arrays = (x_all, v_all, self.tri, self.n_flat0, self.N0, self.area0, self.flat0)
+        if lib is not None and f and all(a.flags.c_contiguous for a in arrays) and self.tri.dtype == np.int64 \
+                and x_all.dtype == v_all.dtype == np.float64:  # the C loop (cell_kernel.c), the same bits
+            lib.facet_kinematics(f, *[a.ctypes.data for a in arrays], x.ctypes.data, v.ctypes.data,
+                                 area.ctypes.data, n.ctypes.data)
+        else:
+            _facet_kinematics(*arrays, x, v, area, n)
         return x, v, area, n
 
     def to_nodes(self, f: np.ndarray, out: np.ndarray) -> None:

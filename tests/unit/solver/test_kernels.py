@@ -353,3 +353,33 @@ def test_c_update_passes_are_central_differences():
     want = np.where(fixed, 0.0, (fe - fi) / m[:, None])
     assert np.allclose(acc[:own], want[:own], rtol=1e-15) and np.all(acc[own:] == 0.0)
     assert np.allclose(work[:own], 2.0 * half[:own], rtol=1e-13, atol=0)  # the same forces: twice the half
+
+
+@pytest.mark.skipif(ckernel.library() is None, reason=str(ckernel.why_not()))
+def test_c_facet_kinematics_is_the_numba_loop_to_the_bit():
+    """Surface.kinematics's C loop (vectorised across facets) and its numba reference give the same bits on
+    deformed facets, a collapsed one (zero area: NaN normal) and one turned over (1 + a.b below 1e-12)."""
+    from fepen.solver.surface import _facet_kinematics
+
+    rng = np.random.default_rng(11)
+    nn, nf = 400, 900
+    X = rng.standard_normal((nn, 3))
+    tri = rng.integers(0, nn, (nf, 3)).astype(np.int64)
+    tri[5] = [7, 7, 8]  # collapsed
+    av = 0.5 * np.cross(X[tri[:, 1]] - X[tri[:, 0]], X[tri[:, 2]] - X[tri[:, 0]])
+    flat0 = np.linalg.norm(av, axis=1)
+    n_flat0 = av / np.maximum(flat0, 1e-300)[:, None]
+    N0 = n_flat0 + 0.05 * rng.standard_normal((nf, 3))
+    N0 /= np.linalg.norm(N0, axis=1)[:, None]
+    area0 = flat0 * (1.0 + 0.01 * rng.random(nf))
+    x = X + 0.02 * rng.standard_normal((nn, 3))
+    x[tri[9]] = X[tri[9][[0, 2, 1]]]  # turned over: its normal reversed
+    v = 300.0 * rng.standard_normal((nn, 3))
+    out_c = [np.empty((nf, 3)), np.empty((nf, 3)), np.empty(nf), np.empty((nf, 3))]
+    out_n = [np.empty_like(a) for a in out_c]
+    ckernel.library().facet_kinematics(nf, *[a.ctypes.data for a in (x, v, tri, n_flat0, N0, area0, flat0)],
+                                       *[a.ctypes.data for a in out_c])
+    _facet_kinematics(x, v, tri, n_flat0, N0, area0, flat0, *out_n)
+    assert np.isnan(out_n[3][5]).all()
+    for a, b in zip(out_c, out_n):
+        assert np.array_equal(a, b, equal_nan=True)
