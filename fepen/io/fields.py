@@ -253,8 +253,7 @@ def mesh_index(h5_path: Path, cells_xdmf: Path, facets_xdmf: Path) -> None:
 def _write_vtu(path: Path, points: np.ndarray, cells: np.ndarray, name: str, values: np.ndarray) -> None:
     """The same grid as VTK XML (.vtu): pyvista's XDMF reader cannot open an XDMF file without time values
     (pyvista 0.49), and a static XDMF file with them is one meshio.read cannot open."""
-    import meshio
+    from fepen.io.vtu import write_vtu
 
     kind = {4: "tetra", 3: "triangle"}[cells.shape[1]]
-    with replacing(path, ".vtu") as tmp:
-        meshio.write(tmp, meshio.Mesh(points, [(kind, cells)], cell_data={name: [values.ravel()]}), file_format="vtu")
+    write_vtu(path, points, [(kind, cells)], {name: [values.ravel()]})

@@ -247,9 +247,7 @@ def write_cut_planes(st: dict, x: np.ndarray, tip: np.ndarray, planes: dict, pat
     the target's frame (m): triangles and quads with every cell field of the state, ``cell_tag`` and
     ``plane`` (0 the x–y plane of incidence, 1 the y–z plane across it); VTK XML, which ParaView, pyvista
     and meshio open."""
-    import meshio
-
-    from fepen.atomic import replacing
+    from fepen.io.vtu import write_vtu
 
     points, blocks, data = [], {3: [], 4: []}, {3: [], 4: []}
     names = [k for k, v in st.items() if isinstance(v, np.ndarray) and v.shape == (len(st["cells"]),)]
@@ -271,9 +269,7 @@ def write_cut_planes(st: dict, x: np.ndarray, tip: np.ndarray, planes: dict, pat
     for key in ("cell_tag", "plane"):
         if key in cell_data:
             cell_data[key] = [v.astype(np.int32) for v in cell_data[key]]
-    mesh = meshio.Mesh(np.concatenate(points) if points else np.zeros((0, 3)), cells_out, cell_data=cell_data)
-    with replacing(path, ".vtu") as tmp:
-        meshio.write(tmp, mesh, file_format="vtu")
+    write_vtu(path, np.concatenate(points) if points else np.zeros((0, 3)), cells_out, cell_data)
 
 
 def _one_path(polys: list):
