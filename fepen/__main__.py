@@ -1,3 +1,3 @@
-from fepen.cli import main
+from fepen.cli import console
 
-raise SystemExit(main())
+console()

@@ -33,6 +33,8 @@ error is one line on stderr; --debug adds the traceback.
 from __future__ import annotations
 
 import argparse
+import logging
+import os
 import sys
 
 from fepen.cli import envelope, keys, mesh, run, study, sweep, validate, validate_depth, view
@@ -104,6 +106,27 @@ def main(argv: list[str] | None = None) -> int:
         return _main(argv)
     finally:
         rundir._in_cli = False
+
+
+def console() -> None:
+    """The ``fepen`` command as a process (the console script, ``python -m fepen``): main, then a quick exit.
+
+    When main returns, everything the command wrote is closed (its files replaced atomically, the fields'
+    HDF5 files closed, the bars closed). What Python would still do is unload its modules (dolfinx, numba,
+    matplotlib): 0.35 s of a 2-rank run's 11 s. So the streams are flushed, the logs shut down, MPI finalised
+    (every rank of the command reaches it), and the process ends with main's exit code."""
+    code = main()
+    for finish in (sys.stdout.flush, sys.stderr.flush, logging.shutdown):
+        try:
+            finish()
+        except Exception:  # noqa: BLE001 - a closed pipe (fepen keys | head): the exit code still stands
+            pass
+    try:
+        mpi = sys.modules.get("mpi4py.MPI")
+        if mpi is not None and mpi.Is_initialized() and not mpi.Is_finalized():
+            mpi.Finalize()
+    finally:
+        os._exit(code if isinstance(code, int) else 1)
 
 
 def _main(argv: list[str]) -> int:
