@@ -31,7 +31,7 @@ __all__ = ["NodalSum", "exact_sum", "ExactAccumulator", "input_keys"]
 #: LIMB_BITS bits each (the top one signed), so |term| < 2^(LIMBS * LIMB_BITS - GRID_BITS - 10) = 2^70
 GRID_BITS = 100
 LIMB_BITS = 30
-LIMBS = 6  # _to_limbs writes its six limbs out
+LIMBS = 6
 
 
 def input_keys(conn: np.ndarray, input_index: np.ndarray) -> np.ndarray:
@@ -250,44 +250,23 @@ def _run_sums(ptr, run_node, terms, out):
 @numba.njit(cache=True)
 def _to_limbs(values, limbs, bad):
     """Add each column's terms, rounded to the grid, into limbs (m, LIMBS) int64 (not normalised); terms
-    that are not finite or not below 2^70 are counted in bad (m,) instead (their sum is then NaN). A column
-    at a time, its limbs held in registers (the pieces are exact: scaling by powers of two, floor)."""
+    that are not finite or not below 2^70 are counted in bad (m,) instead (their sum is then NaN)."""
     scale = 2.0 ** GRID_BITS
     base = 2.0 ** LIMB_BITS
-    ibase = 1.0 / base
     top = 2.0 ** (LIMBS * LIMB_BITS - GRID_BITS - 10)
     n, m = values.shape
-    for j in range(m):
-        l0 = l1 = l2 = l3 = l4 = l5 = 0
-        nb = 0
-        for i in range(n):
+    for i in range(n):
+        for j in range(m):
             v = values[i, j]
             if not (abs(v) < top):
-                nb += 1
+                bad[j] += 1
                 continue
             y = np.rint(v * scale)  # exact scaling by a power of two, one rounding
-            q = np.floor(y * ibase)
-            l0 += np.int64(y - q * base)  # in [0, 2^30): exact
-            y = q
-            q = np.floor(y * ibase)
-            l1 += np.int64(y - q * base)
-            y = q
-            q = np.floor(y * ibase)
-            l2 += np.int64(y - q * base)
-            y = q
-            q = np.floor(y * ibase)
-            l3 += np.int64(y - q * base)
-            y = q
-            q = np.floor(y * ibase)
-            l4 += np.int64(y - q * base)
-            l5 += np.int64(q)
-        limbs[j, 0] += l0
-        limbs[j, 1] += l1
-        limbs[j, 2] += l2
-        limbs[j, 3] += l3
-        limbs[j, 4] += l4
-        limbs[j, 5] += l5
-        bad[j] += nb
+            for k in range(LIMBS - 1):
+                q = np.floor(y / base)
+                limbs[j, k] += np.int64(y - q * base)  # in [0, 2^30): exact
+                y = q
+            limbs[j, LIMBS - 1] += np.int64(y)
 
 
 @numba.njit(cache=True)
