@@ -23,7 +23,7 @@ from mpi4py import MPI
 
 from fepen.geometry import tags
 from fepen.geometry.frames import unit_axis
-from fepen.solver import probes
+from fepen.solver import diagnostics, probes
 
 GAUGE_NAMES = ["top", "bottom", "side+", "side-"]
 GAUGE_DIRECTIONS = np.array([[1.0, 0.0, 0.0], [-1.0, 0.0, 0.0], [0.0, 0.0, 1.0], [0.0, 0.0, -1.0]])
@@ -491,8 +491,7 @@ def _peaks(sT, mat, eps_p, t, peak, first):
     for e in range(len(peak)):
         vm = 0.0
         if mat[e] >= 0:
-            vm = math.sqrt(1.5 * (sT[0, e] ** 2 + sT[1, e] ** 2 + sT[2, e] ** 2
-                                  + 2.0 * (sT[3, e] ** 2 + sT[4, e] ** 2 + sT[5, e] ** 2)))
+            vm = math.sqrt(1.5 * diagnostics.deviator_square(sT, e))
         p = peak[e]
         if p != p or vm != vm:
             peak[e] = np.nan

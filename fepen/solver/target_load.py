@@ -20,6 +20,24 @@ from fepen.solver import assembly, probes
 from fepen.solver.surface import Surface
 
 
+class _Settled:
+    """An attribute of TargetLoad's last totals: read, it settles a pending reduction first (TargetLoad._settle);
+    set, it replaces the value and drops the pending one."""
+
+    def __set_name__(self, owner, name):
+        self.key = "_" + name
+
+    def __get__(self, obj, objtype=None):
+        if obj is None:
+            return self
+        obj._settle()
+        return getattr(obj, self.key)
+
+    def __set__(self, obj, value):
+        setattr(obj, self.key, value)
+        obj._pending = None
+
+
 class TargetLoad:
     """External force of the concrete target on an ExplicitSolver (an explicit.Load).
 
@@ -126,7 +144,7 @@ class TargetLoad:
                                  -tip[1], reduce, tunnel=self.tunnel, body_xi=xi)
         # the target's moment about O on this rank's points (Σ x × f: a facet's thirds at its corners have its
         # centroid's moment), integrated by the trapezoid rule, whose weights are the central difference's
-        m_o = _moment(x, load.force, _loaded_rows(load.force) if hit is None else hit)
+        m_o = _moment(x, load.force, hit)  # hit: reduce's, which load_on_points always calls
         self.angular_since += 0.5 * dt * (self.moment_o + m_o)
         self.moment_o = m_o
         if self.tunnel is not None and comm.size > 1:  # every rank's pushes of the wall
@@ -161,35 +179,11 @@ class TargetLoad:
             out = _totals(self.last_force, hit, local, comm)
             self._force, self._contact_nodes, self._area = out[:3], int(out[3]), float(out[4])
 
-    @property
-    def force(self) -> np.ndarray:
-        """The target's total force on the body at the last step (N, all ranks; collective when pending)."""
-        self._settle()
-        return self._force
-
-    @force.setter
-    def force(self, value) -> None:
-        self._force, self._pending = value, None
-
-    @property
-    def contact_nodes(self) -> int:
-        """The loaded points at the last step (all ranks; collective when pending)."""
-        self._settle()
-        return self._contact_nodes
-
-    @contact_nodes.setter
-    def contact_nodes(self, value) -> None:
-        self._contact_nodes, self._pending = value, None
-
-    @property
-    def area(self) -> float:
-        """Their area (m², all ranks; collective when pending)."""
-        self._settle()
-        return self._area
-
-    @area.setter
-    def area(self, value) -> None:
-        self._area, self._pending = value, None
+    # the last step's totals over the ranks (collective to read while pending: the history rows and
+    # checkpoints read them on every rank): force (N, world frame), contact_nodes (loaded points), area (m²)
+    force = _Settled()
+    contact_nodes = _Settled()
+    area = _Settled()
 
     def surface_fields(self, solver) -> dict[str, np.ndarray]:
         """The load the last step applied, as nodal fields (fields.xdmf; collective): ``target_force_N`` the
