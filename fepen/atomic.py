@@ -39,6 +39,11 @@ class ForeignFile(InputError):
         return (type(self), (self.path,))
 
 
+class UndeclaredName(RuntimeError):
+    """A write of a name the folder's kind of record does not declare (fepen.io.layout): a bug in fepen, refused
+    before anything is written, so that every name a record lists is one its kind can write."""
+
+
 class Claim:
     """A directory fepen writes into, and its top-level names that are fepen's.
 
@@ -50,14 +55,18 @@ class Claim:
         strict: refuse a write over a top-level name not owned (rank 0, which makes every top-level name of a
             run); False: refuse only links (the other ranks, which write inside directories rank 0 made and
             would not know their names).
+        declared: name -> whether the directory's kind of record writes it (fepen.io.layout), or None: a new
+            top-level name it does not declare is a bug in fepen (UndeclaredName), never written.
     """
 
-    def __init__(self, directory, owned=(), on_new: Callable[[str], None] | None = None, strict: bool = True):
+    def __init__(self, directory, owned=(), on_new: Callable[[str], None] | None = None, strict: bool = True,
+                 declared: Callable[[str], bool] | None = None):
         self.dir = Path(os.path.abspath(directory))
         self.owned: set[str] = set(owned)
         self.added: list[str] = []
         self.on_new = on_new
         self.strict = strict
+        self.declared = declared
 
     def check(self, path: Path) -> None:
         """Refuse (ForeignFile) a write of ``path`` (inside this directory) over a foreign file or through a
@@ -80,8 +89,11 @@ class Claim:
         self.own(top)
 
     def own(self, name: str) -> None:
-        """``name`` (a top-level entry) is fepen's from now on."""
+        """``name`` (a top-level entry) is fepen's from now on (in the manifest before it is made)."""
         if name not in self.owned:
+            if self.declared is not None and not self.declared(name):
+                raise UndeclaredName(f"fepen would write {name!r} into {self.dir}, which the layout of what it "
+                                     "writes there does not declare (fepen.io.layout)")
             self.owned.add(name)
             self.added.append(name)
             if self.on_new is not None:
@@ -91,9 +103,10 @@ class Claim:
 _claims: list[Claim] = []
 
 
-def claim(directory, owned=(), on_new: Callable[[str], None] | None = None, strict: bool = True) -> Claim:
+def claim(directory, owned=(), on_new: Callable[[str], None] | None = None, strict: bool = True,
+          declared: Callable[[str], bool] | None = None) -> Claim:
     """Claim a directory for this process's writes (Claim); ``release`` ends it."""
-    c = Claim(directory, owned, on_new, strict)
+    c = Claim(directory, owned, on_new, strict, declared)
     _claims.append(c)
     return c
 
@@ -157,10 +170,32 @@ def replacing(path, suffix: str = "") -> Iterator[Path]:
     try:
         os.chmod(tmp, _MODE)
         yield tmp
+        _kill_point(tmp)
         os.replace(tmp, path)
     finally:
         if os.path.lexists(tmp):
             tmp.unlink()
+
+
+#: the environment variable that kills this process (SIGKILL) at its K-th write, the temporary complete and not
+#: yet renamed ("K"), or lists every write's temporary in a file ("trace:FILE", one path a line), for the tests of
+#: what a kill leaves (tests/system/test_study_safety.py); nothing happens without it
+KILL = "FEPEN_INJECT_KILL"
+_temporaries = [0]
+
+
+def _kill_point(tmp: Path) -> None:
+    spec = os.environ.get(KILL)
+    if not spec:
+        return
+    _temporaries[0] += 1
+    if spec.startswith("trace:"):
+        with open(spec[6:], "a") as f:
+            f.write(f"{tmp}\n")
+    elif spec.isdigit() and _temporaries[0] == int(spec):
+        import signal
+
+        os.kill(os.getpid(), signal.SIGKILL)
 
 
 def make_dir(path) -> Path:

@@ -41,6 +41,15 @@ def workers_argument(parser, help: str) -> None:
     parser.add_argument("--workers", type=int, default=None, metavar="W", help=help)
 
 
+#: --fresh's help, the same for every study command
+FRESH = "remove what the study wrote in --out first (exactly that) and run every shot again"
+
+
+def fresh_argument(parser) -> None:
+    """--fresh: a study's folder replaced, not continued (fepen.studies.study.run)."""
+    parser.add_argument("--fresh", action="store_true", help=FRESH)
+
+
 def set_argument(parser, help: str) -> None:
     """--set KEY=VALUE, repeatable, into ``args.sets`` (fepen.studies.study.set_option)."""
     from fepen.studies.study import set_option

@@ -13,12 +13,11 @@ line before anything is written), then fepen.studies.study.run on the ranks it w
 
 from __future__ import annotations
 
-from fepen.cli.common import say
+from fepen.cli.common import fresh_argument, say
 
 HELP = "a study of many shots: " + "; ".join(("ballistic-limit", "ricochet", "uncertainty", "charge-safety",
                                                "accuracy-cost",
                                                "calibration, ...")) + " (docs/studies.md)"
-FRESH = "remove what the study wrote in --out first (exactly that) and run every shot again"
 
 
 def add_arguments(parser) -> None:
@@ -30,7 +29,7 @@ def add_arguments(parser) -> None:
         sp = sub.add_parser(name, help=cls.help)
         cls.add_arguments(sp)
         sp.add_argument("--out", default=cls.out, help=f"results directory (default {cls.out})")
-        sp.add_argument("--fresh", action="store_true", help=FRESH)
+        fresh_argument(sp)
         sp.add_argument("--ranks-per-shot", type=int, default=1, metavar="K",
                         help="ranks of each shot's MPI group (default 1; must divide the number of ranks)")
 

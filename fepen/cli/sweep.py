@@ -4,7 +4,7 @@ it runs itself again under ``mpirun -n W`` (fepen.studies.processes.relaunch_swe
 
 from __future__ import annotations
 
-from fepen.cli.common import say, set_argument, written_line
+from fepen.cli.common import fresh_argument, say, set_argument, written_line
 from fepen.errors import InputError
 
 HELP = ("many shots of a base scene (grid, Monte Carlo or a table): sweep.csv, sweep.md, figures; resumable; MPI "
@@ -19,7 +19,7 @@ def add_arguments(parser) -> None:
     parser.add_argument("--workers", type=int, default=None, metavar="W",
                         help="without mpirun: run under mpirun -n W (default: one per core; 1: in this process)")
     set_argument(parser, "override a key of the base scene")
-    parser.add_argument("--fresh", action="store_true", help="discard the shots OUT holds and run them all again")
+    fresh_argument(parser)
 
 
 def run(args) -> int:

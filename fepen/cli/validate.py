@@ -1,10 +1,10 @@
-"""``fepen validate [SCENE.toml] [--out DIR] [--set KEY=VALUE ...] [--workers W]``: the eight Table 1 shots
+"""``fepen validate [SCENE.toml] [--out DIR] [--set KEY=VALUE ...] [--workers W] [--fresh]``: the eight Table 1 shots
 (fepen.studies.validate.Validate), one line per shot; its deformable shots side by side under ``mpirun -n W``
 when started without mpirun (one rank each)."""
 
 from __future__ import annotations
 
-from fepen.cli.common import say, scene_arguments, workers_argument
+from fepen.cli.common import fresh_argument, say, scene_arguments, workers_argument
 
 HELP = "the Table 1 sweep: validation.csv, validation.md, figures"
 
@@ -12,6 +12,7 @@ HELP = "the Table 1 sweep: validation.csv, validation.md, figures"
 def add_arguments(parser) -> None:
     scene_arguments(parser, "results/validation")
     workers_argument(parser, "deformable shots at once, each on one rank under mpirun (default: one per core)")
+    fresh_argument(parser)
 
 
 def run(args) -> int:
@@ -31,9 +32,9 @@ def run(args) -> int:
     if MPI.COMM_WORLD.size == 1 and deformable and workers > 1 and processes.launcher():
         os.environ.setdefault("FEPEN_PROGRESS", "1" if sys.stderr.isatty() else "0")
         argv = ["validate", *([args.scene] if args.scene else []), "--out", args.out,
-                *[f"--set={s}" for s in args.sets]]
+                *[f"--set={s}" for s in args.sets], *(["--fresh"] if args.fresh else [])]
         return processes.relaunch(argv, min(workers, len(plan.scenes)))
-    study.run(st, plan, args.out, MPI.COMM_WORLD, 1, False, say)
+    study.run(st, plan, args.out, MPI.COMM_WORLD, 1, args.fresh, say)
     say(written_line(args.out))
     return 0
 

@@ -1,10 +1,10 @@
-"""``fepen validate-depth [--data PATH ...] [--only] [--set KEY=VALUE ...] [--out DIR] [--workers W]``: depth
+"""``fepen validate-depth [--data PATH ...] [--only] [--set KEY=VALUE ...] [--out DIR] [--workers W] [--fresh]``: depth
 data sets by the rigid fidelity and Forrestal's closed form (fepen.studies.depth.ValidateDepth), one line per
 set; under ``mpirun -n W`` when started without mpirun with W > 1."""
 
 from __future__ import annotations
 
-from fepen.cli.common import say, set_argument
+from fepen.cli.common import fresh_argument, say, set_argument
 
 HELP = "depth data sets by the rigid fidelity and Forrestal's closed form: depth.csv, depth.md, depth.png"
 
@@ -16,6 +16,7 @@ def add_arguments(parser) -> None:
     set_argument(parser, "override a scene key in every rigid run (e.g. target.strength_model=forrestal-S)")
     parser.add_argument("--out", default="results/validate-depth", help="results directory")
     parser.add_argument("--workers", type=int, default=1, help="ranks at once, under mpirun (default 1)")
+    fresh_argument(parser)
 
 
 def run(args) -> int:
@@ -35,9 +36,9 @@ def run(args) -> int:
     if MPI.COMM_WORLD.size == 1 and workers > 1 and processes.launcher():
         os.environ.setdefault("FEPEN_PROGRESS", "1" if sys.stderr.isatty() else "0")
         argv = ["validate-depth", *[a for d in args.data for a in ("--data", d)], *(["--only"] if args.only else []),
-                "--out", args.out, *[f"--set={s}" for s in args.sets]]
+                "--out", args.out, *[f"--set={s}" for s in args.sets], *(["--fresh"] if args.fresh else [])]
         return processes.relaunch(argv, workers)
-    table = study.run(st, plan, args.out, MPI.COMM_WORLD, 1, False, lambda *ls: None)["table"]
+    table = study.run(st, plan, args.out, MPI.COMM_WORLD, 1, args.fresh, lambda *ls: None)["table"]
     say(*(f"{r['set']}: {r['count']} shots; mean |error| default {100 * r['default mean_abs']:.1f} % "
           f"(bias {100 * r['default bias']:+.1f} %), forrestal-S {100 * r['forrestal-S mean_abs']:.1f} %, "
           f"closed form {100 * r['closed form mean_abs']:.1f} %" + _covered(r) for r in table),

@@ -20,6 +20,20 @@ from fepen.data.steels import STEELS
 from fepen.data.steels import names as steel_names
 from fepen.data.targets import CONSTANTS, FAMILIES, TARGETS
 
-__all__ = ["experiments", "steels", "targets", "explosives", "prediction_errors", "EXPLOSIVES",
+__all__ = ["experiments", "steels", "targets", "explosives", "prediction_errors", "digests", "EXPLOSIVES",
            "SHOTS", "Shot", "shot", "STEELS", "steel_names", "TARGETS", "FAMILIES",
            "CONSTANTS"]
+
+
+def digests() -> dict[str, str]:
+    """{path below fepen/data: SHA-256} of every data file shipped here (tables and libraries, not code): what a
+    continued study checks it still reads (fepen.studies.study: a recalibrated target is another model)."""
+    import hashlib
+    from pathlib import Path
+
+    root = Path(__file__).parent
+    out = {}
+    for path in sorted(root.rglob("*")):
+        if path.is_file() and path.suffix in (".toml", ".csv", ".json"):
+            out[path.relative_to(root).as_posix()] = hashlib.sha256(path.read_bytes()).hexdigest()
+    return out

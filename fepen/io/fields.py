@@ -15,8 +15,11 @@ import numpy as np
 from mpi4py import MPI
 
 from fepen.atomic import make_dir, replacing
+from fepen.io import layout
 
 #: what fields.xdmf says of its own frame and units (an Information element of its Domain)
+#: what fepen writes in fields.d/ (fepen.io.layout)
+_TIMES = layout.RUN.node("fields.d")
 FRAME = ("fepen field output. Frame: the target's, in metres; the target face is the plane y = 0 and the target "
          "lies at y < 0 (depth = -y); the impact plane is x-y, z is normal to it; the geometry is the undeformed "
          "projectile (tip at the origin, axis +y towards the tail) placed at t = 0 by displacement_m, which is the "
@@ -70,8 +73,8 @@ class FieldWriter:
             if not self.times or not mesh_file.exists():
                 self._write_h5(mesh_file, {"geometry": geom, "topology": topo})
             keep = {mesh_file.name} | {self._step_file(k).name for k in range(len(self.times))}
-            for f in self.dir.iterdir():  # output times after a checkpoint, and temporaries
-                if f.name not in keep:
+            for f in self.dir.iterdir():  # output times after a checkpoint, and temporaries (a user's file stays)
+                if f.name not in keep and (_TIMES.node(f.name) is layout.LEAF or _TIMES.temporary(f.name)):
                     f.unlink()
             self._write_index()
 
@@ -214,7 +217,7 @@ class FieldWriter:
                         for name in self.names:
                             dst.create_dataset(f"/Function/{name}/{_time_name(t)}", data=src[name][()])
             self._write_xdmf(consolidated=True)
-            shutil.rmtree(self.dir)
+            layout.remove_entry(self.dir, _TIMES)  # what fepen wrote there (a user's file stays, and the folder)
         self.comm.barrier()
 
 

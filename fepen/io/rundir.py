@@ -34,28 +34,16 @@ from mpi4py import MPI
 from fepen import atomic
 from fepen.atomic import replacing
 from fepen.errors import InputError, MachineFault, describe_os_error
+from fepen.io import layout
 from fepen.io.files import _make_directory, inject
 from fepen.version import __version__
 
-LOCK = ".fepen.lock"
-#: space held back while a run goes on, given back to write the record of a stop on a full disk
-RESERVE, RESERVE_BYTES = ".fepen.reserve", 256 * 1024
-#: the names of a run's record: a directory whose manifest holds nothing else holds no results
-RECORD_NAMES = frozenset({"run.json", "fepen.log", RESERVE})
-#: every top-level name a fepen run may write into its directory (a user's file or link of one of these names
-#: is refused before the run starts; any other name is checked when written)
-RUN_NAMES = frozenset({
-    "summary.json", "run.json", "fepen.log", "scene.toml", RESERVE, "history.csv", "history.png", "probes.csv",
-    "fields.xdmf", "fields.h5", "fields.d", "checkpoint", "view.py", "accelerations.csv", "hazard.csv",
-    "hazard.png", "strains.csv", "nose_profile.csv", "nose_profile.png", "stress_maps_peak.png",
-    "stress_maps_peak.vtu", "stress_maps_end.png", "stress_maps_end.vtu", "trajectory.png", "deformed.png",
-    "charge_sections.csv", "charge_histories.png", "stress_maps.png", "stress_maps.vtu", "cross_sections.png",
-    "cross_sections.vtu", "interface.png"})
-#: what ``fepen mesh`` writes
-MESH_NAMES = frozenset({"run.json", "fepen.log", RESERVE, "mesh.json", "scene.toml", "mesh.xdmf", "mesh.h5",
-                        "mesh.vtu", "mesh_facets.xdmf", "mesh_facets.vtu", "mesh.png"})
-#: the largest run.json or lock file read back (bytes): a record is small; anything larger is not fepen's
-RECORD_MAX = 4 << 20
+#: the names and the record's limits, declared once with what each kind of record writes (fepen.io.layout)
+LOCK, RESERVE, RECORD_NAMES, RUN_NAMES, MESH_NAMES = (layout.LOCK, layout.RESERVE, layout.RECORD_NAMES,
+                                                      layout.RUN_NAMES, layout.MESH_NAMES)
+RESERVE_BYTES = 256 * 1024
+RECORD_MAX = layout.RECORD_MAX
+read_record, manifest = layout.read_record, layout.manifest
 
 _log_path: Path | None = None
 _transcript: list[str] = []
@@ -199,68 +187,9 @@ def _alive(pid: int) -> bool:
     return True
 
 
-def _plain_name(name) -> bool:
-    """A manifest entry fepen can have written: one name in the directory, no path."""
-    return (isinstance(name, str) and name not in ("", ".", "..", LOCK) and "/" not in name and "\0" not in name
-            and "\\" not in name)
-
-
-def read_record(out: Path) -> tuple[dict | None, str | None]:
-    """The record (run.json) of the last fepen command in ``out``: (record, None); (None, None) when there is
-    none; (None, why) when a run.json there is not one fepen wrote (a link, not JSON, not a record, too large)."""
-    path = Path(out) / "run.json"
-    try:
-        st = os.lstat(path)
-    except FileNotFoundError:
-        return None, None
-    if stat.S_ISLNK(st.st_mode) or not stat.S_ISREG(st.st_mode):
-        return None, "a link or not a regular file"
-    if st.st_size > RECORD_MAX:
-        return None, f"{st.st_size} bytes, not a record fepen wrote"
-    try:
-        rec = json.loads(path.read_text())
-    except (OSError, ValueError):
-        return None, "not a record fepen wrote (not JSON)"
-    if not isinstance(rec, dict) or not isinstance(rec.get("command"), list) or "fepen" not in rec:
-        return None, "not a record fepen wrote"
-    return rec, None
-
-
-def manifest(record: dict) -> set[str] | None:
-    """The names a record's runs wrote (its "files"), or None when it keeps no valid manifest (an earlier fepen)."""
-    files = record.get("files")
-    if not isinstance(files, list) or not all(_plain_name(f) for f in files):
-        return None
-    return set(files)
-
-
 def results_in(record: dict) -> list[str]:
     """The result files a record lists (its manifest without the record itself and the scene)."""
     return sorted((manifest(record) or set()) - RECORD_NAMES - {"scene.toml"})
-
-
-def remove(path: Path) -> None:
-    """Remove what fepen wrote at ``path``: a file or a link (the link itself, never its target); a directory
-    that holds a fepen record, by its manifest (a user's file inside stays, and so does the directory then);
-    any other directory fepen made (checkpoint/, fields.d/, shots/, rounds/), with all it holds, each
-    directory inside by the same rule."""
-    try:
-        st = os.lstat(path)
-    except FileNotFoundError:
-        return
-    if not stat.S_ISDIR(st.st_mode):
-        path.unlink()
-        return
-    rec, _ = read_record(path)
-    files = manifest(rec) if rec is not None else None
-    for child in ([path / n for n in sorted(files)] if files is not None else sorted(path.iterdir())):
-        remove(child)
-    if files is not None:
-        (path / LOCK).unlink(missing_ok=True)  # the lock of a record that is gone (its run cannot be running)
-    try:
-        path.rmdir()
-    except OSError:  # a user's file inside a study's shot folder: the folder stays
-        pass
 
 
 def _names(names) -> str:
@@ -296,6 +225,9 @@ class RunDirectory:
         self.command = list(command)
         default = MESH_NAMES if kind == "mesh" else RUN_NAMES
         self.names = default if names is None else RECORD_NAMES | frozenset(names)
+        if names is not None and kind not in ("run", "mesh"):
+            layout.declare(kind, names)
+        self.layout = layout.layout_of(kind)
         self.inputs, self.digest = inputs, digest
         self.record: dict = {}
         self.claim: atomic.Claim | None = None
@@ -364,7 +296,7 @@ class RunDirectory:
                 self._unlock()
                 return ("input", key, refused), ()
             owned = refused
-            self.claim = atomic.claim(self.out, owned, on_new=self._new_name)
+            self.claim = atomic.claim(self.out, owned, on_new=self._new_name, declared=self._declares)
             for name in ("run.json", "fepen.log", RESERVE):
                 self.claim.owned.add(name)
             self._write_record()
@@ -407,10 +339,18 @@ class RunDirectory:
             if self.mode == "continue" and results and not same_kind:
                 return (f"{self.out} holds the results of a {rec.get('kind', 'run')}, not of a {self.kind}: name "
                         "another --out, or --fresh to remove them first (exactly the files it wrote)")
-            if self.mode == "continue" and same_kind and rec.get("digest") not in (None, self.digest):
-                return (f"{self.out} holds the results of another {self.kind}: give a new --out, or --fresh to "
-                        "replace them")
+            if self.mode == "continue" and same_kind and results and rec.get("digest") != self.digest:
+                changed = _study_changed(rec.get("inputs"), self.inputs)
+                return (f"{self.out} holds the results of a {self.kind} made of other inputs ({changed}): a "
+                        f"continued {self.kind} runs the rest of the same shots with the same model; --fresh to "
+                        "replace them, or a new --out")
             owned = files
+            kind = rec.get("kind", "run")
+            extra = layout.undeclared(kind, files)
+            if extra:  # a record is trusted only for what its kind writes
+                return (f"{self.out / 'run.json'} lists {_names(extra)}, which a fepen {kind} never writes: fepen "
+                        "removes or replaces only what its record lists and its kind writes; take them out of its "
+                        "\"files\" (or move them away), or name another --out")
         elif self.mode == "resume":
             return f"{self.out} holds no fepen run to resume (no run.json)"
         blocking = [n for n in sorted(self.names | owned) if os.path.lexists(self.out / n)
@@ -419,13 +359,27 @@ class RunDirectory:
             what = ", ".join(f"{n} (a link)" if os.path.islink(self.out / n) else n for n in blocking[:4])
             return (f"{self.out} holds {what}, which fepen did not write and this {self.kind} would replace: fepen "
                     "never overwrites a file it did not write; move it away or name another --out")
+        self._sweep(rec)
         if rec is not None and self.mode in ("new", "force"):
             if self.mode == "new":
                 logging.getLogger("fepen").info(f"{self.out}: the files of its last {rec.get('kind', 'run')} "
                                                 f"({rec.get('outcome')}) are replaced")
-            self._clear(owned)
-            owned = set()
+            owned = self._clear(owned, rec.get("kind", "run"))
         return owned
+
+    def _sweep(self, rec: dict | None) -> None:
+        """Rank 0, the lock held: the temporaries a killed command left here (its kind's and this one's layout:
+        fepen.io.layout), named in fepen.log."""
+        gone = []
+        for kind in dict.fromkeys([self.kind, *([rec.get("kind", "run")] if rec else [])]):
+            gone += layout.sweep_temporaries(self.out, kind)
+        if gone:
+            log_line(f"fepen: {len(gone)} temporar{'y' if len(gone) == 1 else 'ies'} a killed command left removed: "
+                     f"{_names(gone)}")
+
+    def _declares(self, name: str) -> bool:
+        """This command's kind writes ``name`` at the top of its folder (fepen.io.layout)."""
+        return self.layout is not None and self.layout.node(name) is not None
 
     def _new_name(self, name: str) -> None:
         """A name newly written into the directory: the manifest in run.json at once (rank 0)."""
@@ -483,10 +437,11 @@ class RunDirectory:
         except (OSError, ValueError, AttributeError):
             pass
 
-    def _clear(self, names: set[str]) -> None:
-        """Remove exactly ``names`` (the earlier command's manifest; links among them were refused before)."""
-        for name in sorted(names):
-            remove(self.out / name)
+    def _clear(self, names: set[str], kind: str) -> set[str]:
+        """Remove exactly ``names`` (the earlier command's manifest, all of them names its ``kind`` writes; links
+        among them were refused before), each by its kind's layout (fepen.io.layout). Returns the names still
+        there: folders that keep a user's file, fepen's still."""
+        return layout.remove_owned(self.out, names, kind)
 
     def _write_record(self) -> None:
         path = self.out / "run.json"
@@ -494,6 +449,8 @@ class RunDirectory:
         if self.mode in ("resume", "continue") and path.is_file():
             earlier, _ = read_record(self.out)
             earlier = earlier if earlier and earlier.get("kind", "run") == self.kind else {}
+            if self.mode == "continue" and earlier.get("digest") != self.digest:  # it had no results: a new study
+                earlier = {}
         this = {"command": self.command, "cwd": os.getcwd(), "ranks": self.comm.size, "fepen": __version__,
                 "revision": revision(), "host": socket.gethostname(), "pid": os.getpid(), "start": _now(),
                 "end": None, "outcome": "running", "exit_code": None}
@@ -529,13 +486,35 @@ class RunDirectory:
         self._unlock()
 
 
-def study_directory(out, comm, fresh: bool, kind: str, names, digest: str | None = None) -> RunDirectory:
+def _study_changed(before, now) -> str:
+    """What differs between a study's recorded inputs (fepen.studies.study.inputs_of) and a continuation's, in one
+    phrase."""
+    if not isinstance(before, dict) or not isinstance(now, dict):
+        return "recorded by an earlier fepen, without its inputs"
+    parts = []
+    if before.get("fepen") != now.get("fepen"):
+        parts.append(f"fepen {before.get('fepen')} -> {now.get('fepen')}")
+    if before.get("study") != now.get("study"):
+        parts.append("its shots or their scene")
+    for what, label in (("data", "fepen/data/"), ("files", "")):
+        old, new = before.get(what) or {}, now.get(what) or {}
+        if not isinstance(old, dict) or not isinstance(new, dict):
+            continue
+        changed = sorted(k for k in set(old) | set(new) if old.get(k) != new.get(k))
+        parts += [f"{label}{k} {'changed' if k in old and k in new else 'added' if k in new else 'gone'}"
+                  for k in changed[:3]]
+    return "; ".join(parts) or "its inputs' digest differs"
+
+
+def study_directory(out, comm, fresh: bool, kind: str, names, digest: str | None = None,
+                    inputs: dict | None = None) -> RunDirectory:
     """The claim of a study on its results directory (a RunDirectory of its ``kind``): ``fresh`` removes what
     the study's manifest lists first ("force"), else the study goes on with what the same kind of study wrote
     there ("continue"), unless its ``digest`` differs (another study of that kind: refused); ``names``, the
     top-level names it writes, are refused before it starts where a file fepen did not write holds one. Each
     shot's own folder inside it is a run directory of its own."""
-    return RunDirectory(out, comm, "force" if fresh else "continue", kind=kind, names=names, digest=digest)
+    return RunDirectory(out, comm, "force" if fresh else "continue", kind=kind, names=names, digest=digest,
+                        inputs=inputs)
 
 
 def own_name(out: Path, name: str) -> None:

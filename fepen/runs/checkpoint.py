@@ -13,15 +13,17 @@ from __future__ import annotations
 import hashlib
 import io
 import json
-import shutil
 from pathlib import Path
 
 import numpy as np
 
 from fepen.atomic import make_dir, replacing, sha256_file
 from fepen.errors import InputError
-from fepen.io import files
+from fepen.io import files, layout
 from fepen.version import __version__
+
+#: what fepen writes in checkpoint/ (fepen.io.layout)
+_STEPS = layout.RUN.node("checkpoint")
 
 
 def _save(path: Path, arrays: dict) -> str:
@@ -54,8 +56,9 @@ def write(out: Path, comm, step: int, t: float, arrays: dict, meta: dict) -> Non
         state = {"step": step, "t_s": t, "ranks": comm.size, "fepen": __version__, "sha256": digests, **meta}
         with replacing(d / "state.json") as tmp:
             tmp.write_text(json.dumps(state, indent=1) + "\n")
-        for f in d.iterdir():
-            if f.name.startswith("step") and not f.name.startswith(f"step{step:09d}-"):
+        for f in d.iterdir():  # the older steps' files (a user's file here stays: fepen.io.layout)
+            if _STEPS.node(f.name) is layout.LEAF and f.name.startswith("step") and \
+                    not f.name.startswith(f"step{step:09d}-"):
                 f.unlink()
 
     files.agree(comm, f"{d / 'state.json'}", finish)
@@ -104,6 +107,7 @@ def read_arrays(out: Path, comm, state: dict, root_names: tuple[str, ...]) -> di
 
 
 def drop(out: Path, comm) -> None:
-    """Remove the checkpoints of a completed run (rank 0)."""
-    if comm.rank == 0 and (Path(out) / "checkpoint").exists():
-        shutil.rmtree(Path(out) / "checkpoint")
+    """Remove the checkpoints of a completed run (rank 0): what fepen wrote in checkpoint/ (a user's file there
+    stays, and the folder with it)."""
+    if comm.rank == 0:
+        layout.remove_entry(Path(out) / "checkpoint", _STEPS)

@@ -77,7 +77,7 @@ class AccuracyCost(Study):
 
     name = "accuracy-cost"
     help = "what accuracy costs in time: study.csv, study.md, pareto.png"
-    names = ("runs", "shots.jsonl", "study.csv", "study.md", "study.json", "pareto.png")
+    names = ("runs", "rounds", "shots.jsonl", "study.csv", "study.md", "study.json", "pareto.png")
     out = "results/study"
 
     @classmethod
@@ -120,8 +120,8 @@ class AccuracyCost(Study):
             return
         for rk in sorted(set(ranks)):  # one round per rank count (the 1-rank run of the speed-up)
             idx = [i for i, r in enumerate(ranks) if r == rk]
-            yield Round([plan.scenes[i] for i in idx], folder=f"ranks-{rk}",
-                        shot_folder=lambda out, j, idx=idx: out.parent / "runs" / names[idx[j]], batch=False,
+            yield Round([plan.scenes[i] for i in idx], folder=f"rounds/ranks-{rk}",
+                        shot_folder=lambda out, j, idx=idx: out.parent.parent / "runs" / names[idx[j]], batch=False,
                         label=f"runs on {rk} rank{'s' if rk > 1 else ''}", process=rk)
 
     def result(self, plan: CostPlan, records: list, info) -> dict:

@@ -98,14 +98,16 @@ def boundary(speeds, margins) -> float | None:
 
 
 def table(plan: SafetyPlan, records: dict) -> list[dict]:
-    """One row per point: its speed, angles, status, governing criterion and margin, every criterion's margin,
-    the depth and final axis angle, whether it lies inside the validated envelope."""
+    """One row per point: its speed, angles, status (ok, or why it has no verdict: bad-input, stopped, missing),
+    the shot's outcome and the message of a shot that did not finish, governing criterion and margin, every
+    criterion's margin, the depth and final axis angle, whether it lies inside the validated envelope."""
     rows = []
     for i, (v, o, a) in enumerate(plan.points):
         r = records.get(i, {"status": "missing", "summary": None, "message": ""})
         s = r.get("summary") or {}
         cs = s.get("charge_safety") or {}
         row = {"point": i, "velocity_m_s": v, "obliquity_deg": o, "attack_deg": a, "status": r["status"],
+               "outcome": s.get("outcome"), "message": r.get("message") or None,
                "governing": cs.get("governing"), "margin": cs.get("margin")}
         for name in NAMES:
             c = cs.get(name) or {}

@@ -28,7 +28,7 @@ from pathlib import Path
 
 from mpi4py import MPI
 
-from fepen.errors import InputError, SimulationError
+from fepen.errors import InputError, Interrupted, SimulationError
 from fepen.io import rundir
 
 __all__ = ["execute", "summaries", "run_shot", "run_shots", "process_shot", "How", "read_records",
@@ -42,6 +42,8 @@ POLL = 5e-4
 SYNC = 1.0
 #: shots of a request when the caller asks for batches (rigid shots: fepen.runs.batch)
 BATCH = 32
+#: the status of a shot a signal stopped: never recorded (it runs again when the study is continued)
+INTERRUPTED = "interrupted"
 
 
 def check_ranks_per_shot(ranks_per_shot: int, ranks: int) -> None:
@@ -83,6 +85,7 @@ class _Log:
 
         self.records, self.bar, self.f = records, bar, None
         self.synced = time.monotonic()
+        self.added, self.halted = 0, False  # records written now; a shot a signal stopped
         if out is None:  # the records in memory alone (a study's quick calibration)
             return
         self.path = Path(out) / RECORDS
@@ -94,6 +97,10 @@ class _Log:
                     self.f.write("\n")
 
     def add(self, record: dict) -> None:
+        if record["status"] == INTERRUPTED:  # unfinished: it runs again when the study is continued
+            self.halted = True
+            return
+        self.added += 1
         if self.f is not None:
             self.f.write(json.dumps(record, default=float) + "\n")
             self.f.flush()
@@ -134,7 +141,7 @@ def run_shot(i: int, scene, out, comm) -> dict:
             setup.announce(scene, comm, sh.built)
             summary = run_in_directory(scene, out, comm, "force", sh=sh)  # the study owns its shots' folders
             summary = json.loads(json.dumps(summary))  # as summary.json holds it (and shots.jsonl gives it back)
-    except (SimulationError, InputError) as err:
+    except (SimulationError, InputError, Interrupted) as err:  # Interrupted: a signal; the study stops after it
         summary = err
     return _record(i, summary, time.perf_counter() - t0, comm)
 
@@ -142,7 +149,9 @@ def run_shot(i: int, scene, out, comm) -> dict:
 def _record(i: int, result, wall: float, comm) -> dict:
     """A shot's record from its summary or the SimulationError or InputError it raised."""
     summary, status, message = None, "ok", ""
-    if isinstance(result, SimulationError):
+    if isinstance(result, Interrupted):  # not recorded: the shot runs again when the study is continued
+        status, message = INTERRUPTED, str(result)
+    elif isinstance(result, SimulationError):
         status, message = "stopped", str(result)
     elif isinstance(result, InputError):
         status, message = "bad-input", f"{result.key}: {result.message}"
@@ -243,7 +252,7 @@ def process_shot(i: int, scene, out: Path, ranks: int) -> dict:
 
 def execute(n: int, scene_of, out, comm=None, ranks_per_shot: int = 1, keep=None, say=None,
             desc: str = "shots", batch: int = 1, progress: bool = True, folder=None,
-            process: int = 0) -> tuple[dict, int]:
+            process: int = 0, stop=None) -> tuple[dict, int, bool]:
     """Run the shots 0 … n−1 not yet recorded in OUT/shots.jsonl.
 
     Args:
@@ -256,9 +265,13 @@ def execute(n: int, scene_of, out, comm=None, ranks_per_shot: int = 1, keep=None
             stderr (bar_disabled: on a terminal, or FEPEN_PROGRESS=1).
         folder: (out, index) -> the folder of a shot that keeps its results (None: OUT/shots/NNNNN).
         process: 0, or each shot a whole ``fepen run`` process on this many ranks (How).
+        stop: the study's fepen.runs.interrupts.Interrupts, or None: a signal it catches (or a shot stopped by one)
+            ends the round at its next shot boundary: no new shot starts, the shots in flight end (a deformable
+            one at its next check, with a checkpoint) and are not recorded, so that they run again.
 
     Returns:
-        ({shot: record} of every finished shot on rank 0, {} elsewhere; the number of shots run now).
+        ({shot: record} of every finished shot on rank 0, {} elsewhere; the number of shots recorded now (rank
+        0); whether a signal stopped the round on this rank's side (rank 0: on any group's)).
     """
     comm = MPI.COMM_WORLD if comm is None else comm
     k = ranks_per_shot
@@ -285,25 +298,35 @@ def execute(n: int, scene_of, out, comm=None, ranks_per_shot: int = 1, keep=None
     level = quiet.level
     quiet.setLevel(logging.ERROR)  # the shots' notes were said once when the study was read
     interval = sys.getswitchinterval()
+    halted = _halting(stop)
     try:
-        runs = chunks(pending, batch, groups)
+        runs = [] if halted else chunks(pending, batch, groups)
         if comm.size == 1:
             for run in runs:
                 for r in run_shots(run, scene_of, out, comm, how):
                     log.add(r)
+                if _halting(stop) or log.halted:
+                    break
         elif MPI.Query_thread() < MPI.THREAD_MULTIPLE:  # no dispatcher thread: a fixed round robin
             if comm.rank == 0 and say is not None:
                 say(f"{desc}: this MPI has no MPI_THREAD_MULTIPLE: shots go round robin, not by a queue")
-            _round_robin(runs, scene_of, out, comm, k, how, log)
+            _round_robin(runs, scene_of, out, comm, k, how, log, stop)
         else:
             sys.setswitchinterval(1e-3)  # rank 0's dispatcher answers within a millisecond or so
-            _parallel(runs, scene_of, out, comm, k, how, log)
+            _parallel(runs, scene_of, out, comm, k, how, log, stop)
     finally:
         quiet.setLevel(level)
         sys.setswitchinterval(interval)
         if log is not None:
             log.close()
-    return records, len(pending)
+    halted = halted or _halting(stop) or (log is not None and log.halted)
+    return records, (log.added if log is not None else 0), halted
+
+
+def _halting(stop, records=()) -> bool:
+    """A signal asks the shots to stop (``stop``: the study's Interrupts), or one of ``records`` is a shot a signal
+    stopped."""
+    return bool(stop is not None and stop.caught) or any(r["status"] == INTERRUPTED for r in records)
 
 
 def _shot_dir(out: Path, i: int) -> Path:
@@ -311,26 +334,29 @@ def _shot_dir(out: Path, i: int) -> Path:
 
 
 
-def _parallel(runs, scene_of, out, comm, k, how, log) -> None:
+def _parallel(runs, scene_of, out, comm, k, how, log, stop=None) -> None:
     group = comm.Split(comm.rank // k, comm.rank)
     queue = comm.Dup()
     groups = comm.size // k
     dispatcher = None
     if comm.rank == 0:
-        dispatcher = threading.Thread(target=_dispatch, args=(queue, list(runs), groups, log), daemon=True)
+        dispatcher = threading.Thread(target=_dispatch, args=(queue, list(runs), groups, log, stop), daemon=True)
         dispatcher.start()
     try:
-        records = None
+        records, halt = None, False
         while True:
             run = None
             if group.rank == 0:
-                queue.send(records, dest=0, tag=_REQUEST)
+                queue.send((records, halt), dest=0, tag=_REQUEST)
                 run = queue.recv(source=0, tag=_REPLY)
             run = group.bcast(run, root=0)
             if not run:
                 break
             rs = run_shots(run, scene_of, out, group, how)
             records = rs if group.rank == 0 else None
+            halt = _halting(stop, rs)
+            if group.size > 1:  # a signal to any rank of the group
+                halt = group.allreduce(halt, op=MPI.LOR)
     finally:
         if dispatcher is not None:
             dispatcher.join()
@@ -338,7 +364,7 @@ def _parallel(runs, scene_of, out, comm, k, how, log) -> None:
         queue.Free()
 
 
-def _round_robin(runs, scene_of, out, comm, k, how, log) -> None:
+def _round_robin(runs, scene_of, out, comm, k, how, log, stop=None) -> None:
     group = comm.Split(comm.rank // k, comm.rank)
     mine = []
     for run in runs[comm.rank // k:: comm.size // k]:
@@ -348,26 +374,33 @@ def _round_robin(runs, scene_of, out, comm, k, how, log) -> None:
                 log.add(r)
         elif group.rank == 0:
             mine.extend(rs)
+        halt = _halting(stop, rs)
+        if group.size > 1 and group.allreduce(halt, op=MPI.LOR) or group.size == 1 and halt:
+            break
     for part in comm.gather(mine, root=0) or []:
         for r in part:
             log.add(r)
     group.Free()
 
 
-def _dispatch(queue, runs: list, groups: int, log) -> None:
+def _dispatch(queue, runs: list, groups: int, log, stop=None) -> None:
     """Rank 0's thread: hand out the pending runs of shots in order to whichever leader asks, record what they
-    send back, tell each leader to stop (an empty run) when none is left."""
+    send back, tell each leader to stop (an empty run) when none is left, or when a signal stopped a group (it
+    says so with its request) or rank 0 (``stop``)."""
     status = MPI.Status()
-    nxt, stopped = 0, 0
+    nxt, stopped, halted = 0, 0, False
     while stopped < groups:
         if not queue.Iprobe(source=MPI.ANY_SOURCE, tag=_REQUEST, status=status):
             time.sleep(POLL)
             continue
         src = status.Get_source()
-        records = queue.recv(source=src, tag=_REQUEST)
+        records, halt = queue.recv(source=src, tag=_REQUEST)
         for record in records or ():
             log.add(record)
-        if nxt < len(runs):
+        halted = halted or halt or _halting(stop)
+        if halted:
+            log.halted = True
+        if nxt < len(runs) and not halted:
             queue.send(runs[nxt], dest=src, tag=_REPLY)
             nxt += 1
         else:
@@ -384,7 +417,7 @@ def summaries(scenes, comm=None) -> list:
         scenes: resolved Scenes. comm: the communicator (None: COMM_SELF); every rank gets the summaries.
     """
     comm = MPI.COMM_SELF if comm is None else comm
-    records, _ = execute(len(scenes), lambda i: scenes[i], None, comm, keep=lambda sc: False, batch=BATCH,
+    records, _, _ = execute(len(scenes), lambda i: scenes[i], None, comm, keep=lambda sc: False, batch=BATCH,
                          progress=False)
     records = comm.bcast(records if comm.rank == 0 else None, root=0) if comm.size > 1 else records
     out = []

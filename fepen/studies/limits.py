@@ -14,6 +14,7 @@ obliquity × speed grid.
 
 from __future__ import annotations
 
+import os
 from dataclasses import dataclass
 
 import numpy as np
@@ -98,8 +99,11 @@ def scene_line(sc) -> str:
 
         if fc and TARGETS.get(sc.get("target.material"), {}).get("family") in ("concrete", "rock"):
             target += f", f_c {fc / 1e6:g} MPa"
-    return (f"{sc.get('effects.fidelity')} fidelity; {sc.get('projectile.mass') * 1e3:g} g, "
-            f"{sc.get('projectile.diameter') * 1e3:g} mm projectile; {target}")
+    mass, diameter = sc.get("projectile.mass"), sc.get("projectile.diameter")
+    drawn = sc.get("projectile.profile") or sc.get("projectile.cad")
+    body = (f"{mass * 1e3:g} g, {diameter * 1e3:g} mm projectile" if mass and diameter
+            else f"the projectile of {os.path.basename(drawn)}" if drawn else "the projectile")
+    return f"{sc.get('effects.fidelity')} fidelity; {body}; {target}"
 
 
 def _summaries(r: int, records: dict, n: int) -> list[dict]:

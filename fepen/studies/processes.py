@@ -4,8 +4,10 @@ ranks > 1 (studies, demos, benchmarks and tests all start them here)."""
 from __future__ import annotations
 
 import os
+import signal
 import subprocess
 import sys
+import threading
 import time
 from pathlib import Path
 
@@ -35,9 +37,28 @@ def launcher(python: str | Path | None = None) -> str | None:
 
 
 def command(args, ranks: int = 1, fepen: bool = True) -> list[str]:
-    """``python -m fepen ARGS`` (or ``python ARGS`` with fepen=False), under the launcher when ranks > 1."""
+    """``python -m fepen ARGS`` (or ``python ARGS`` with fepen=False), under the launcher when ranks > 1 (Open MPI's
+    quietly: without the banner it prints after a rank's non-zero exit, or its note of a forwarded signal,
+    below fepen's own line)."""
     cmd = [sys.executable, *(["-m", "fepen"] if fepen else []), *map(str, args)]
-    return [launcher() or "mpirun", "-n", str(ranks), *cmd] if ranks > 1 else cmd
+    if ranks <= 1:
+        return cmd
+    run = launcher() or "mpirun"
+    return [run, *(["-q"] if _open_mpi(run) else []), "-n", str(ranks), *cmd]
+
+
+def _open_mpi(run: str) -> bool:
+    """The launcher is Open MPI's (which knows -q), by what it says of itself (remembered per path)."""
+    if run not in _OPEN_MPI:
+        try:
+            text = subprocess.run([run, "--version"], capture_output=True, text=True, timeout=30).stdout
+        except (OSError, subprocess.SubprocessError):
+            text = ""
+        _OPEN_MPI[run] = "Open MPI" in text or "OpenRTE" in text
+    return _OPEN_MPI[run]
+
+
+_OPEN_MPI: dict[str, bool] = {}
 
 
 def rank_pids(launcher_pid: int) -> list[int]:
@@ -88,12 +109,60 @@ def run_fepen_process(args: list[str], ranks: int = 1) -> tuple[int, float, str]
     return r.returncode, wall, (lines[-1] if lines else r.stderr.strip()[-400:])
 
 
+#: the signals a relaunching command passes on to the ranks it started (as SIGUSR1, which the launcher forwards
+#: to every rank without ending them: fepen.runs.interrupts)
+FORWARDED = (signal.SIGTERM, signal.SIGINT, signal.SIGHUP)
+
+
 def relaunch(argv: list, workers: int) -> int:
     """A study command started without mpirun on a machine that has it (``fepen sweep``, ``fepen validate``,
     ``fepen validate-depth``): the same command again as ``mpirun -n WORKERS python -m fepen ARGV --workers 1``,
     whose ranks share the shots (the caller checked its input first, and sets FEPEN_PROGRESS for the bar).
-    Returns that process's exit code."""
-    return subprocess.run(command([*map(str, argv), "--workers", "1"], workers), env=mpi_env()).returncode
+
+    The launcher runs in a session of its own, so that Ctrl-C and a scheduler's signal reach this process only,
+    which passes SIGTERM, SIGINT and SIGHUP on as SIGUSR1: Open MPI's mpirun and MPICH's mpiexec forward SIGUSR1
+    to every rank (their own SIGTERM would end the ranks within a second), and every rank stops at its next shot
+    boundary, records the study resumable and ends; this process waits for them. A second SIGINT (Ctrl-C twice)
+    is passed on as SIGTERM: the ranks end at once. Should this process be killed outright, the kernel sends the
+    launcher SIGUSR1 (PR_SET_PDEATHSIG, Linux): its ranks stop the same way, never left running into OUT.
+
+    Returns:
+        The launcher's exit code.
+    """
+    proc = subprocess.Popen(command([*map(str, argv), "--workers", "1"], workers), env=mpi_env(),
+                            start_new_session=True, preexec_fn=_usr1_when_parent_dies)
+    caught: list[int] = []
+
+    def forward(signum, frame) -> None:
+        second = signum == signal.SIGINT and signal.SIGINT in caught
+        caught.append(signum)
+        try:
+            proc.send_signal(signal.SIGTERM if second else signal.SIGUSR1)
+        except OSError:  # gone meanwhile
+            pass
+
+    previous = {}
+    if threading.current_thread() is threading.main_thread():
+        previous = {sig: signal.signal(sig, forward) for sig in FORWARDED}
+    try:
+        while True:
+            try:
+                return proc.wait()
+            except KeyboardInterrupt:  # a handler of a caller's: keep waiting for the ranks
+                continue
+    finally:
+        for sig, handler in previous.items():
+            signal.signal(sig, handler)
+
+
+def _usr1_when_parent_dies() -> None:
+    """In the launcher's process before it starts: SIGUSR1 to it when the relaunching process dies (Linux)."""
+    try:
+        import ctypes
+
+        ctypes.CDLL(None, use_errno=True).prctl(1, signal.SIGUSR1, 0, 0, 0)  # PR_SET_PDEATHSIG
+    except (OSError, AttributeError):  # not Linux: the signal handlers alone
+        pass
 
 
 def relaunch_sweep(sweep_file, out, ranks_per_shot: int, workers: int, sets=(), fresh: bool = False) -> int:

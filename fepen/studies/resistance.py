@@ -95,7 +95,7 @@ def calibrate(base: dict, comm=None, lambdas=LAMBDA_GRID) -> Response:
     comm = MPI.COMM_SELF if comm is None else comm
     keys = calibration_scene_keys(base)
     scenes = [fscene.Scene({**keys, RESISTANCE: float(lam)}) for lam in lambdas]
-    done, _ = engine.execute(len(scenes), lambda i: scenes[i], None, comm, keep=lambda sc: False, batch=engine.BATCH,
+    done, _, _ = engine.execute(len(scenes), lambda i: scenes[i], None, comm, keep=lambda sc: False, batch=engine.BATCH,
                              progress=False)  # the records in memory: a second to run again
     records = [done[i] for i in range(len(scenes))]
     one = list(lambdas).index(1.0)

@@ -24,7 +24,10 @@ from collections.abc import Callable, Iterator, Sequence
 from dataclasses import dataclass, field
 from pathlib import Path
 
-__all__ = ["Round", "Sub", "Study", "RunInfo", "run", "register", "get", "public", "set_option", "numbers",
+from fepen.io import layout
+
+__all__ = ["Round", "Sub", "Study", "RunInfo", "run", "failed", "inputs_of", "scene_files", "canonical_digest",
+           "register", "get", "public", "set_option", "numbers",
            "STUDIES", "REGISTRY", "study_names"]
 
 #: every study by name, in the order the command line lists them: (its module, its class). A module is imported
@@ -52,6 +55,7 @@ def register(cls: type) -> type:
     if STUDIES.get(cls.name, (None, None))[1] != cls.__name__:
         raise ValueError(f"study {cls.name!r} ({cls.__name__}) is not in fepen.studies.study.STUDIES")
     REGISTRY[cls.name] = cls
+    layout.declare(cls.name, cls.names)  # what its folder may hold: the one declaration --fresh removes by
     return cls
 
 
@@ -70,6 +74,14 @@ def get(name: str) -> type:
 
         importlib.import_module(STUDIES[name][0])
     return REGISTRY[name]
+
+
+def _names_of(kind: str) -> tuple:
+    """A study's declared names by its kind (fepen.io.layout asks for a study it has not met in this process)."""
+    return get(kind).names
+
+
+layout.study_names = _names_of
 
 
 def study_names(command: str | None = None) -> list[str]:
@@ -159,8 +171,9 @@ class Study:
         raise NotImplementedError
 
     def digest(self, plan) -> str | None:
-        """What makes the folder resumable: a folder of the same study with another digest is refused."""
-        return None
+        """What makes the folder resumable: a folder of the same study with another digest is refused (by
+        default the plan's fields, its scenes resolved: canonical_digest)."""
+        return canonical_digest(plan)
 
     def prepare(self, plan, out: Path, comm) -> None:
         """Before the first round (every rank; the folder claimed): e.g. the tables of what is drawn."""
@@ -236,6 +249,7 @@ class RunInfo:
     say: Callable = print
     ran: int = 0
     records: list = field(default_factory=list)
+    stop: object = None  #: the study's fepen.runs.interrupts.Interrupts while its rounds run
 
     @property
     def wall_s(self) -> float:
@@ -266,18 +280,166 @@ def run(study: Study, plan, out, comm=None, ranks_per_shot: int = 1, fresh: bool
     comm = MPI.COMM_WORLD if comm is None else comm
     engine.check_ranks_per_shot(ranks_per_shot, comm.size)
     info = RunInfo(time.perf_counter(), comm.size, ranks_per_shot, say)
-    digest = study.digest(plan)
-    with rundir.study_directory(out, comm, fresh, study.name, study.names, digest=digest):
+    inputs = inputs_of(study, plan)
+    with rundir.study_directory(out, comm, fresh, study.name, study.names, digest=inputs["sha256"], inputs=inputs):
         out = files.prepare(Path(out), comm)
         study.prepare(plan, out, comm)
-        _rounds(study, plan, out, comm, info, progress)
-        result = None
+        from fepen.runs.interrupts import Interrupts
+
+        with Interrupts(comm) as info.stop:  # a signal stops the study at its next shot boundary
+            _rounds(study, plan, out, comm, info, progress)
+        result, failure = None, None
         if comm.rank == 0:
-            result = study.result(plan, info.records, info)
-            study.write(plan, result, out, info)
-            say(*study.lines(result))
-            result = {"wall_s": info.wall_s, "ran": info.ran, **public(result)}
-        return comm.bcast(result, root=0)
+            failure = failed(info.records)
+            if failure is None:
+                result = study.result(plan, info.records, info)
+                study.write(plan, result, out, info)
+                say(*study.lines(result))
+                result = {"wall_s": info.wall_s, "ran": info.ran, **public(result)}
+            else:
+                _write_what_failed(study, plan, out, info)
+        result, failure = comm.bcast((result, failure), root=0) if comm.size > 1 else (result, failure)
+        if failure is not None:
+            raise failure
+        return result
+
+
+def failed(records: list) -> Exception | None:
+    """The error of a study none of whose shots finished (every one refused, stopped or failed), or None.
+
+    Args:
+        records: the rounds' records ({shot: record} each, fepen.studies.engine).
+
+    Returns:
+        InputError (exit 2) when the first failed shot was refused, SimulationError (3) when it stopped,
+        MachineFault (4) when its process failed; its message names the counts and the first shot's reason.
+    """
+    from fepen.errors import InputError, MachineFault, SimulationError
+
+    shots = [r for recs in records if isinstance(recs, dict) for r in recs.values()
+             if isinstance(r, dict) and "status" in r]
+    if not shots or any(r["status"] == "ok" for r in shots):
+        return None
+    first = min(shots, key=lambda r: r.get("shot", 0))
+    counts = {}
+    for r in shots:
+        counts[r["status"]] = counts.get(r["status"], 0) + 1
+    what = ", ".join(f"{n} {k}" for k, n in sorted(counts.items()))
+    reason = first.get("message") or first["status"]
+    message = f"no shot finished ({what}); shot {first.get('shot', 0)}: {reason}"
+    if first["status"] == "bad-input":
+        return InputError("study", message)
+    if first["status"] == "stopped":
+        return SimulationError(message)
+    return MachineFault(message)
+
+
+def _write_what_failed(study: Study, plan, out: Path, info: RunInfo) -> None:
+    """The tables of a study none of whose shots finished, as far as its result can be made (each point's
+    outcome is in them); a result that cannot be made of failed shots writes nothing more (rank 0)."""
+    import logging
+
+    try:
+        result = study.result(plan, info.records, info)
+        study.write(plan, result, out, info)
+    except Exception as err:  # noqa: BLE001 - the shots' failure is the one to report
+        logging.getLogger("fepen").debug(f"no table of the failed shots: {type(err).__name__}: {err}")
+
+
+def inputs_of(study: Study, plan) -> dict:
+    """What a study's results are made of, for its record (run.json "inputs"): the study's own digest (its
+    shots' given keys, fepen.studies.study.Study.digest), fepen's version, every data file fepen ships
+    (fepen.data.digests: the named targets, steels and explosives the shots resolve to) and every file the
+    shots read (a drawn profile, a CAD body) by content; ``sha256`` of them all. A continued study refuses a
+    folder whose inputs differ (fepen.io.rundir), naming what changed, before any shot runs.
+
+    Returns:
+        {"sha256", "study", "fepen", "data": {path: sha}, "files": {path: sha}}.
+    """
+    import hashlib
+    import json
+
+    from fepen import data
+    from fepen.atomic import sha256_file
+    from fepen.errors import InputError
+    from fepen.version import __version__
+
+    files = {}
+    for key, path in scene_files(plan):
+        try:
+            files[path] = sha256_file(path)
+        except OSError as err:
+            raise InputError(key, f"cannot be read: {err.strerror or err} ({path})") from None
+    parts = {"study": study.digest(plan), "fepen": __version__, "data": data.digests(), "files": files}
+    blob = json.dumps(parts, sort_keys=True, default=str)
+    return {"sha256": hashlib.sha256(blob.encode()).hexdigest()[:16], **parts}
+
+
+def scene_files(plan) -> list[tuple[str, str]]:
+    """(key, absolute path) of every file the plan's scenes name (fepen.runs.setup.FILE_KEYS: a drawn profile, a
+    CAD body), found in its fields: Scenes, a sweep's spec (its base and shots), dicts and lists of them."""
+    import os
+    from dataclasses import fields, is_dataclass
+
+    from fepen.runs.setup import FILE_KEYS
+    from fepen.scene import Scene
+
+    found: dict[str, str] = {}
+
+    def given(values: dict) -> None:
+        for k in FILE_KEYS:
+            if isinstance(values.get(k), str) and values[k]:
+                found.setdefault(os.path.abspath(values[k]), k)
+
+    def visit(obj, depth: int = 0) -> None:
+        if depth > 4:
+            return
+        if isinstance(obj, Scene):
+            given({k: obj.get(k) for k in FILE_KEYS})
+        elif isinstance(obj, dict):
+            given(obj)
+            for v in obj.values():
+                if isinstance(v, (Scene, dict, list, tuple)) or is_dataclass(v):
+                    visit(v, depth + 1)
+        elif isinstance(obj, (list, tuple)):
+            for v in obj[:1] if obj and not isinstance(obj[0], (Scene, dict)) else obj:
+                visit(v, depth + 1)
+        elif is_dataclass(obj) and not isinstance(obj, type):
+            for f in fields(obj):
+                visit(getattr(obj, f.name), depth + 1)
+
+    visit(plan)
+    return sorted((k, p) for p, k in found.items())
+
+
+def canonical_digest(*parts) -> str:
+    """A digest of a study's own inputs (its plan's scenes resolved, flat; numbers, texts, lists, dicts) for
+    ``Study.digest``: the same inputs, the same 16 hex digits on any machine."""
+    import hashlib
+    import json
+
+    from fepen.scene import Scene, flatten
+
+    def plain(x):
+        if isinstance(x, Scene):
+            return flatten(x.as_dict())
+        if hasattr(x, "__dataclass_fields__"):
+            return {k: plain(getattr(x, k)) for k in x.__dataclass_fields__}
+        if isinstance(x, dict):
+            return {str(k): plain(v) for k, v in x.items()}
+        if isinstance(x, (list, tuple)):
+            return [plain(v) for v in x]
+        return x
+
+    def other(x):
+        if isinstance(x, Path):
+            return str(x)
+        if hasattr(x, "item") and hasattr(x, "dtype"):  # a numpy scalar
+            return x.item()
+        raise TypeError(f"a study's digest holds plain values, not {type(x).__name__}")
+
+    blob = json.dumps(plain(list(parts)), sort_keys=True, default=other)
+    return hashlib.sha256(blob.encode()).hexdigest()[:16]
 
 
 def public(result: dict) -> dict:
@@ -287,7 +449,10 @@ def public(result: dict) -> dict:
 
 def _rounds(study: Study, plan, out: Path, comm, info: RunInfo, progress: bool) -> None:
     """Drive the study's rounds on the executor, each round's records into info.records (rank 0's; the other
-    ranks' only for a round whose records decide the next, Round.then)."""
+    ranks' only for a round whose records decide the next, Round.then); a signal ends them at a shot boundary
+    (Interrupted on every rank: the study's record says "interrupted", and the same command continues it)."""
+    from mpi4py import MPI
+
     from fepen.studies import engine
 
     gen = study.rounds(plan)
@@ -308,20 +473,30 @@ def _rounds(study: Study, plan, out: Path, comm, info: RunInfo, progress: bool) 
             from fepen.io import files
 
             files.agree(comm, str(folder), lambda f=folder: make_dir(f))
-        recs, ran = engine.execute(len(rnd.scenes), lambda i, s=rnd.scenes: s[i], folder, comm, info.ranks_per_shot,
-                                   keep=rnd.keep, say=info.say if rnd.label else None, desc=rnd.label or "shots",
-                                   batch=engine.BATCH if rnd.batch else 1, progress=progress,
-                                   folder=rnd.shot_folder, process=rnd.process)
         if comm.rank == 0:
             _own_folders(out, folder, rnd)
+        recs, ran, halted = engine.execute(len(rnd.scenes), lambda i, s=rnd.scenes: s[i], folder, comm,
+                                           info.ranks_per_shot, keep=rnd.keep, say=info.say if rnd.label else None,
+                                           desc=rnd.label or "shots", batch=engine.BATCH if rnd.batch else 1,
+                                           progress=progress, folder=rnd.shot_folder, process=rnd.process,
+                                           stop=info.stop)
+        if (comm.allreduce(halted, op=MPI.LOR) if comm.size > 1 else halted):
+            from fepen.errors import Interrupted
+
+            what = info.stop.name if info.stop is not None and info.stop.name else "a signal to another rank"
+            what = "a signal passed on through mpirun (SIGUSR1)" if what == "SIGUSR1" else what
+            raise Interrupted(f"{what} stopped the {study.name} at a shot boundary, {info.ran + ran} shot(s) "
+                              "recorded now; the same command continues it (the shots in flight run again)")
         records = comm.bcast(recs if comm.rank == 0 else None, root=0) if rnd.then and comm.size > 1 else recs
         info.records.append(records)
         info.ran += ran
 
 
 def _own_folders(out: Path, folder: Path, rnd: Round) -> None:
-    """Rank 0: the kept shots' folders in the study's manifest, whichever group made them (the other ranks'
-    writes are not recorded where they happen: fepen.atomic.Claim's strict owner is rank 0)."""
+    """Rank 0, before the round: the top-level folders its kept shots will be in (OUT/shots, OUT/runs, OUT/C1, ...)
+    in the study's manifest before any group makes them (the other ranks' writes, and a shot run as a process of
+    its own, are not recorded where they happen: fepen.atomic.Claim's strict owner is rank 0). A name already
+    there stays what it is (a user's was refused when the folder was claimed)."""
     import os
 
     from fepen import atomic
@@ -337,6 +512,6 @@ def _own_folders(out: Path, folder: Path, rnd: Round) -> None:
             tops.add(Path(os.path.abspath(how.where(folder, i))).relative_to(claim.dir).parts[0])
         except (ValueError, IndexError):
             continue
-    for top in sorted(tops):
-        if (claim.dir / top).is_dir() and not (claim.dir / top).is_symlink():
+    for top in sorted(tops):  # a study that declares no folder of its shots keeps none
+        if not os.path.lexists(claim.dir / top) and claim.declared is not None and claim.declared(top):
             claim.own(top)

@@ -82,7 +82,7 @@ def test_another_sweep_into_the_same_directory_is_refused(mc, tmp_path):
     other.write_text(sweep.resized(DEMO, N + 1, seed=11))
     r = run_fepen("sweep", other, "--out", mc / "serial", "--workers", "1")
     assert r.returncode == 2
-    assert "--out" in r.stderr and "another sweep" in r.stderr and "Traceback" not in r.stderr
+    assert "--out" in r.stderr and "sweep made of other inputs (its shots" in r.stderr and "Traceback" not in r.stderr
 
 
 GRID = """scene = "{root}/scenes/default.toml"

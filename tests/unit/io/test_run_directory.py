@@ -29,9 +29,8 @@ def test_second_run_into_a_finished_run_refuses_then_force_clears(tmp_path, caps
     out = tmp_path / "run"
     assert fepen(capsys, "run", *RIGID, "--out", out)[0] == 0
     record = json.loads((out / "run.json").read_text())
-    (out / "extra.csv").write_text("a file the earlier run wrote")  # as if that run had written one more file
-    json.dumps(record)
-    (out / "run.json").write_text(json.dumps({**record, "files": [*record["files"], "extra.csv"]}))
+    (out / "hazard.csv").write_text("a file the earlier run wrote")  # as if that run had written one more file
+    (out / "run.json").write_text(json.dumps({**record, "files": [*record["files"], "hazard.csv"]}))
     (out / "notes.txt").write_text("mine")  # the user's own file
     code, _, err = fepen(capsys, "run", *RIGID, "--set", "impact.velocity=700", "--out", out)
     assert code == 2 and len(err) == 1 and err[0].startswith("fepen: bad input: --out:")
@@ -39,7 +38,7 @@ def test_second_run_into_a_finished_run_refuses_then_force_clears(tmp_path, caps
     assert json.loads((out / "summary.json").read_text())["scene"]["impact"]["velocity"] != 700.0  # untouched
     code, _, err = fepen(capsys, "run", *RIGID, "--set", "impact.velocity=700", "--out", out, "--force")
     assert code == 0, err
-    assert not (out / "extra.csv").exists() and (out / "notes.txt").read_text() == "mine"
+    assert not (out / "hazard.csv").exists() and (out / "notes.txt").read_text() == "mine"
     assert json.loads((out / "summary.json").read_text())["scene"]["impact"]["velocity"] == 700.0
     assert "notes.txt" not in json.loads((out / "run.json").read_text())["files"]
 

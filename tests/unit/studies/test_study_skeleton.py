@@ -30,7 +30,7 @@ def test_a_new_study_is_one_short_file_that_fepen_study_runs(tmp_path):
     assert json.loads((out / "run.json").read_text())["kind"] == "toy-ladder"
     again = fepen.study("toy-ladder", out=out, speeds=[400.0, 800.0])  # resumed from its records: no shot runs
     assert again["ran"] == 0 and again["depth_mm"] == res["depth_mm"]
-    with pytest.raises(InputError, match="another toy-ladder"):
+    with pytest.raises(InputError, match="toy-ladder made of other inputs"):
         fepen.study("toy-ladder", out=out, speeds=[500.0])
     assert math.isfinite(fepen.study("toy-ladder", out=out, fresh=True, speeds=[500.0, 600.0])["depth_mm"][0])
 
