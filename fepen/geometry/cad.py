@@ -9,8 +9,8 @@ from __future__ import annotations
 
 import hashlib
 import math
+import os
 from dataclasses import dataclass, replace
-from pathlib import Path
 from typing import ClassVar
 
 import numpy as np
@@ -85,8 +85,30 @@ class CadBody:
 
 
 def digest(path: str) -> str:
-    """A short hash of the file's bytes (mesh-cache key): a changed file is meshed again."""
-    return hashlib.sha256(Path(path).read_bytes()).hexdigest()[:16]
+    """A short hash of the file's bytes (mesh-cache key): a changed file is meshed again. Read as probe checks
+    it (a regular file, opened without blocking), in blocks."""
+    h = hashlib.sha256()
+    with _opened(path) as fh:
+        for block in iter(lambda: fh.read(1 << 20), b""):
+            h.update(block)
+    return h.hexdigest()[:16]
+
+
+def _opened(path: str):
+    """The CAD file open for reading: a regular file of at most CAD_MAX bytes, checked without blocking (a pipe
+    or a device named projectile.cad is refused, not read for ever). InputError (projectile.cad) else."""
+    from fepen.scene.resolve import open_input, unreadable
+
+    try:
+        fh = open_input(path)
+    except (OSError, ValueError) as err:
+        raise unreadable(err, path, "projectile.cad", "a STEP or BREP body", missing=f"no such file: {path}") from None
+    size = os.fstat(fh.fileno()).st_size
+    if size > CAD_MAX:
+        fh.close()
+        raise InputError("projectile.cad", f"{path!r} is {size} bytes: a STEP or BREP body is at most "
+                                           f"{CAD_MAX >> 20} MiB")
+    return fh
 
 
 def _import(path: str, scale: float) -> list:
@@ -123,11 +145,7 @@ def probe(path: str, scale: float) -> tuple[float, float]:
     """
     import gmsh
 
-    if not Path(path).is_file():
-        raise InputError("projectile.cad", f"no such file: {path}")
-    from fepen.atomic import input_file
-
-    input_file(path, "projectile.cad", CAD_MAX, "a STEP or BREP body")
+    _opened(path).close()  # gmsh opens it by name: checked here first
     _import(path, scale)
     xmin, ymin, zmin, xmax, ymax, zmax = gmsh.model.getBoundingBox(-1, -1)
     gmsh.model.remove()

@@ -270,27 +270,34 @@ def min_radius(path: list[Segment], z0: float, z1: float) -> float:
 # ---------------------------------------------------------------------------------------------------------
 #: the largest drawn profile read (bytes): a few thousand rows are a few hundred kB
 PROFILE_MAX = 16 << 20
+#: the most points a drawn profile holds: each segment between two is a panel of the rigid fidelity's load rings
+#: and a curve of the meshed body's outline (a rigid shot of the default body drawn with 200 points, 5,472 load
+#: points: 1.5 s; 2,000 points, 48,672 load points: 3.4 s; 20,000 points: 27 s; 200,000: 9 minutes and 3.9 GB);
+#: an arc row draws a curve exactly with one segment
+PROFILE_POINTS_MAX = 2000
 
 
 def read_points(path: str, key: str) -> list[tuple[float, float, float]]:
-    """A drawn profile: rows ``z_m, r_m[, arc_radius_m]`` (a header line allowed, # comments). The segment
-    into each point is straight, or a circle arc of that radius when arc_radius_m is not 0: positive bulging
-    away from the axis (convex, an ogive), negative toward it.
+    """A drawn profile: rows ``z_m, r_m[, arc_radius_m]`` (a header line allowed, # comments), at most
+    PROFILE_POINTS_MAX of them. The segment into each point is straight, or a circle arc of that radius when
+    arc_radius_m is not 0: positive bulging away from the axis (convex, an ogive), negative toward it.
 
     Args:
-        path: the CSV file. key: the scene key that names it (for the error message).
+        path: the CSV file: a regular file (not a pipe or a device, checked without blocking) of at most
+            PROFILE_MAX bytes. key: the scene key that names it (for the error message).
 
     Returns:
         [(z, r, arc)] in file order. Raises InputError naming ``key`` when unreadable.
     """
-    from fepen.atomic import input_file
     from fepen.errors import InputError
+    from fepen.scene.resolve import read_capped
 
-    input_file(path, key, PROFILE_MAX, "the profile")  # a regular file, not a device read forever
+    data = read_capped(path, PROFILE_MAX, key, "the profile",
+                       missing=f"cannot read the profile {path!r}: No such file or directory")
     try:
-        text = open(path, encoding="utf-8").read()
-    except (OSError, UnicodeDecodeError) as err:
-        raise InputError(key, f"cannot read the profile {path!r}: {getattr(err, 'strerror', None) or err}") from None
+        text = data.decode("utf-8")
+    except UnicodeDecodeError as err:
+        raise InputError(key, f"cannot read the profile {path!r}: {err}") from None
     rows = []
     for n, line in enumerate(text.splitlines(), 1):
         line = line.split("#", 1)[0].strip()
@@ -306,6 +313,10 @@ def read_points(path: str, key: str) -> list[tuple[float, float, float]]:
         if len(nums) not in (2, 3) or not all(math.isfinite(v) for v in nums):
             raise InputError(key, f"{path}:{n}: expected 2 or 3 finite numbers (z_m, r_m[, arc_radius_m]), "
                                   f"got {line!r}")
+        if len(rows) == PROFILE_POINTS_MAX:
+            raise InputError(key, f"{path}:{n}: more than {PROFILE_POINTS_MAX} points; a drawn profile holds at most "
+                                  f"{PROFILE_POINTS_MAX} (each segment is a ring of load points and a curve of the "
+                                  "mesh): thin them, or draw curves as arcs (a third column, the arc radius)")
         rows.append((nums[0], nums[1], nums[2] if len(nums) == 3 else 0.0))
     if len(rows) < 2:
         raise InputError(key, f"{path}: a profile needs at least 2 points, got {len(rows)}")

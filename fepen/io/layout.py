@@ -34,9 +34,9 @@ from collections.abc import Callable
 from dataclasses import dataclass, field
 from pathlib import Path
 
-__all__ = ["Folder", "LEAF", "RECORD", "RUN", "MESH", "RECORD_NAMES", "RUN_NAMES", "MESH_NAMES", "LOCK", "RESERVE", "RECORD_MAX",
-           "TEMPORARY", "declare", "layout_of", "temporary_of", "undeclared", "remove_owned", "remove_entry",
-           "sweep_temporaries", "read_record", "manifest"]
+__all__ = ["Folder", "LEAF", "RECORD", "RUN", "MESH", "RECORD_NAMES", "RUN_NAMES", "MESH_NAMES", "LOCK", "RESERVE",
+           "RECORD_MAX", "TEMPORARY", "declare", "layout_of", "temporary_of", "undeclared", "remove_owned",
+           "remove_entry", "sweep_temporaries", "read_record", "manifest"]
 
 LOCK = ".fepen.lock"
 #: space held back while a run goes on, given back to write the record of a stop on a full disk

@@ -17,7 +17,7 @@ from typing import Any
 from fepen.errors import InputError
 
 __all__ = ["ABSENT", "Key", "number", "positive", "choice", "flag", "finite", "shown", "display_name",
-           "check_sections", "check_layers"]
+           "check_sections", "check_layers", "check_nesting", "DEPTH_MAX"]
 
 #: marks an optional key whose absence means something (e.g. semi-infinite target)
 ABSENT = object()
@@ -196,6 +196,34 @@ def display_name(name: str, limit: int = 80) -> str:
         The text.
     """
     return name if name.isprintable() and len(name) <= limit else shown(name, limit)
+
+
+#: the deepest nesting of tables and arrays read from a scene or a sweep (a document's top-level keys at level
+#: 1): a scene uses 4 at most ([[output.probes]] point = [x, y, z]), a sweep 6 (a [grid] of probe lists)
+DEPTH_MAX = 16
+
+
+def check_nesting(value: Any, key: str, what: str, level: int = 1) -> None:
+    """Refuse tables and arrays nested more than DEPTH_MAX deep, one inside another (InputError naming ``key``):
+    no scene or sweep needs them, and every reader after this one may follow them down. Walked without recursion,
+    depth first, so that a structure that holds itself (a dict given to fepen.Scene) is refused too.
+
+    Args:
+        value: a parsed TOML document, a table or a value (dicts, lists and scalars).
+        key: the key the error names (SCENE, SWEEP, or the scene key given the value).
+        what: the thing nested, as the message says it ("the value", a file's name).
+        level: the depth of ``value`` itself: 0 for a whole document (its keys are at level 1), 1 for a value.
+    """
+    if not isinstance(value, (dict, list, tuple)):
+        return
+    stack = [(value, level)]
+    while stack:
+        node, depth = stack.pop()
+        if depth > DEPTH_MAX:
+            raise InputError(key, f"{what} nests tables and arrays more than {DEPTH_MAX} levels deep, one inside "
+                                  f"another: a scene or sweep nests them at most {DEPTH_MAX} levels")
+        children = node.values() if isinstance(node, dict) else node
+        stack.extend((c, depth + 1) for c in children if isinstance(c, (dict, list, tuple)))
 
 
 def check_sections(key: Key, name: str, value: Any) -> list:

@@ -10,19 +10,26 @@ from __future__ import annotations
 import copy
 import difflib
 import os
+import stat
 import tomllib
 from collections.abc import Callable
 from pathlib import Path
-from typing import Any
+from typing import Any, BinaryIO
 
 from fepen.data import CONSTANTS, STEELS, TARGETS, shot
 from fepen.errors import InputError
 from fepen.laws.target import a_over_c_cubed, cylinder_strength, youngs_modulus_aci
-from fepen.scene.keys import ABSENT, display_name, shown
+from fepen.scene.keys import ABSENT, DEPTH_MAX, check_nesting, display_name, shown
 from fepen.scene.schema import SCHEMA, SECTIONS
 
 __all__ = ["Section", "Scene", "load", "resolve", "read_toml", "parse_set", "flatten", "unknown_key",
-           "cross_check", "registered_checks", "CROSS_CHECKS", "CHECKS_AFTER_RESOLUTION", "CAD_EXCLUDES"]
+           "cross_check", "registered_checks", "CROSS_CHECKS", "CHECKS_AFTER_RESOLUTION", "CAD_EXCLUDES",
+           "read_capped", "open_input", "unreadable", "NotRegularFile", "toml_error", "SCENE_MAX", "given_twice"]
+
+
+#: the largest scene file read (bytes): a scene is a page of text; a larger file is refused before it is parsed
+#: (the scene fepen writes into its results is held within it too: _written_scene_fits)
+SCENE_MAX = 1 << 20
 
 
 # ---------------------------------------------------------------------------------------------------------
@@ -36,7 +43,8 @@ def cross_check(description: str) -> Callable[[Callable], Callable]:
     descriptions in the order the checks are defined in this module (the order they run in is resolve's:
     the first refusal is the one reported). A check raises InputError naming a key; it takes
     ``(flat, given)`` (the scene's resolved values and the keys the user gave), or for one target material
-    or layer ``(where, constants, family, given)``, ``(where, layer)`` or ``(name, constants)``.
+    or layer ``(where, constants, family, given)``, ``(where, layer)`` or ``(name, constants)``, or the
+    resolved Scene itself.
 
     Args:
         description: what the check demands, in one line, naming the keys.
@@ -231,6 +239,44 @@ def _cell_probes_meshed(flat: dict, given: dict) -> None:
                                                           "rigid fidelity has 'node' probes only)")
 
 
+@cross_check("charge.* keys only with effects.charge = true, or with effects.charge = false given (a sweep that "
+             "varies the charge); left off by default, they would change nothing")
+def _charge_keys_need_the_charge(flat: dict, given: dict) -> None:
+    if flat["effects.charge"] or "effects.charge" in given:  # given false: the keys are kept for the charged shots
+        return
+    for key in given:
+        if key.startswith("charge."):
+            raise InputError(key, "a key of the charge, which is off: set effects.charge = true, or drop the key (it "
+                                  "would change nothing; a sweep that varies the charge gives effects.charge = false "
+                                  "in its base)")
+
+
+#: the rows of the list keys (layers, probes, cavity sections) up to which the scene fepen writes is not measured:
+#: each row writes at most about 2 kB, the rest of a scene about 10 kB, far below SCENE_MAX
+ROWS_UNMEASURED = 64
+#: the list keys whose rows make a written scene long, and what their rows are called
+_ROW_KEYS = (("target.layers", "layers"), ("output.probes", "probes"), ("projectile.cavity_sections", "sections"))
+
+
+@cross_check(f"the scene.toml fepen writes into the results (every key) within the {SCENE_MAX >> 20} MiB a scene file "
+             "may be, so that it reads back (fepen run --resume, fepen.load): not too many target.layers, "
+             "output.probes or projectile.cavity_sections")
+def _written_scene_fits(scene: Scene) -> None:
+    """(Measured only past ROWS_UNMEASURED rows: fepen.scene.writing.to_toml writes the scene.)"""
+    rows = {key: len(scene.get(key) or ()) for key, _ in _ROW_KEYS}
+    if sum(rows.values()) <= ROWS_UNMEASURED:
+        return
+    from fepen.scene.writing import to_toml
+
+    size = len(to_toml(scene).encode())
+    if size > SCENE_MAX:
+        key, word = max(_ROW_KEYS, key=lambda kw: rows[kw[0]])
+        n = rows[key]
+        raise InputError(key, f"{n} {word} would make the scene.toml fepen writes into the results {size >> 10} "
+                              f"KiB, past the {SCENE_MAX >> 10} KiB a scene file may be: it could not be read back "
+                              f"(fepen run --resume, fepen.load); give at most about {n * SCENE_MAX // size} of these")
+
+
 #: the projectile keys of a drawn body, refused beside projectile.cad
 CAD_EXCLUDES = ("projectile.nose", "projectile.diameter", "projectile.length", "projectile.crh", "projectile.mass",
                 "projectile.nose_length", "projectile.meplat_diameter", "projectile.boattail_length",
@@ -362,7 +408,7 @@ def _check_across(flat: dict, given: dict, derived: dict) -> None:
     each layer's and the mass rule of a shot were checked as they resolved."""
     _check_projectile_keys(flat, given)
     for check in (_mass_and_charge, _erosion_meshed, _cell_probes_meshed, _orders, _melt_above_room, _axis_into_target,
-                  _rigid_step_within_end, _charge_hardening):
+                  _rigid_step_within_end, _charge_hardening, _charge_keys_need_the_charge):
         check(flat, given)
     if "target.layers" not in flat:
         _check_target("target", {**{k: flat[f"target.{k}"] for k in CONSTANTS if f"target.{k}" in flat},
@@ -477,9 +523,10 @@ def resolve(given: dict[str, Any]) -> Scene:
     Returns:
         The resolved, read-only Scene.
     """
-    for name in given:
-        if name not in SCHEMA:
-            raise unknown_key(name)
+    for name, value in given.items():
+        if not isinstance(name, str) or name not in SCHEMA:
+            raise unknown_key(str(name))
+        check_nesting(value, name, "the value")
     flat: dict[str, Any] = {}
     for name, key in SCHEMA.items():
         if name in given:
@@ -502,7 +549,9 @@ def resolve(given: dict[str, Any]) -> Scene:
         for part in parts[:-1]:
             node = node.setdefault(part, {})
         node[parts[-1]] = value
-    return Scene._resolved(tree, set(given), derived)
+    scene = Scene._resolved(tree, set(given), derived)
+    _written_scene_fits(scene)
+    return scene
 
 
 # ---------------------------------------------------------------------------------------------------------
@@ -516,18 +565,41 @@ def flatten(tree: dict, prefix: str = "") -> dict[str, Any]:
         prefix: put before every key (used by the recursion).
 
     Returns:
-        The flat dict. An empty table raises InputError.
+        The flat dict. InputError for an empty table, for a key given twice (a quoted dotted key,
+        ``"impact.velocity" = 900.0``, beside the same key in nested tables, ``[impact] velocity = 500.0``:
+        TOML reads them as two keys, fepen as one), and for tables and arrays nested more than DEPTH_MAX deep.
     """
-    flat = {}
+    if not prefix:  # the whole tree (the recursion below is as deep as the tree: at most DEPTH_MAX)
+        check_nesting(tree, "SCENE", "the scene", level=0)
+    flat: dict[str, Any] = {}
     for k, v in tree.items():
         name = f"{prefix}{k}"
         if isinstance(v, dict):
             if not v:
                 raise InputError(display_name(name), "empty table")
-            flat.update(flatten(v, name + "."))
+            items = flatten(v, name + ".").items()
         else:
-            flat[name] = v
+            items = ((name, v),)
+        for leaf, value in items:
+            if leaf in flat:
+                raise InputError(display_name(leaf), given_twice(leaf))
+            flat[leaf] = value
     return flat
+
+
+def given_twice(name: str) -> str:
+    """The message of a key given twice in one table, once as a quoted dotted key and once in nested tables
+    (flatten; a sweep's [grid] and [monte_carlo.vary]: fepen.studies.spec.flat_leaves).
+
+    Args:
+        name: the dotted key.
+
+    Returns:
+        The message.
+    """
+    head, _, leaf = display_name(name).rpartition(".")
+    return (f'given twice: as a quoted dotted key ("{head}.{leaf}" = ...) and in nested tables ([{head}] {leaf} = '
+            "...), which name the same key: give it once")
 
 
 def unknown_key(name: str) -> InputError:
@@ -590,6 +662,9 @@ def parse_set(item: str) -> tuple[str, Any]:
         value = tomllib.loads(f"v = {text}")["v"]
     except ValueError:  # TOMLDecodeError, or an integer past Python's 4300 digits: a bare word
         value = text
+    except RecursionError:  # arrays or inline tables nested thousands deep
+        raise toml_error(RecursionError(), display_name(key), "the value") from None
+    check_nesting(value, display_name(key), "the value")
     return key, value
 
 
@@ -621,46 +696,125 @@ def set_item(key: str, value) -> str:
     return f"{key}={text}"
 
 
-#: the largest scene file read (bytes): a scene is a page of text; a larger file is refused before it is parsed
-SCENE_MAX = 1 << 20
+class NotRegularFile(OSError):
+    """A user's input file that is not a regular file: a pipe, a device, a folder or a socket (open_input)."""
 
 
-def read_capped(path: Path, limit: int, key: str, what: str) -> bytes:
-    """The bytes of a user's text file, refused (InputError naming ``key``) when larger than ``limit``: never
-    more than ``limit`` + 1 bytes are read."""
+def _kind(mode: int) -> str:
+    """What a file that is not a regular one is, in words."""
+    for test, word in ((stat.S_ISDIR, "a folder"), (stat.S_ISFIFO, "a pipe"), (stat.S_ISCHR, "a device"),
+                       (stat.S_ISBLK, "a device"), (stat.S_ISSOCK, "a socket")):
+        if test(mode):
+            return word
+    return "a special file"
+
+
+def open_input(path) -> BinaryIO:
+    """Open a user's input file for reading, refusing anything but a regular file without blocking: opened with
+    O_NONBLOCK (a pipe without a writer opens at once instead of waiting for one for ever), then what was opened
+    is asked (fstat), so a file swapped for a pipe between a check and the open is caught too.
+
+    Args:
+        path: the file (str or Path).
+
+    Returns:
+        The open binary file (a context manager; ``os.fstat(f.fileno()).st_size`` its size).
+
+    Raises:
+        NotRegularFile (an OSError) for a pipe, a device, a folder or a socket; OSError as open() raises it;
+        ValueError for a name holding a NUL. :func:`unreadable` turns each into the one-line InputError.
+    """
+    flags = os.O_RDONLY | getattr(os, "O_NONBLOCK", 0) | getattr(os, "O_NOCTTY", 0) | getattr(os, "O_CLOEXEC", 0)
+    fd = os.open(path, flags)
     try:
-        with open(path, "rb") as fh:
-            data = fh.read(limit + 1)
-    except OSError as err:
-        raise InputError(key, f"cannot read {display_name(str(path), 200)}: {err.strerror or err}") from None
-    if len(data) > limit:
+        mode = os.fstat(fd).st_mode
+        if not stat.S_ISREG(mode):
+            raise NotRegularFile(_kind(mode))
+        return os.fdopen(fd, "rb")  # (O_NONBLOCK changes nothing in the reads of a regular file)
+    except BaseException:
+        os.close(fd)
+        raise
+
+
+def unreadable(err: Exception, path, key: str, what: str, missing: str | None = None) -> InputError:
+    """The error of a user's input file :func:`open_input` could not open, naming ``key``.
+
+    Args:
+        err: what open_input raised (NotRegularFile, another OSError, or ValueError).
+        path: the file. key: the key that names it. what: what the file is ("a scene file", "the profile").
+        missing: the message when there is no such file (None: "cannot read PATH: No such file or directory").
+
+    Returns:
+        The InputError (to raise).
+    """
+    name = display_name(str(path), 200)
+    if isinstance(err, NotRegularFile):
+        return InputError(key, f"{name} is {err}, not a regular file: {what} is read from a regular file")
+    if isinstance(err, FileNotFoundError) and missing is not None:
+        return InputError(key, missing)
+    return InputError(key, f"cannot read {name}: {getattr(err, 'strerror', None) or err}")
+
+
+def read_capped(path: Path, limit: int, key: str, what: str, missing: str | None = None) -> bytes:
+    """The bytes of a user's text file, refused (InputError naming ``key``) when it is not a regular file (a
+    pipe, a device or a folder, checked without blocking: :func:`open_input`) or larger than ``limit``: never
+    more than ``limit`` + 1 bytes are read.
+
+    Args:
+        path: the file. limit: the most bytes it may hold. key: the key that names it.
+        what: what the file is, as the messages say it ("a scene file").
+        missing: the message when there is no such file (:func:`unreadable`).
+
+    Returns:
+        The file's bytes.
+    """
+    try:
+        with open_input(path) as fh:
+            size = os.fstat(fh.fileno()).st_size
+            data = b"" if size > limit else fh.read(limit + 1)
+    except (OSError, ValueError) as err:
+        raise unreadable(err, path, key, what, missing) from None
+    if size > limit or len(data) > limit:
         raise InputError(key, f"{display_name(str(path), 200)} is larger than {limit >> 10} KiB, the most {what} "
                               "may be")
     return data
 
 
-def read_toml(path: str | Path) -> dict[str, Any]:
+def toml_error(err: Exception, key: str, where: str) -> InputError:
+    """The error of TOML tomllib could not read, naming ``key``: not TOML (TOMLDecodeError, text that is not
+    UTF-8, an integer past Python's 4300 digits: a ValueError), or nested too deep for it to read (RecursionError:
+    arrays or inline tables thousands deep).
+
+    Args:
+        err: the exception. key: the key the error names. where: the file or text, as the message says it.
+
+    Returns:
+        The InputError (to raise).
+    """
+    if isinstance(err, RecursionError):
+        return InputError(key, f"{where} nests tables and arrays too deep to read, one inside another: a scene or "
+                               f"sweep nests them at most {DEPTH_MAX} levels")
+    return InputError(key, f"{where} is not valid TOML: {display_name(str(err), 200)}")
+
+
+def read_toml(path: str | Path, key: str = "SCENE") -> dict[str, Any]:
     """Read a scene file into a flat {dotted key: value} dict, without validating the keys.
 
     Args:
-        path: the TOML file.
+        path: the TOML file: a regular file of at most SCENE_MAX bytes (read_capped).
+        key: the key its errors name (a sweep's ``scene``).
 
     Returns:
         The flat dict.
     """
     p = Path(path)
-    try:
-        found = p.is_file()
-    except (OSError, ValueError):  # a name too long, or holding a NUL
-        found = False
-    if not found:
-        raise InputError("SCENE", f"no such scene file: {display_name(str(p), 200)}")
-    data = read_capped(p, SCENE_MAX, "SCENE", "a scene file")
+    name = display_name(str(p), 200)
+    data = read_capped(p, SCENE_MAX, key, "a scene file", missing=f"no such scene file: {name}")
     try:
         tree = tomllib.loads(data.decode())
-    except ValueError as err:  # TOMLDecodeError, text that is not UTF-8, an integer past 4300 digits
-        raise InputError("SCENE", f"{display_name(str(p), 200)} is not valid TOML: "
-                                  f"{display_name(str(err), 200)}") from None
+    except (ValueError, RecursionError) as err:
+        raise toml_error(err, key, name) from None
+    check_nesting(tree, key, name, level=0)
     return flatten(tree)
 
 
@@ -677,8 +831,8 @@ def _given(source) -> dict[str, Any]:
     if isinstance(source, str):
         try:
             tree = tomllib.loads(source)
-        except ValueError as err:  # TOMLDecodeError, or an integer past Python's 4300 digits
-            raise InputError("SCENE", f"the scene text is not valid TOML: {display_name(str(err), 200)}") from None
+        except (ValueError, RecursionError) as err:
+            raise toml_error(err, "SCENE", "the scene text") from None
         return flatten(tree)
     raise InputError("SCENE", f"expected a TOML file, TOML text, a dict or a Scene, got {type(source).__name__}")
 

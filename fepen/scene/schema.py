@@ -24,7 +24,7 @@ from fepen.scene.keys import (
     shown,
 )
 
-__all__ = ["SCHEMA", "SECTIONS", "LAYER_KEYS", "LAYER_FIELDS", "PROBE_FIELDS"]
+__all__ = ["SCHEMA", "SECTIONS", "LAYER_KEYS", "LAYER_FIELDS", "PROBE_FIELDS", "PROBES_MAX", "PROBE_NAME_MAX"]
 
 
 def _layers(key: Key, name: str, value) -> list:
@@ -32,9 +32,17 @@ def _layers(key: Key, name: str, value) -> list:
     return check_layers(key, name, value, LAYER_FIELDS)
 
 
+#: the most [[output.probes]] a scene holds: each is a history of every row in probes.csv (100 probes of a rigid
+#: shot: about 4 MB of it, 1,000: 41 MB, 10,000: 412 MB and 42 s); the whole body's histories are in fields.xdmf
+PROBES_MAX = 100
+#: the longest probe name (characters): it starts each of its columns' names in probes.csv
+PROBE_NAME_MAX = 64
+
+
 def _probes(key: Key, name: str, value) -> list:
-    """output.probes' rows: each table's name (unique, letters, digits, '_' or '-'), point ([x, y, z], m) and
-    kind ('node', 'cell' or 'accelerometer', default 'node'); unknown keys refused.
+    """output.probes' rows: at most PROBES_MAX tables, each one's name (unique, at most PROBE_NAME_MAX letters,
+    digits, '_' or '-'), point ([x, y, z], m) and kind ('node', 'cell' or 'accelerometer', default 'node');
+    unknown keys refused.
 
     Args:
         key: the list key (for its allowed form). name: the key's name. value: what the user gave.
@@ -44,6 +52,9 @@ def _probes(key: Key, name: str, value) -> list:
     """
     if not isinstance(value, list) or not value or not all(isinstance(v, dict) for v in value):
         raise InputError(name, f"got {shown(value)}, expected {key.allowed()} ([[output.probes]] in TOML)")
+    if len(value) > PROBES_MAX:
+        raise InputError(name, f"{len(value)} probes: a scene holds at most {PROBES_MAX} (each is a history of every "
+                               "row in probes.csv; fields.xdmf holds the whole body's)")
     out, seen = [], set()
     for i, table in enumerate(value):
         here = f"{name}[{i}]"
@@ -51,10 +62,11 @@ def _probes(key: Key, name: str, value) -> list:
             if k not in PROBE_FIELDS:
                 raise InputError(f"{here}.{display_name(k)}", f"unknown key (allowed: {', '.join(PROBE_FIELDS)})")
         label, point = table.get("name"), table.get("point")
-        if not isinstance(label, str) or not label or not all(c.isascii() and (c.isalnum() or c in "_-")
-                                                               for c in label):
-            raise InputError(f"{here}.name", f"got {shown(label)}, expected a name of letters, digits, '_' or '-' "
-                                             "(it starts the probe's column names in probes.csv)")
+        if (not isinstance(label, str) or not label or len(label) > PROBE_NAME_MAX
+                or not all(c.isascii() and (c.isalnum() or c in "_-") for c in label)):
+            raise InputError(f"{here}.name", f"got {shown(label)}, expected a name of at most {PROBE_NAME_MAX} "
+                                             "letters, digits, '_' or '-' (it starts the probe's column names in "
+                                             "probes.csv)")
         if label in seen:
             raise InputError(f"{here}.name", f"{label!r} is given twice: each probe needs its own name")
         seen.add(label)

@@ -44,15 +44,19 @@ import numpy as np
 
 from fepen import scene as fscene
 from fepen.errors import InputError
-from fepen.scene.keys import Key
+from fepen.scene.keys import Key, check_nesting, display_name
+from fepen.scene.resolve import given_twice, toml_error
 from fepen.studies.monte_carlo import DISTRIBUTIONS, FINITE, POSITIVE, distribution, monte_carlo
 
 __all__ = ["Spec", "read", "load", "sections", "base_keys", "flat_leaves", "distribution", "sample", "monte_carlo",
-           "expand_shot", "keep_basis", "resized", "MAX_SHOTS", "TABLE_MAX", "DISTRIBUTIONS", "IMPACT"]
+           "expand_shot", "keep_basis", "resized", "MAX_SHOTS", "TABLE_MAX", "CELL_MAX", "DISTRIBUTIONS", "IMPACT"]
 
 MAX_SHOTS = 200_000
 #: the largest table of shots read (bytes)
 TABLE_MAX = 64 << 20
+#: the largest cell of a table of shots (characters): one scene value (a number, a word, a path, a short list);
+#: Python's csv module's own default field limit, past which it stopped with an error of its own
+CELL_MAX = 128 << 10
 IMPACT = ("impact.velocity", "impact.obliquity_deg", "impact.attack_deg")
 
 
@@ -106,22 +110,34 @@ def resized(path, samples: int, seed: int | None = None) -> str:
     return text
 
 
-def flat_leaves(tree: dict, is_leaf, prefix: str = "") -> dict:
-    """{dotted key: leaf} of a TOML table whose keys may be quoted ("impact.velocity") or nested."""
+def flat_leaves(tree: dict, is_leaf, prefix: str = "", where: str = "") -> dict:
+    """{dotted key: leaf} of a TOML table whose keys may be quoted ("impact.velocity") or nested.
+
+    Args:
+        tree: the table ([grid], [monte_carlo.vary]). is_leaf: whether a table is a leaf (a range, a distribution)
+            rather than a table of keys. prefix: put before every key (used by the recursion).
+        where: the table's name, which the error of a key given twice starts with ("grid").
+
+    Returns:
+        The flat dict. InputError naming ``where.KEY`` for a key given twice (a quoted dotted key beside the
+        same key in nested tables: TOML reads them as two keys).
+    """
     out = {}
     for k, v in tree.items():
         name = f"{prefix}{k}"
-        if isinstance(v, dict) and not is_leaf(v):
-            out.update(flat_leaves(v, is_leaf, name + "."))
-        else:
-            out[name] = v
+        items = flat_leaves(v, is_leaf, name + ".", where).items() if isinstance(v, dict) and not is_leaf(v) else (
+            (name, v),)
+        for leaf, value in items:
+            if leaf in out:
+                raise InputError(f"{where}.{display_name(leaf)}" if where else display_name(leaf), given_twice(leaf))
+            out[leaf] = value
     return out
 
 
 def _check_key(section: str, name: str) -> None:
     if name not in fscene.SCHEMA:
         err = fscene.unknown_key(name)
-        raise InputError(f"{section}.{name}", f"not a scene key ({err.message})")
+        raise InputError(f"{section}.{display_name(name)}", f"not a scene key ({err.message})")
 
 
 #: the checks of the spec's own numbers, as the scene's keys are checked (fepen.scene.keys.Key)
@@ -159,26 +175,66 @@ def _grid_values(name: str, spec) -> list:
     raise InputError(where, f"a list of values or a range table {{start, stop, num}}, got {spec!r}")
 
 
-def _read_table(path: Path) -> tuple[list, list]:
-    """Keys and shots of a CSV table (header: scene keys; values in TOML syntax, bare words strings)."""
+def _csv_rows(path: Path, text: str) -> list[tuple[int, list]]:
+    """(line, cells) of each row of a CSV text but blank and # comment rows: every cell read whole (csv's own
+    field limit raised to the table's size for the read, then restored), so that a long cell is named by
+    _read_table with its column; a CSV csv cannot read is InputError (table.file)."""
+    reader = csv.reader(io.StringIO(text))
+    limit = csv.field_size_limit(max(csv.field_size_limit(), TABLE_MAX))
+    rows = []
     try:
-        text = fscene.read_capped(path, TABLE_MAX, "table.file", "a table of shots").decode()
+        for r in reader:
+            if r and not r[0].lstrip().startswith("#"):
+                rows.append((reader.line_num, r))
+    except csv.Error as err:
+        raise InputError("table.file", f"{path} line {reader.line_num}: not CSV fepen reads: {err}") from None
+    finally:
+        csv.field_size_limit(limit)
+    return rows
+
+
+def _read_table(path: Path) -> tuple[list, list]:
+    """Keys and shots of a CSV table (header: scene keys, each once; values in TOML syntax, bare words strings;
+    cells of at most CELL_MAX characters; UTF-8, a byte-order mark allowed)."""
+    try:
+        text = fscene.read_capped(path, TABLE_MAX, "table.file", "a table of shots").decode("utf-8-sig")
     except UnicodeDecodeError:
         raise InputError("table.file", f"{path} is not UTF-8 text") from None
-    rows = list(csv.reader(io.StringIO(text)))
-    rows = [r for r in rows if r and not r[0].lstrip().startswith("#")]
+    rows = _csv_rows(path, text)
     if len(rows) < 2:
         raise InputError("table.file", f"{path} needs a header of scene keys and at least one row")
     if len(rows) - 1 > MAX_SHOTS:
         raise InputError("table.file", f"{path} holds {len(rows) - 1} shots; a sweep holds at most {MAX_SHOTS}")
-    keys = [k.strip() for k in rows[0]]
-    for k in keys:
+    header_line, header = rows[0]
+    keys = [k.strip() for k in header]
+
+    def column(j: int) -> str:
+        return f"column {j + 1}" + (f" ({display_name(keys[j])})" if j < len(keys) and keys[j] else "")
+
+    for n, r in rows:
+        for j, v in enumerate(r):
+            if len(v) > CELL_MAX:
+                raise InputError("table.file", f"{path} line {n}, {column(j)}: a cell of {len(v)} characters; a "
+                                               f"cell holds one scene value, at most {CELL_MAX}")
+    for j, k in enumerate(keys):
+        if not k:
+            raise InputError("table.file", f"{path} line {header_line}, column {j + 1}: an empty header cell; each "
+                                           "column names a scene key")
+        if k in keys[:j]:
+            raise InputError("table.file", f"{path} line {header_line}, {column(j)}: given twice (also column "
+                                           f"{keys.index(k) + 1}); each key is one column")
         _check_key("table.file", k)
     shots = []
-    for n, r in enumerate(rows[1:], start=2):
+    for n, r in rows[1:]:
         if len(r) != len(keys):
             raise InputError("table.file", f"{path} line {n}: {len(r)} values for {len(keys)} keys")
-        shots.append({k: fscene.parse_set(f"{k}={v.strip()}")[1] for k, v in zip(keys, r)})
+        shot = {}
+        for j, (k, v) in enumerate(zip(keys, r)):
+            try:
+                shot[k] = fscene.parse_set(f"{k}={v.strip()}")[1]
+            except InputError as err:
+                raise InputError("table.file", f"{path} line {n}, {column(j)}: {err.message}") from None
+        shots.append(shot)
     return keys, shots
 
 
@@ -247,20 +303,31 @@ def expand_shot(base: dict) -> dict:
 
 
 def load(path: Path) -> dict:
+    """The sections of a sweep file, read and checked by name (:func:`sections`).
+
+    Args:
+        path: the SWEEP.toml: a regular file (not a pipe or a device, checked without blocking) of at most
+            fepen.scene.SCENE_MAX bytes.
+
+    Returns:
+        The parsed file. InputError (SWEEP) when it cannot be read, is not TOML, or nests too deep.
+    """
     import tomllib
 
-    if not path.is_file():
-        raise InputError("SWEEP", f"cannot read {fscene.display_name(str(path), 200)}: no such file")
-    data = fscene.read_capped(path, fscene.SCENE_MAX, "SWEEP", "a sweep file")
+    name = display_name(str(path), 200)
+    data = fscene.read_capped(path, fscene.SCENE_MAX, "SWEEP", "a sweep file",
+                              missing=f"cannot read {name}: no such file")
     try:
         spec = tomllib.loads(data.decode())
-    except (tomllib.TOMLDecodeError, UnicodeDecodeError) as err:
-        raise InputError("SWEEP", f"{path} is not valid TOML: {err}") from None
-    return sections(spec, str(path))
+    except (ValueError, RecursionError) as err:  # TOMLDecodeError, not UTF-8; arrays nested thousands deep
+        raise toml_error(err, "SWEEP", name) from None
+    return sections(spec, name)
 
 
 def sections(spec: dict, where: str) -> dict:
-    """The sweep's sections, checked by name (InputError naming an unknown one)."""
+    """The sweep's sections, checked by name (InputError naming an unknown one) and by depth (SWEEP: tables
+    and arrays nested at most fepen.scene.keys.DEPTH_MAX deep)."""
+    check_nesting(spec, "SWEEP", where, level=0)
     known = {"scene", "base", "grid", "monte_carlo", "table", "output"}
     for k in spec:
         if k not in known:
@@ -275,9 +342,7 @@ def base_keys(path: Path, spec: dict, sets) -> dict:
         if not isinstance(spec["scene"], str):
             raise InputError("scene", "the base scene's file name (a string)")
         scene_path = (path.parent / spec["scene"]).resolve()
-        if not scene_path.is_file():
-            raise InputError("scene", f"no such file: {scene_path}")
-        base.update(fscene.read_toml(scene_path))
+        base.update(fscene.read_toml(scene_path, key="scene"))
     if "base" in spec:
         if not isinstance(spec["base"], dict):
             raise InputError("base", "a table of scene keys")
@@ -294,7 +359,7 @@ def base_keys(path: Path, spec: dict, sets) -> dict:
 def _grid(grid) -> tuple[list, list]:
     if not isinstance(grid, dict) or not grid:
         raise InputError("grid", "a table of scene keys, each with a list or a range")
-    values = flat_leaves(grid, lambda d: "start" in d)
+    values = flat_leaves(grid, lambda d: "start" in d, where="grid")
     for k in values:
         _check_key("grid", k)
     values = {k: _grid_values(k, v) for k, v in values.items()}
@@ -322,7 +387,7 @@ def sample(mc, resolved) -> tuple[list, list]:
     vary = mc.get("vary")
     if not isinstance(vary, dict) or not vary:
         raise InputError("monte_carlo.vary", "a table of scene keys, each with its distribution")
-    specs = flat_leaves(vary, lambda d: "distribution" in d)
+    specs = flat_leaves(vary, lambda d: "distribution" in d, where="monte_carlo.vary")
     for k in specs:
         _check_key("monte_carlo.vary", k)
     dists = {k: distribution(k, v, resolved.get(k)) for k, v in specs.items()}
