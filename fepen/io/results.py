@@ -296,7 +296,7 @@ class RunFiles:
 
         try:
             return tomllib.loads((self.out / "scene.toml").read_text())
-        except (OSError, ValueError, UnicodeDecodeError):
+        except (OSError, ValueError, UnicodeDecodeError, RecursionError):
             return {}
 
     def scene_keys(self) -> dict:
