@@ -6,8 +6,10 @@ Exit codes (contract, docs/results.md):
     1  an internal error: a bug in fepen (one line; ``fepen --debug ...`` shows the traceback)
     2  bad input (InputError): one line naming the key or argument and what is allowed
     3  the simulation cannot go on (SimulationError): what, where and when; what it wrote is kept
-    4  a fault of the machine (MachineFault): disk full, permission, a file that cannot be read, or a signal
-       (SIGTERM, SIGINT) that stopped the run after a checkpoint; ``fepen run --resume DIR`` continues it
+    4  a fault of the machine (MachineFault): disk full, permission, a file that cannot be read, memory (OutOfMemory:
+       a MemoryError, a library that cannot be mapped under ``ulimit -v``), a broken set-up (no C compiler, a
+       kernel cache that cannot be written), or a signal (SIGTERM, SIGINT) that stopped the run after a
+       checkpoint; ``fepen run --resume DIR`` continues it
 
 How a run ended is one of OUTCOMES; ``stop_outcome(err)`` is the one place an exception is classified, for
 summary.json, run.json and the command line alike.
@@ -15,6 +17,10 @@ summary.json, run.json and the command line alike.
 
 from __future__ import annotations
 
+import errno
+import os
+import re
+import resource  # now, not when memory has run out (its own shared object would then fail to map)
 from dataclasses import dataclass
 
 
@@ -70,11 +76,127 @@ class Interrupted(MachineFault):
     Exit code 4; ``fepen run --resume DIR`` finishes it with the same results."""
 
 
-def describe_os_error(err: OSError) -> str:
-    """One line for an OSError: what the system said and the file it concerns."""
-    import errno
-    import os
+class OutOfMemory(MachineFault):
+    """Memory ran out: a MemoryError, or a shared object that could not be mapped while a module was imported
+    (ImportError, OSError: "failed to map segment", ENOMEM), most often under an address-space limit (``ulimit
+    -v``, a batch system's h_vmem). Exit code 4; the message names the limits set (out_of_memory)."""
 
+
+#: what the dynamic loader and the system say when a library cannot be mapped or memory not allocated
+_NO_MEMORY = re.compile(r"(?:([^\s:'\"]+): )?(failed to map segment from shared object|cannot allocate memory)",
+                        re.IGNORECASE)
+#: the per-process limits on memory: (resource, its name in ulimit, what it bounds, the /proc/self/status field of
+#: what the process holds against it)
+_LIMITS = (("RLIMIT_AS", "ulimit -v", "address-space", "VmSize"), ("RLIMIT_DATA", "ulimit -d", "data", "VmData"))
+_MIB = 1 << 20
+
+
+def _rlimits() -> list[tuple[str, str, int, str]]:
+    """The per-process memory limits that are set (soft limits): (ulimit name, what it bounds, bytes, the
+    /proc/self/status field of what the process holds against it)."""
+    found = []
+    for res, name, what, field in _LIMITS:
+        try:
+            soft = resource.getrlimit(getattr(resource, res))[0]
+        except (AttributeError, ValueError, OSError):
+            continue
+        if soft != resource.RLIM_INFINITY:
+            found.append((name, what, int(soft), field))
+    return found
+
+
+def memory_limits() -> list[tuple[str, str, int, int | None]]:
+    """The per-process memory limits that are set (soft limits): ``(ulimit name, what it bounds, the limit in
+    bytes, what this process holds against it now in bytes, or None where /proc is not readable)``, e.g.
+    ``("ulimit -v", "address-space", 786432000, 534773760)``."""
+    held = {}
+    try:
+        with open("/proc/self/status") as f:
+            for line in f:
+                key, _, value = line.partition(":")
+                if key in ("VmSize", "VmData"):
+                    held[key] = 1024 * int(value.split()[0])
+    except (OSError, ValueError, IndexError):
+        pass
+    return [(name, what, soft, held.get(field)) for name, what, soft, field in _rlimits()]
+
+
+#: limits_text() as the command started (start_within_limits): what a message says when memory has run out so
+#: far that it cannot be said afresh
+_LIMITS_TEXT = [""]
+
+
+#: the variables OpenBLAS reads its thread count from, in its order
+_BLAS_THREADS = ("OPENBLAS_NUM_THREADS", "GOTO_NUM_THREADS", "OMP_NUM_THREADS")
+
+
+def start_within_limits() -> None:
+    """Before numpy, MPI or gmsh is loaded (fepen.cli.main): under an address-space limit (``ulimit -v``, a batch
+    system's h_vmem), OpenBLAS on one thread, unless OPENBLAS_NUM_THREADS, GOTO_NUM_THREADS or OMP_NUM_THREADS
+    says otherwise. OpenBLAS starts a thread per core as it loads, each mapping a buffer of its own (gmsh's copy,
+    linked into libgmsh: 136 MiB per thread, measured), and the OpenBLAS gmsh carries calls a null pointer when
+    that map fails: a segmentation fault as gmsh is imported, not an error (a deformable run under ulimit -v 650
+    to 750 MiB; gmsh alone under 150 to 250 MiB). On one thread it starts none. fepen's runs do not use threaded
+    BLAS (its tests run with OMP_NUM_THREADS=1)."""
+    _LIMITS_TEXT[0] = limits_text()
+    limited = any(name == "ulimit -v" for name, *_ in _rlimits())
+    if limited and not any(os.environ.get(v) for v in _BLAS_THREADS):
+        os.environ["OPENBLAS_NUM_THREADS"] = "1"
+
+
+def limits_text() -> str:
+    """The memory limits set, for a message: "the address-space limit ulimit -v is 750 MiB" ("" when none is)."""
+    try:
+        return ", ".join(f"the {what} limit {name} is {limit / _MIB:.0f} MiB" for name, what, limit, _ in _rlimits())
+    except MemoryError:
+        return _LIMITS_TEXT[0]
+
+
+#: what Python says of a C function that failed without raising: an allocation it did not check, under a limit
+_NO_EXCEPTION = re.compile(r"without (setting an )?exception|with an exception set")
+
+
+def _near_a_limit() -> bool:
+    """Whether this process maps within a tenth (at least 64 MiB) of a per-process memory limit (memory_limits)."""
+    try:
+        return any(held is not None and limit - held < max(64 * _MIB, limit / 10)
+                   for _, _, limit, held in memory_limits())
+    except MemoryError:
+        return True
+
+
+def out_of_memory(err: BaseException) -> OutOfMemory | None:
+    """The OutOfMemory an exception means, or None: a MemoryError; an ImportError or OSError whose shared object
+    could not be mapped ("failed to map segment from shared object", "cannot allocate memory") or that is ENOMEM;
+    a SystemError of a C function that failed without raising ("error return without exception set": measured
+    while numba is imported under ulimit -v 400 MiB) when the process maps within a tenth of a memory limit.
+    Its message: "out of memory: what failed (the address-space limit ulimit -v is N MiB)"."""
+    if isinstance(err, OutOfMemory):
+        return err
+    if isinstance(err, MemoryError):
+        detail = " ".join(str(err).split()) or "a memory allocation failed"
+    elif isinstance(err, (ImportError, OSError)):
+        found = _NO_MEMORY.search(str(err))
+        if found is not None:
+            detail = f"loading {os.path.basename(found.group(1))}: {found.group(2)}" if found.group(1) else \
+                found.group(2)
+        elif isinstance(err, OSError) and err.errno == errno.ENOMEM:
+            detail = describe_os_error(err)
+        else:
+            return None
+    elif isinstance(err, SystemError) and _NO_EXCEPTION.search(str(err)) and _near_a_limit():
+        detail = f"a library failed without saying why, near the limit (SystemError: {' '.join(str(err).split())})"
+    else:
+        return None
+    limits = limits_text()
+    return OutOfMemory(f"out of memory: {detail}" + (f" ({limits})" if limits else ""))
+
+
+def describe_os_error(err: OSError) -> str:
+    """One line for an OSError: what the system said and the file it concerns (the exception's own text when it
+    carries no errno: llvmlite's, ctypes')."""
+    if err.errno is None and not err.strerror:
+        return " ".join(str(err).split()) or type(err).__name__
     what = {errno.ENOSPC: "no space left on device", errno.EDQUOT: "disk quota exceeded",
             errno.EACCES: "permission denied", errno.EPERM: "operation not permitted",
             errno.EROFS: "read-only file system", errno.EIO: "input/output error"}.get(
@@ -113,8 +235,10 @@ OUTCOMES = {o.name: o for o in (
     Outcome("ended", 0, False, True, "reached run.end_time before any of the above"),
     Outcome("bad-input", 2, False, False, "the input was refused (InputError) after the run had started"),
     Outcome("stopped", 3, False, False, "the simulation could not go on (SimulationError)"),
-    Outcome("interrupted", 4, True, False, "a signal (SIGTERM, SIGINT) stopped it after a checkpoint"),
-    Outcome("fault", 4, True, False, "a fault of the machine (MachineFault: disk full, permission, I/O)"),
+    Outcome("interrupted", 4, True, False, "a signal (SIGTERM, SIGINT, SIGHUP, SIGUSR1) stopped it after a "
+                                           "checkpoint, or a study at a shot boundary"),
+    Outcome("fault", 4, True, False, "a fault of the machine (MachineFault: disk full, permission, I/O, out of "
+                                     "memory, no C compiler or kernel cache)"),
     Outcome("error", 1, False, False, "an internal error: a bug in fepen"),
 )}
 
@@ -127,6 +251,6 @@ def stop_outcome(err: BaseException) -> Outcome:
         return OUTCOMES["bad-input"]
     if isinstance(err, SimulationError):
         return OUTCOMES["stopped"]
-    if isinstance(err, (OSError, MemoryError)):
+    if isinstance(err, (OSError, MemoryError)) or out_of_memory(err) is not None:
         return OUTCOMES["fault"]
     return OUTCOMES["error"]

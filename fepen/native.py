@@ -11,9 +11,16 @@ rule.
                    the stop rules) and stay on
     FEPEN_KERNEL_CACHE   where the libraries are kept (else $XDG_CACHE_HOME/fepen, ~/.cache/fepen); a folder others
                    can write is never loaded from (a private one is used instead, with one warning)
+    CC             the C compiler's command line, split as a shell splits it: CC="gcc -O2", CC="ccache gcc"
+                   (default: cc)
 
-Every library carries, in its cache name, a hash of its source (and of what it #includes), its flags, the
-compiler's version and the CPU's flags: an edited source or another machine builds again.
+Every library carries, in its cache name, a hash of its source (and of what it #includes), its flags and the
+CPU's flags, then a hash of the compiler (its ``--version`` text, which a wrapper such as ccache passes through)
+and one of the options CC adds, if any: an edited source, another machine, another compiler or other options
+build again. Where the compiler cannot be run (not installed, CC naming no program), a library of the same
+source, flags, CPU and CC options that an earlier compiler built is loaded; with none, the required kernels stop
+fepen with a MachineFault (exit 4) naming the compiler and what to do, as a kernel cache that is not a directory
+or cannot be written does.
 """
 
 from __future__ import annotations
@@ -23,14 +30,17 @@ import functools
 import hashlib
 import os
 import re
+import shlex
 import stat
 import subprocess
 from dataclasses import dataclass, field
 from pathlib import Path
 
 from fepen.atomic import replacing
+from fepen.errors import MachineFault, OutOfMemory, describe_os_error, out_of_memory
 
-__all__ = ["FLAGS", "KERNELS", "Kernel", "cache_dir", "kernel", "library_path", "why_not", "python_only", "load"]
+__all__ = ["FLAGS", "KERNELS", "Kernel", "cache_dir", "compiler", "kernel", "library_path", "why_not", "python_only",
+           "load"]
 
 #: no fast-math (NaN and inf must propagate); -fno-math-errno only lets sqrt be one instruction (errno is never
 #: read), without which GCC keeps a loop that takes a square root scalar
@@ -98,7 +108,9 @@ def kernel(name: str) -> ctypes.CDLL | None:
         FEPEN_KERNEL turns off or that does not build (why_not says which).
 
     Raises:
-        RuntimeError: a required kernel that does not build (fepen needs a C compiler: cc, or $CC).
+        MachineFault: a required kernel that neither builds nor was built before (no C compiler, a cache that
+            cannot be written: the message names the compiler or the variable and what to do); OutOfMemory: a
+            library that cannot be mapped (ulimit -v), optional or not.
     """
     if name in _LOADED:
         return _LOADED[name]
@@ -107,12 +119,12 @@ def kernel(name: str) -> ctypes.CDLL | None:
     if not k.required and python_only():
         _WHY_NOT[name] = f"FEPEN_KERNEL={os.environ.get('FEPEN_KERNEL')}"
     else:
-        lib, why = load(PACKAGE / k.source, k.flags)
-        if lib is None:
-            if k.required:
-                raise RuntimeError(f"{k.source} does not build, and fepen needs it ({why}): install a C compiler "
-                                   "(cc, or set CC)")
-            _WHY_NOT[name] = why
+        try:
+            lib = _load(PACKAGE / k.source, tuple(k.flags))
+        except MachineFault as err:
+            if k.required or isinstance(err, OutOfMemory):
+                raise
+            _WHY_NOT[name] = str(err)
         else:
             for fn, (args, res) in k.functions.items():
                 getattr(lib, fn).argtypes = args
@@ -124,7 +136,7 @@ def kernel(name: str) -> ctypes.CDLL | None:
 def library_path(name: str) -> str:
     """The file of a kernel's built library (kernel(name) built it)."""
     k = KERNELS[name]
-    return str(_build(PACKAGE / k.source, os.environ.get("CC", "cc"), tuple(k.flags)))
+    return str(_build(PACKAGE / k.source, tuple(compiler()), tuple(k.flags)))
 
 
 def why_not(name: str) -> str | None:
@@ -144,11 +156,18 @@ def _cpu_flags() -> str:
 
 
 def cache_dir() -> Path:
-    """Where the built libraries are kept ($FEPEN_KERNEL_CACHE, else ~/.cache/fepen)."""
+    """Where the built libraries are kept ($FEPEN_KERNEL_CACHE, else $XDG_CACHE_HOME/fepen, ~/.cache/fepen).
+
+    Raises:
+        MachineFault: none of the three is known (no HOME, and no home directory in the user database)."""
     env = os.environ.get("FEPEN_KERNEL_CACHE")
     if env:
         return Path(env)
-    base = os.environ.get("XDG_CACHE_HOME") or str(Path.home() / ".cache")
+    try:
+        base = os.environ.get("XDG_CACHE_HOME") or str(Path.home() / ".cache")
+    except RuntimeError:  # Path.home(): "Could not determine home directory"
+        raise MachineFault("no home directory to keep fepen's C kernels in: set FEPEN_KERNEL_CACHE to a directory "
+                           "this user can write") from None
     return Path(base) / "fepen"
 
 
@@ -166,11 +185,39 @@ def _private(path: Path) -> bool:
 _own_dir: list[Path] = []
 
 
+def _cache_fault(folder: Path, err: OSError) -> MachineFault:
+    """The MachineFault of a kernel cache that cannot be made or written, naming the variable that chose it."""
+    memory = out_of_memory(err)
+    if memory is not None:
+        return memory
+    env = os.environ
+    if env.get("FEPEN_KERNEL_CACHE"):
+        where, do = f"FEPEN_KERNEL_CACHE={env['FEPEN_KERNEL_CACHE']}", "set FEPEN_KERNEL_CACHE to a directory"
+    elif env.get("XDG_CACHE_HOME"):
+        where = f"{folder} (from XDG_CACHE_HOME={env['XDG_CACHE_HOME']})"
+        do = "set XDG_CACHE_HOME, or FEPEN_KERNEL_CACHE, to a directory"
+    else:
+        where, do = str(folder), "set FEPEN_KERNEL_CACHE to a directory"
+    what = ("is not a directory" if isinstance(err, (FileExistsError, NotADirectoryError))
+            else f"cannot be written ({describe_os_error(OSError(err.errno, err.strerror))})")  # the folder named
+    return MachineFault(f"the C kernels' cache {where} {what}: {do} this user can write (fepen builds its C "
+                        "kernels there, once per machine)")
+
+
 def _folder() -> Path:
     """cache_dir(), or, when others can write it, a private folder of this process's (one warning): a library
-    is never loaded from where another user could have put it."""
+    is never loaded from where another user could have put it.
+
+    Raises:
+        MachineFault: the cache is not a directory (FEPEN_KERNEL_CACHE or XDG_CACHE_HOME naming a file) or
+            cannot be made."""
     folder = cache_dir()
-    folder.mkdir(parents=True, exist_ok=True)
+    try:
+        folder.mkdir(parents=True, exist_ok=True)
+    except OSError as err:
+        raise _cache_fault(folder, err) from None
+    if not folder.is_dir():  # a link to a file
+        raise _cache_fault(folder, NotADirectoryError(20, "Not a directory", str(folder)))
     if _private(folder):
         return folder
     if not _own_dir:
@@ -198,24 +245,115 @@ def _source_bytes(source: Path, seen=None) -> bytes:
     return out
 
 
+def compiler() -> list[str]:
+    """The C compiler's command line: $CC split as a shell splits it (CC="gcc -O2", CC="ccache gcc"), else cc.
+
+    Raises:
+        MachineFault: CC that is not a command line (an unclosed quote)."""
+    text = os.environ.get("CC", "")
+    try:
+        words = shlex.split(text)
+    except ValueError as err:
+        raise MachineFault(f"CC={text!r} is not a command line ({err}): set CC to a C compiler, e.g. CC=gcc") from None
+    return words or ["cc"]
+
+
+def _named(cc: tuple) -> str:
+    """The compiler as a message names it: "CC='gcc -O2'", or "'cc'" when CC is not set."""
+    return f"CC={os.environ['CC']!r}" if os.environ.get("CC", "").strip() else repr(shlex.join(cc))
+
+
+def _options(cc: tuple) -> str:
+    """The options CC adds to the compiler (CC="gcc -O2": "-O2"; CC="ccache gcc": none): its libraries are other
+    libraries, named apart (_build)."""
+    return " ".join(w for w in cc[1:] if w.startswith("-"))
+
+
 @functools.lru_cache(maxsize=8)
-def _compiler(cc: str) -> str:
-    """The compiler's version text (asked once per process: a subprocess costs tens of milliseconds)."""
-    return subprocess.run([cc, "--version"], capture_output=True, text=True, check=True).stdout
+def _identity(cc: tuple) -> tuple[str | None, str]:
+    """What names the compiler in a library's cache name: its ``--version`` text (a wrapper such as ccache answers
+    with the compiler's); a program that has no --version is named by its command line. Asked once per process
+    (a subprocess costs tens of milliseconds).
+
+    Returns:
+        (the identity, "") or, when the compiler cannot be run, (None, why: "not found", "permission denied").
+    """
+    try:
+        answer = subprocess.run([*cc, "--version"], capture_output=True, text=True)
+    except OSError as err:
+        memory = out_of_memory(err)
+        if memory is not None:
+            raise memory from err
+        return None, f"{cc[0]}: not found" if isinstance(err, FileNotFoundError) else describe_os_error(err)
+    return (answer.stdout if answer.returncode == 0 and answer.stdout.strip() else shlex.join(cc)), ""
 
 
-def _build(source: Path, cc: str, extra: tuple = ()) -> Path:
+def _hash(text: str) -> str:
+    return hashlib.sha256(text.encode()).hexdigest()[:8]
+
+
+def _built_before(folder: Path, stem: str, base: str, options: str) -> Path | None:
+    """The newest private library of this source, flags, CPU and CC options that any compiler built, or None."""
+    tail = f"-{_hash(options)}.so" if options else ".so"
+    found = [p for p in folder.glob(f"{stem}-{base}-*.so") if _private(p) and p.is_file()
+             and p.name.endswith(tail) and len(p.name) == len(f"{stem}-{base}-") + 8 + len(tail)]
+    return max(found, key=lambda p: p.stat().st_mtime_ns, default=None)
+
+
+def _build(source: Path, cc: tuple, extra: tuple = ()) -> Path:
+    """The library of ``source`` built by the compiler ``cc`` (its words) with FLAGS and ``extra``: from the cache,
+    else built into it (replaced whole), else, when ``cc`` cannot be run, one an earlier compiler built.
+
+    Raises:
+        MachineFault: no compiler and no library built before, a compiler that fails, a cache that cannot be
+            written (each naming what to do); OutOfMemory.
+    """
     flags = [*FLAGS, *extra]
-    version = _compiler(cc)
-    key = hashlib.sha256(_source_bytes(source) + " ".join(flags).encode() + version.encode()
-                         + _cpu_flags().encode())
-    out = _folder() / f"{source.stem}-{key.hexdigest()[:16]}.so"
+    folder = _folder()
+    base = hashlib.sha256(_source_bytes(source) + " ".join(flags).encode() + _cpu_flags().encode()).hexdigest()[:16]
+    identity, why = _identity(cc)
+    options = _options(cc)
+    if identity is None:  # no compiler: a library of this very source, flags, CPU and CC options serves
+        built = _built_before(folder, source.stem, base, options)
+        if built is not None:
+            return built
+        what = ("set CC to a C compiler that runs (e.g. CC=gcc), or install one" if "CC=" in _named(cc) else
+                "install a C compiler (gcc or clang), or set CC to one")
+        raise MachineFault(f"the C compiler {_named(cc)} cannot be run ({why}), and fepen's C kernel {source.name} "
+                           f"is not built yet in {folder}: {what}; fepen builds its kernels once per machine")
+    out = folder / f"{source.stem}-{base}-{_hash(identity)}{'-' + _hash(options) if options else ''}.so"
     if out.exists() and _private(out):
         return out
-    with replacing(out, ".so") as tmp:
-        subprocess.run([cc, *flags, str(source), "-lm", "-o", str(tmp)], capture_output=True, text=True,
-                       check=True)
+    try:
+        with replacing(out, ".so") as tmp:
+            done = subprocess.run([*cc, *flags, str(source), "-lm", "-o", str(tmp)], capture_output=True, text=True)
+            if done.returncode != 0:
+                said = (done.stderr or done.stdout).strip().splitlines()
+                said = [ln for ln in said if "error" in ln.lower()] or said[-1:] or ["no message"]
+                raise MachineFault(f"the C compiler {_named(cc)} failed on fepen's C kernel {source.name} (exit "
+                                   f"{done.returncode}: {said[0].strip()}): set CC to a working C compiler (gcc or "
+                                   "clang)")
+    except MachineFault:
+        raise
+    except OSError as err:  # the cache that cannot be written, a full disk, no memory to start the compiler
+        raise _cache_fault(folder, err) from None
     return out
+
+
+def _load(source: Path, extra: tuple = ()) -> ctypes.CDLL:
+    """Build (once) and load a C source.
+
+    Raises:
+        MachineFault: as _build, or a library that does not load; OutOfMemory: one that cannot be mapped."""
+    path = _build(source, tuple(compiler()), tuple(extra))
+    try:
+        return ctypes.CDLL(str(path))
+    except OSError as err:
+        memory = out_of_memory(err)
+        if memory is not None:
+            raise memory from err
+        raise MachineFault(f"fepen's C kernel {path} does not load ({describe_os_error(err)}): remove it, and "
+                           "fepen builds it again") from err
 
 
 def load(source: Path, extra: tuple = ()) -> tuple[ctypes.CDLL | None, str | None]:
@@ -226,10 +364,14 @@ def load(source: Path, extra: tuple = ()) -> tuple[ctypes.CDLL | None, str | Non
             must round as numpy does, one operation at a time).
 
     Returns:
-        (the library, None), or (None, why it could not be built or loaded).
+        (the library, None), or (None, why it could not be built or loaded: the MachineFault's message).
+
+    Raises:
+        OutOfMemory: the library cannot be mapped (ulimit -v): the process has no memory to go on with.
     """
     try:
-        return ctypes.CDLL(str(_build(source, os.environ.get("CC", "cc"), tuple(extra)))), None
-    except (OSError, subprocess.CalledProcessError) as err:
-        detail = (getattr(err, "stderr", "") or str(err)).strip()
-        return None, f"{source.name} not built ({detail.splitlines()[-1] if detail else err})"
+        return _load(source, tuple(extra)), None
+    except OutOfMemory:
+        raise
+    except MachineFault as err:
+        return None, str(err)

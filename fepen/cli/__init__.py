@@ -39,7 +39,17 @@ import sys
 
 from fepen.cli import envelope, keys, mesh, run, study, sweep, validate, validate_depth, view
 from fepen.cli.common import say
-from fepen.errors import InputError, Interrupted, MachineFault, SimulationError, describe_os_error, stop_outcome
+from fepen.errors import (
+    OUTCOMES,
+    InputError,
+    Interrupted,
+    MachineFault,
+    SimulationError,
+    describe_os_error,
+    out_of_memory,
+    start_within_limits,
+    stop_outcome,
+)
 
 __all__ = ["main", "COMMANDS", "version_line", "stack_line", "common", "run", "mesh", "validate", "validate_depth",
            "study", "sweep", "keys", "view", "envelope"]
@@ -62,7 +72,7 @@ def _parser() -> argparse.ArgumentParser:
     """The parser: the global options and one sub-parser per command, from its module's add_arguments."""
     ap = _Parser(prog="fepen", description="Projectile penetrating concrete, projectile-target separation.",
                  epilog="Exit codes: 0 success, 2 bad input, 3 the simulation cannot go on, 4 a fault of the "
-                        "machine (disk full, permission, SIGTERM/SIGINT after a checkpoint), 1 a bug. "
+                        "machine (disk full, permission, memory, no C compiler, a signal after a checkpoint), 1 a bug. "
                         "--debug (anywhere): tracebacks.")
     ap.add_argument("--version", action="store_true", help="print fepen's version and code revision, and the "
                     "dolfinx, PETSc, MPI, numpy and Python it runs on, and exit")
@@ -97,9 +107,12 @@ def stack_line() -> str:
 def main(argv: list[str] | None = None) -> int:
     """Entry point of the ``fepen`` console script and of ``python -m fepen``. Returns the exit code
     (fepen.errors): every error is one line on stderr, with its traceback only under --debug."""
-    from fepen.io import rundir
-
     argv = list(sys.argv[1:] if argv is None else argv)
+    start_within_limits()  # before numpy, MPI or gmsh is loaded
+    try:  # MPI and numpy load here: a fault of the machine (memory under ulimit -v) is one line already
+        from fepen.io import rundir
+    except BaseException as err:  # noqa: B036 - every way out is one line and a documented code
+        return _failed(err, "--debug" in argv)
     rundir.begin_command(["fepen", *map(str, argv)])  # run.json's "command"
     rundir._in_cli = True  # the API calls of the command keep this line
     try:
@@ -145,13 +158,28 @@ def _main(argv: list[str]) -> int:
     except BaseException as err:  # noqa: B036 - every way out is one line and a documented code
         if isinstance(err, SystemExit):
             return err.code if isinstance(err.code, int) else 0  # --help
-        code, line = _verdict(err)
-        if debug:
-            import traceback
+        return _failed(err, debug)
 
+
+def _failed(err: BaseException, debug: bool) -> int:
+    """The exit code of an error that ended the command, its one line said (and its traceback, with --debug).
+    Memory that ran out is given back first (the locals of the frames the traceback holds), and a line that still
+    cannot be said, or kept in fepen.log, leaves the exit code as it is."""
+    import traceback
+
+    if out_of_memory(err) is not None:
+        traceback.clear_frames(err.__traceback__)
+    try:
+        code, line = _verdict(err)
+    except MemoryError:
+        code, line = OUTCOMES["fault"].exit_code, "fepen: stopped by a fault of the machine: out of memory"
+    try:
+        if debug:
             traceback.print_exc()
         _error(line)
-        return code
+    except MemoryError:
+        pass
+    return code
 
 
 #: the longest error line: a longer one (a value of megabytes echoed) keeps its start, which names the key, and
@@ -181,14 +209,15 @@ def _verdict_line(err: BaseException) -> tuple[int, str]:
         return code, f"fepen: simulation stopped: {err}"
     if isinstance(err, Interrupted):
         return code, f"fepen: interrupted: {err}"
+    memory = out_of_memory(err)  # a MemoryError, a library that cannot be mapped (ulimit -v): exit 4, not a bug
+    if memory is not None:
+        return code, f"fepen: stopped by a fault of the machine: {memory}"
     if isinstance(err, MachineFault):
         return code, f"fepen: stopped by a fault of the machine: {err}"
     if isinstance(err, OSError):
         return code, f"fepen: stopped by a fault of the machine: {describe_os_error(err)}"
     if isinstance(err, KeyboardInterrupt):
         return code, "fepen: interrupted (SIGINT) before the run had anything to keep"
-    if isinstance(err, MemoryError):
-        return code, "fepen: stopped by a fault of the machine: out of memory"
     text = " ".join(str(err).split())[:300]
     return code, (f"fepen: internal error (a bug in fepen; run again with --debug for the traceback and report "
                   f"it): {type(err).__name__}: {text}")
@@ -215,11 +244,15 @@ def _quiet() -> None:
 
 
 def _error(line: str) -> None:
-    """The one line of an error, on stderr (rank 0), kept for fepen.log."""
-    from mpi4py import MPI
-
-    from fepen.io import rundir
-
-    if MPI.COMM_WORLD.rank == 0:
+    """The one line of an error, on stderr (rank 0), kept for fepen.log. Without MPI when MPI did not load (no
+    memory for it): the rank is then mpirun's (OMPI_COMM_WORLD_RANK, PMI_RANK)."""
+    mpi = sys.modules.get("mpi4py.MPI")
+    if mpi is not None and mpi.Is_initialized():
+        rank = mpi.COMM_WORLD.rank
+    else:
+        rank = int(os.environ.get("OMPI_COMM_WORLD_RANK", os.environ.get("PMI_RANK", "0")) or 0)
+    if rank == 0:
         print(line, file=sys.stderr, flush=True)
-        rundir.log_line(line)
+        rundir = sys.modules.get("fepen.io.rundir")
+        if rundir is not None:
+            rundir.log_line(line)

@@ -262,11 +262,15 @@ class RunDirectory:
         else:
             o = stop_outcome(err)
             outcome, code = o.name, o.exit_code
+            if outcome == "fault" and tb is not None:  # out of memory: the failed run's frames let go of theirs
+                import traceback
+
+                traceback.clear_frames(tb)
         global _log_path
         try:
             if self.comm.rank == 0:
-                self._close(outcome, code,
-                            None if err is None else str(err).splitlines()[0] if str(err) else kind.__name__)
+                text = "" if err is None else next((ln for ln in str(err).splitlines() if ln.strip()), "")
+                self._close(outcome, code, None if err is None else text or kind.__name__)
         finally:
             atomic.release(self.claim)
             if self._outer_log is not None:  # a shot's folder inside a study's: the study's log again (a run's own
@@ -471,19 +475,24 @@ class RunDirectory:
         last = self.record["resumes"][-1] if self.record.get("resumes") else self.record
         from fepen.io.files import versions
 
-        last.update(end=_now(), outcome=outcome, exit_code=code, **({"message": message} if message else {}),
-                    versions=versions())  # at the end: dolfinx and PETSc are named when the run imported them
-        refused = self.mode == "resume" and outcome == "bad-input"  # a refused resume leaves the run as it was
-        if "resumes" in self.record and not refused:  # the first invocation's record stays; the whole run's beside it
-            self.record.update(final_outcome=outcome, final_exit_code=code)
-        _remove_reserve(self.out)
-        self.claim.owned.discard(RESERVE)
         try:
-            self._save()
-        except OSError:  # a full disk: run.json keeps its "running" record; the lock goes all the same
-            pass
-        _append(self.out / "fepen.log", [f"# {last['end']} {outcome} (exit {code})"])
-        self._unlock()
+            last.update(end=_now(), outcome=outcome, exit_code=code, **({"message": message} if message else {}))
+            refused = self.mode == "resume" and outcome == "bad-input"  # a refused resume leaves the run as it was
+            if "resumes" in self.record and not refused:  # the first invocation's record stays; the run's beside it
+                self.record.update(final_outcome=outcome, final_exit_code=code)
+            _remove_reserve(self.out)
+            self.claim.owned.discard(RESERVE)
+            try:
+                last["versions"] = versions()  # at the end: dolfinx and PETSc are named when the run imported them
+            except (OSError, MemoryError, ImportError):  # out of memory: the record without them
+                pass
+            try:
+                self._save()
+            except (OSError, MemoryError):  # a full disk, or no memory left: run.json keeps "running"
+                pass
+            _append(self.out / "fepen.log", [f"# {last['end']} {outcome} (exit {code})"])
+        finally:
+            self._unlock()  # the lock goes all the same
 
 
 def _study_changed(before, now) -> str:

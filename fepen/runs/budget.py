@@ -1,6 +1,7 @@
 """What a shot will cost, known before any work starts (docs/results.md, "Limits"): the cells and memory of a
-deformable shot's mesh, refused before gmsh starts when they pass ``mesh.max_cells`` or the machine's memory,
-and a mesh too coarse for the body refused in one line naming ``mesh.size``.
+deformable shot's mesh, refused before gmsh starts when they pass ``mesh.max_cells``, the machine's memory or
+what a per-process limit leaves the process (``ulimit -v``, a batch system's h_vmem; ``ulimit -d``), and a mesh
+too coarse for the body refused in one line naming ``mesh.size``.
 
 The figures are measured on this project's machines (docs/results.md gives the measurements): gmsh makes
 4.4 (1 mm) to 5.0 (2.5 mm) tetrahedra per (meshed volume / mesh.size³) on the default body, and a deformable
@@ -15,7 +16,7 @@ import os
 
 import numpy as np
 
-from fepen.errors import InputError
+from fepen.errors import InputError, MachineFault, memory_limits
 
 #: tetrahedra per (meshed volume / size³): the measured 5.0 with a tenth more
 CELLS_PER_SIZE3 = 5.5
@@ -59,7 +60,7 @@ def expected_bytes(cells: float, processes: int) -> float:
     return processes * PROCESS_BYTES + cells * CELL_BYTES
 
 
-def available_bytes() -> float | None:
+def machine_bytes() -> float | None:
     """The memory this machine has available now (MemAvailable of /proc/meminfo), or None where unknown."""
     try:
         with open("/proc/meminfo") as f:
@@ -74,9 +75,59 @@ def available_bytes() -> float | None:
         return None
 
 
+def process_room() -> tuple[float, str, float, float] | None:
+    """What the tightest per-process memory limit leaves this process: ``(bytes left, the limit's name ("ulimit
+    -v": the address space, less what the process maps now, /proc/self/status VmSize; "ulimit -d": the data
+    segment, less VmData), the limit (bytes), what the process holds against it (bytes))``, or None when no
+    limit is set (fepen.errors.memory_limits)."""
+    rooms = [(limit - (held or 0), name, limit, held or 0) for name, _, limit, held in memory_limits()]
+    return min(rooms) if rooms else None
+
+
+def available_bytes() -> float | None:
+    """The memory this process can still take (bytes): the least of the machine's (machine_bytes) and what a
+    per-process limit leaves it (process_room), or None where neither is known."""
+    room = process_room()
+    found = [b for b in (machine_bytes(), None if room is None else room[0]) if b is not None]
+    return min(found) if found else None
+
+
+_MIB = float(1 << 20)
+
+
+def _up(x: float) -> float:
+    """``x`` rounded up to two significant digits: a size said to fit does."""
+    step = 10.0 ** (math.floor(math.log10(x)) - 1)
+    return math.ceil(x / step * (1.0 - 1e-12)) * step
+
+
+def _check_room(room: tuple, size: float, cells: float, processes: int, coarsest: float) -> None:
+    """Refuse a mesh past what a per-process limit leaves (process_room): each process takes PROCESS_BYTES, and
+    rank 0 the whole mesh's cells (gmsh makes it there, and dolfinx distributes it from there). InputError
+    naming mesh.size when a coarser mesh fits; MachineFault naming the limit when none does."""
+    left, name, limit, held = room
+    need = expected_bytes(cells, 1)
+    if need <= left:
+        return
+    what = f"the {'address-space' if name == 'ulimit -v' else 'data'} limit {name}"
+    raise_it = f"raise {name} (a batch system's h_vmem)" if name == "ulimit -v" else f"raise {name}"
+    whole = "the whole mesh on rank 0 while it is made" if processes > 1 else ""
+    fits = size * (cells * CELL_BYTES / max(left - PROCESS_BYTES, 1.0)) ** (1.0 / 3.0)
+    if left <= PROCESS_BYTES or fits > coarsest:
+        raise MachineFault(f"{what} is {limit / _MIB:.0f} MiB and this process already maps {held / _MIB:.0f} MiB: "
+                           f"a deformable run needs about {need / _MIB:.0f} MiB more per process before its first "
+                           f"step ({cells:.3g} cells at mesh.size = {size:g} m{', ' + whole if whole else ''}): "
+                           f"{raise_it} to at least {(held + need) / _MIB:.0f} MiB")
+    raise InputError("mesh.size", f"{size:g} m makes about {cells:.3g} cells, about {need / _MIB:.0f} MiB more per "
+                                  f"process before the first step{' (' + whole + ')' if whole else ''}; {what} "
+                                  f"({limit / _MIB:.0f} MiB) leaves this process {left / _MIB:.0f} MiB: use "
+                                  f"mesh.size >= {_up(fits):.2g} m, or {raise_it}")
+
+
 def check_mesh(shape, size: float, nose_size: float | None, charge: bool, max_cells: float, processes: int) -> dict:
-    """Refuse, before gmsh starts, a mesh too coarse for the body or too large for ``mesh.max_cells`` or for the
-    machine's memory (InputError naming the key, the estimate and what would do).
+    """Refuse, before gmsh starts, a mesh too coarse for the body or too large for ``mesh.max_cells``, for the
+    machine's memory or for what a per-process limit leaves each process (``ulimit -v``: InputError naming the
+    key, the estimate and what would do; MachineFault naming the limit when no mesh would do).
 
     Args:
         shape: the exact body (a Shape or a CadBody). size, nose_size: mesh.size and mesh.nose_size (m).
@@ -96,7 +147,10 @@ def check_mesh(shape, size: float, nose_size: float | None, charge: bool, max_ce
         raise InputError("mesh.size", f"{size:g} m makes about {cells:.3g} cells (about {need / 1e9:.1f} GB before the "
                                       f"first step), more than mesh.max_cells = {max_cells:.3g}: use mesh.size >= "
                                       f"{finest:.2g} m, or raise mesh.max_cells on a machine that has the memory")
-    free = available_bytes()
+    free, room = available_bytes(), process_room()
+    if room is not None and (free is None or room[0] <= free):  # a per-process limit binds: each process's own
+        _check_room(room, size, cells, processes, coarsest)
+        free = machine_bytes()  # and the machine's, for all the processes
     if free is not None and need > free:
         fits = size * ((need - processes * PROCESS_BYTES) / max(free - processes * PROCESS_BYTES, 1.0)) ** (1 / 3)
         raise InputError("mesh.size", f"{size:g} m makes about {cells:.3g} cells, about {need / 1e9:.1f} GB before "
