@@ -223,21 +223,6 @@ def create_new(path, mode: str = "wb"):
     return os.fdopen(fd, mode)
 
 
-def input_file(path, key: str, limit: int, what: str) -> Path:
-    """A user's input file checked before it is read (InputError naming ``key``): a regular file (not a device,
-    a pipe or a directory, which could be read forever) of at most ``limit`` bytes."""
-    p = Path(path)
-    try:
-        st = os.stat(p)
-    except (OSError, ValueError) as err:
-        raise InputError(key, f"cannot read {what} {str(p)!r}: {getattr(err, 'strerror', None) or err}") from None
-    if not stat.S_ISREG(st.st_mode):
-        raise InputError(key, f"{str(p)!r} is not a regular file: {what} is a file")
-    if st.st_size > limit:
-        raise InputError(key, f"{str(p)!r} is {st.st_size} bytes: {what} is at most {limit >> 20} MiB")
-    return p
-
-
 def sha256_file(path) -> str:
     """The SHA-256 of a file's bytes (hex), read in blocks: the checksum checkpoints and mesh-cache entries
     carry."""

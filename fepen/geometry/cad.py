@@ -97,7 +97,7 @@ def digest(path: str) -> str:
 def _opened(path: str):
     """The CAD file open for reading: a regular file of at most CAD_MAX bytes, checked without blocking (a pipe
     or a device named projectile.cad is refused, not read for ever). InputError (projectile.cad) else."""
-    from fepen.scene.resolve import open_input, unreadable
+    from fepen.inputs import open_input, unreadable
 
     try:
         fh = open_input(path)

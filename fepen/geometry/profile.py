@@ -290,7 +290,7 @@ def read_points(path: str, key: str) -> list[tuple[float, float, float]]:
         [(z, r, arc)] in file order. Raises InputError naming ``key`` when unreadable.
     """
     from fepen.errors import InputError
-    from fepen.scene.resolve import read_capped
+    from fepen.inputs import read_capped
 
     data = read_capped(path, PROFILE_MAX, key, "the profile",
                        missing=f"cannot read the profile {path!r}: No such file or directory")

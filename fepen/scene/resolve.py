@@ -10,14 +10,14 @@ from __future__ import annotations
 import copy
 import difflib
 import os
-import stat
 import tomllib
 from collections.abc import Callable
 from pathlib import Path
-from typing import Any, BinaryIO
+from typing import Any
 
 from fepen.data import CONSTANTS, STEELS, TARGETS, shot
 from fepen.errors import InputError
+from fepen.inputs import NotRegularFile, open_input, read_capped, unreadable
 from fepen.laws.target import a_over_c_cubed, cylinder_strength, youngs_modulus_aci
 from fepen.scene.keys import ABSENT, DEPTH_MAX, check_nesting, display_name, shown
 from fepen.scene.schema import SCHEMA, SECTIONS
@@ -262,11 +262,11 @@ _ROW_KEYS = (("target.layers", "layers"), ("output.probes", "probes"), ("project
              "may be, so that it reads back (fepen run --resume, fepen.load): not too many target.layers, "
              "output.probes or projectile.cavity_sections")
 def _written_scene_fits(scene: Scene) -> None:
-    """(Measured only past ROWS_UNMEASURED rows: fepen.scene.writing.to_toml writes the scene.)"""
+    """(Measured only past ROWS_UNMEASURED rows: fepen.scene.text.to_toml writes the scene.)"""
     rows = {key: len(scene.get(key) or ()) for key, _ in _ROW_KEYS}
     if sum(rows.values()) <= ROWS_UNMEASURED:
         return
-    from fepen.scene.writing import to_toml
+    from fepen.scene.text import to_toml
 
     size = len(to_toml(scene).encode())
     if size > SCENE_MAX:
@@ -694,90 +694,6 @@ def set_item(key: str, value) -> str:
     else:
         raise TypeError(f"{key}: a scene value is a number, a boolean or a text, not {type(value).__name__}")
     return f"{key}={text}"
-
-
-class NotRegularFile(OSError):
-    """A user's input file that is not a regular file: a pipe, a device, a folder or a socket (open_input)."""
-
-
-def _kind(mode: int) -> str:
-    """What a file that is not a regular one is, in words."""
-    for test, word in ((stat.S_ISDIR, "a folder"), (stat.S_ISFIFO, "a pipe"), (stat.S_ISCHR, "a device"),
-                       (stat.S_ISBLK, "a device"), (stat.S_ISSOCK, "a socket")):
-        if test(mode):
-            return word
-    return "a special file"
-
-
-def open_input(path) -> BinaryIO:
-    """Open a user's input file for reading, refusing anything but a regular file without blocking: opened with
-    O_NONBLOCK (a pipe without a writer opens at once instead of waiting for one for ever), then what was opened
-    is asked (fstat), so a file swapped for a pipe between a check and the open is caught too.
-
-    Args:
-        path: the file (str or Path).
-
-    Returns:
-        The open binary file (a context manager; ``os.fstat(f.fileno()).st_size`` its size).
-
-    Raises:
-        NotRegularFile (an OSError) for a pipe, a device, a folder or a socket; OSError as open() raises it;
-        ValueError for a name holding a NUL. :func:`unreadable` turns each into the one-line InputError.
-    """
-    flags = os.O_RDONLY | getattr(os, "O_NONBLOCK", 0) | getattr(os, "O_NOCTTY", 0) | getattr(os, "O_CLOEXEC", 0)
-    fd = os.open(path, flags)
-    try:
-        mode = os.fstat(fd).st_mode
-        if not stat.S_ISREG(mode):
-            raise NotRegularFile(_kind(mode))
-        return os.fdopen(fd, "rb")  # (O_NONBLOCK changes nothing in the reads of a regular file)
-    except BaseException:
-        os.close(fd)
-        raise
-
-
-def unreadable(err: Exception, path, key: str, what: str, missing: str | None = None) -> InputError:
-    """The error of a user's input file :func:`open_input` could not open, naming ``key``.
-
-    Args:
-        err: what open_input raised (NotRegularFile, another OSError, or ValueError).
-        path: the file. key: the key that names it. what: what the file is ("a scene file", "the profile").
-        missing: the message when there is no such file (None: "cannot read PATH: No such file or directory").
-
-    Returns:
-        The InputError (to raise).
-    """
-    name = display_name(str(path), 200)
-    if isinstance(err, NotRegularFile):
-        return InputError(key, f"{name} is {err}, not a regular file: {what} is read from a regular file")
-    if isinstance(err, FileNotFoundError) and missing is not None:
-        return InputError(key, missing)
-    return InputError(key, f"cannot read {name}: {getattr(err, 'strerror', None) or err}")
-
-
-def read_capped(path: Path, limit: int, key: str, what: str, missing: str | None = None) -> bytes:
-    """The bytes of a user's text file, refused (InputError naming ``key``) when it is not a regular file (a
-    pipe, a device or a folder, checked without blocking: :func:`open_input`) or larger than ``limit``: never
-    more than ``limit`` + 1 bytes are read.
-
-    Args:
-        path: the file. limit: the most bytes it may hold. key: the key that names it.
-        what: what the file is, as the messages say it ("a scene file").
-        missing: the message when there is no such file (:func:`unreadable`).
-
-    Returns:
-        The file's bytes.
-    """
-    try:
-        with open_input(path) as fh:
-            size = os.fstat(fh.fileno()).st_size
-            data = b"" if size > limit else fh.read(limit + 1)
-    except (OSError, ValueError) as err:
-        raise unreadable(err, path, key, what, missing) from None
-    if size > limit or len(data) > limit:
-        raise InputError(key, f"{display_name(str(path), 200)} is larger than {limit >> 10} KiB, the most {what} "
-                              "may be")
-    return data
 
 
 def toml_error(err: Exception, key: str, where: str) -> InputError:

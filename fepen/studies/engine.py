@@ -20,7 +20,6 @@ import json
 import logging
 import os
 import sys
-import threading
 import time
 from collections.abc import Callable
 from dataclasses import dataclass
@@ -30,14 +29,12 @@ from mpi4py import MPI
 
 from fepen.errors import InputError, Interrupted, SimulationError
 from fepen.io import rundir
+from fepen.studies import queue
 
 __all__ = ["execute", "summaries", "run_shot", "run_shots", "process_shot", "How", "read_records",
            "check_ranks_per_shot", "RECORDS", "BATCH", "chunks"]
 
 RECORDS = "shots.jsonl"
-_REQUEST, _REPLY = 7101, 7102
-#: the dispatcher's poll period (s) between requests
-POLL = 5e-4
 #: the records are synced to the disk at most this often (s)
 SYNC = 1.0
 #: shots of a request when the caller asks for batches (rigid shots: fepen.runs.batch)
@@ -299,6 +296,13 @@ def execute(n: int, scene_of, out, comm=None, ranks_per_shot: int = 1, keep=None
     quiet.setLevel(logging.ERROR)  # the shots' notes were said once when the study was read
     interval = sys.getswitchinterval()
     halted = _halting(stop)
+
+    def work(run, group):  # a run of shots on a group
+        return run_shots(run, scene_of, out, group, how)
+
+    def halting(records=()):  # a signal stops the shots, or stopped one of them
+        return _halting(stop, records)
+
     try:
         runs = [] if halted else chunks(pending, batch, groups)
         if comm.size == 1:
@@ -310,10 +314,10 @@ def execute(n: int, scene_of, out, comm=None, ranks_per_shot: int = 1, keep=None
         elif MPI.Query_thread() < MPI.THREAD_MULTIPLE:  # no dispatcher thread: a fixed round robin
             if comm.rank == 0 and say is not None:
                 say(f"{desc}: this MPI has no MPI_THREAD_MULTIPLE: shots go round robin, not by a queue")
-            _round_robin(runs, scene_of, out, comm, k, how, log, stop)
+            queue.round_robin(runs, work, comm, k, log, halting)
         else:
             sys.setswitchinterval(1e-3)  # rank 0's dispatcher answers within a millisecond or so
-            _parallel(runs, scene_of, out, comm, k, how, log, stop)
+            queue.parallel(runs, work, comm, k, log, halting)
     finally:
         quiet.setLevel(level)
         sys.setswitchinterval(interval)
@@ -332,80 +336,6 @@ def _halting(stop, records=()) -> bool:
 def _shot_dir(out: Path, i: int) -> Path:
     return out / "shots" / f"{i:05d}"
 
-
-
-def _parallel(runs, scene_of, out, comm, k, how, log, stop=None) -> None:
-    group = comm.Split(comm.rank // k, comm.rank)
-    queue = comm.Dup()
-    groups = comm.size // k
-    dispatcher = None
-    if comm.rank == 0:
-        dispatcher = threading.Thread(target=_dispatch, args=(queue, list(runs), groups, log, stop), daemon=True)
-        dispatcher.start()
-    try:
-        records, halt = None, False
-        while True:
-            run = None
-            if group.rank == 0:
-                queue.send((records, halt), dest=0, tag=_REQUEST)
-                run = queue.recv(source=0, tag=_REPLY)
-            run = group.bcast(run, root=0)
-            if not run:
-                break
-            rs = run_shots(run, scene_of, out, group, how)
-            records = rs if group.rank == 0 else None
-            halt = _halting(stop, rs)
-            if group.size > 1:  # a signal to any rank of the group
-                halt = group.allreduce(halt, op=MPI.LOR)
-    finally:
-        if dispatcher is not None:
-            dispatcher.join()
-        group.Free()
-        queue.Free()
-
-
-def _round_robin(runs, scene_of, out, comm, k, how, log, stop=None) -> None:
-    group = comm.Split(comm.rank // k, comm.rank)
-    mine = []
-    for run in runs[comm.rank // k:: comm.size // k]:
-        rs = run_shots(run, scene_of, out, group, how)
-        if comm.rank == 0:
-            for r in rs:
-                log.add(r)
-        elif group.rank == 0:
-            mine.extend(rs)
-        halt = _halting(stop, rs)
-        if group.size > 1 and group.allreduce(halt, op=MPI.LOR) or group.size == 1 and halt:
-            break
-    for part in comm.gather(mine, root=0) or []:
-        for r in part:
-            log.add(r)
-    group.Free()
-
-
-def _dispatch(queue, runs: list, groups: int, log, stop=None) -> None:
-    """Rank 0's thread: hand out the pending runs of shots in order to whichever leader asks, record what they
-    send back, tell each leader to stop (an empty run) when none is left, or when a signal stopped a group (it
-    says so with its request) or rank 0 (``stop``)."""
-    status = MPI.Status()
-    nxt, stopped, halted = 0, 0, False
-    while stopped < groups:
-        if not queue.Iprobe(source=MPI.ANY_SOURCE, tag=_REQUEST, status=status):
-            time.sleep(POLL)
-            continue
-        src = status.Get_source()
-        records, halt = queue.recv(source=src, tag=_REQUEST)
-        for record in records or ():
-            log.add(record)
-        halted = halted or halt or _halting(stop)
-        if halted:
-            log.halted = True
-        if nxt < len(runs) and not halted:
-            queue.send(runs[nxt], dest=src, tag=_REPLY)
-            nxt += 1
-        else:
-            queue.send([], dest=src, tag=_REPLY)
-            stopped += 1
 
 
 def summaries(scenes, comm=None) -> list:

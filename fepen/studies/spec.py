@@ -32,9 +32,7 @@ once): bad input is one line naming the spec's key, or the shot and the scene ke
 
 from __future__ import annotations
 
-import csv
 import hashlib
-import io
 import json
 import math
 from dataclasses import dataclass, field
@@ -47,16 +45,12 @@ from fepen.errors import InputError
 from fepen.scene.keys import Key, check_nesting, display_name
 from fepen.scene.resolve import given_twice, toml_error
 from fepen.studies.monte_carlo import DISTRIBUTIONS, FINITE, POSITIVE, distribution, monte_carlo
+from fepen.studies.shot_table import CELL_MAX, TABLE_MAX, check_key, read_table
 
 __all__ = ["Spec", "read", "load", "sections", "base_keys", "flat_leaves", "distribution", "sample", "monte_carlo",
            "expand_shot", "keep_basis", "resized", "MAX_SHOTS", "TABLE_MAX", "CELL_MAX", "DISTRIBUTIONS", "IMPACT"]
 
 MAX_SHOTS = 200_000
-#: the largest table of shots read (bytes)
-TABLE_MAX = 64 << 20
-#: the largest cell of a table of shots (characters): one scene value (a number, a word, a path, a short list);
-#: Python's csv module's own default field limit, past which it stopped with an error of its own
-CELL_MAX = 128 << 10
 IMPACT = ("impact.velocity", "impact.obliquity_deg", "impact.attack_deg")
 
 
@@ -134,12 +128,6 @@ def flat_leaves(tree: dict, is_leaf, prefix: str = "", where: str = "") -> dict:
     return out
 
 
-def _check_key(section: str, name: str) -> None:
-    if name not in fscene.SCHEMA:
-        err = fscene.unknown_key(name)
-        raise InputError(f"{section}.{display_name(name)}", f"not a scene key ({err.message})")
-
-
 #: the checks of the spec's own numbers, as the scene's keys are checked (fepen.scene.keys.Key)
 COUNT = Key(int, None, lo=1, hi=100_000)
 SAMPLES = Key(int, None, lo=1, hi=MAX_SHOTS)
@@ -175,69 +163,6 @@ def _grid_values(name: str, spec) -> list:
     raise InputError(where, f"a list of values or a range table {{start, stop, num}}, got {spec!r}")
 
 
-def _csv_rows(path: Path, text: str) -> list[tuple[int, list]]:
-    """(line, cells) of each row of a CSV text but blank and # comment rows: every cell read whole (csv's own
-    field limit raised to the table's size for the read, then restored), so that a long cell is named by
-    _read_table with its column; a CSV csv cannot read is InputError (table.file)."""
-    reader = csv.reader(io.StringIO(text))
-    limit = csv.field_size_limit(max(csv.field_size_limit(), TABLE_MAX))
-    rows = []
-    try:
-        for r in reader:
-            if r and not r[0].lstrip().startswith("#"):
-                rows.append((reader.line_num, r))
-    except csv.Error as err:
-        raise InputError("table.file", f"{path} line {reader.line_num}: not CSV fepen reads: {err}") from None
-    finally:
-        csv.field_size_limit(limit)
-    return rows
-
-
-def _read_table(path: Path) -> tuple[list, list]:
-    """Keys and shots of a CSV table (header: scene keys, each once; values in TOML syntax, bare words strings;
-    cells of at most CELL_MAX characters; UTF-8, a byte-order mark allowed)."""
-    try:
-        text = fscene.read_capped(path, TABLE_MAX, "table.file", "a table of shots").decode("utf-8-sig")
-    except UnicodeDecodeError:
-        raise InputError("table.file", f"{path} is not UTF-8 text") from None
-    rows = _csv_rows(path, text)
-    if len(rows) < 2:
-        raise InputError("table.file", f"{path} needs a header of scene keys and at least one row")
-    if len(rows) - 1 > MAX_SHOTS:
-        raise InputError("table.file", f"{path} holds {len(rows) - 1} shots; a sweep holds at most {MAX_SHOTS}")
-    header_line, header = rows[0]
-    keys = [k.strip() for k in header]
-
-    def column(j: int) -> str:
-        return f"column {j + 1}" + (f" ({display_name(keys[j])})" if j < len(keys) and keys[j] else "")
-
-    for n, r in rows:
-        for j, v in enumerate(r):
-            if len(v) > CELL_MAX:
-                raise InputError("table.file", f"{path} line {n}, {column(j)}: a cell of {len(v)} characters; a "
-                                               f"cell holds one scene value, at most {CELL_MAX}")
-    for j, k in enumerate(keys):
-        if not k:
-            raise InputError("table.file", f"{path} line {header_line}, column {j + 1}: an empty header cell; each "
-                                           "column names a scene key")
-        if k in keys[:j]:
-            raise InputError("table.file", f"{path} line {header_line}, {column(j)}: given twice (also column "
-                                           f"{keys.index(k) + 1}); each key is one column")
-        _check_key("table.file", k)
-    shots = []
-    for n, r in rows[1:]:
-        if len(r) != len(keys):
-            raise InputError("table.file", f"{path} line {n}: {len(r)} values for {len(keys)} keys")
-        shot = {}
-        for j, (k, v) in enumerate(zip(keys, r)):
-            try:
-                shot[k] = fscene.parse_set(f"{k}={v.strip()}")[1]
-            except InputError as err:
-                raise InputError("table.file", f"{path} line {n}, {column(j)}: {err.message}") from None
-        shots.append(shot)
-    return keys, shots
-
-
 def read(path, sets=()) -> Spec:
     """Read and check a sweep file; every shot's scene is resolved, so bad input stops here.
 
@@ -271,7 +196,7 @@ def read(path, sets=()) -> Spec:
         tab = spec["table"]
         if not isinstance(tab, dict) or not isinstance(tab.get("file"), str):
             raise InputError("table.file", "the CSV file of shots (a string)")
-        keys, shots = _read_table((path.parent / tab["file"]).resolve())
+        keys, shots = read_table((path.parent / tab["file"]).resolve(), MAX_SHOTS)
     keep_basis(base, keys, resolved)
     if any(k in IMPACT for k in keys):
         base = expand_shot(base)
@@ -361,7 +286,7 @@ def _grid(grid) -> tuple[list, list]:
         raise InputError("grid", "a table of scene keys, each with a list or a range")
     values = flat_leaves(grid, lambda d: "start" in d, where="grid")
     for k in values:
-        _check_key("grid", k)
+        check_key("grid", k)
     values = {k: _grid_values(k, v) for k, v in values.items()}
     keys = list(values)
     count = math.prod(len(v) for v in values.values())
@@ -389,7 +314,7 @@ def sample(mc, resolved) -> tuple[list, list]:
         raise InputError("monte_carlo.vary", "a table of scene keys, each with its distribution")
     specs = flat_leaves(vary, lambda d: "distribution" in d, where="monte_carlo.vary")
     for k in specs:
-        _check_key("monte_carlo.vary", k)
+        check_key("monte_carlo.vary", k)
     dists = {k: distribution(k, v, resolved.get(k)) for k, v in specs.items()}
     return list(dists), monte_carlo(dists, n, seed, lhs)
 

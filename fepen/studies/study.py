@@ -26,8 +26,7 @@ from pathlib import Path
 
 from fepen.io import layout
 
-__all__ = ["Round", "Sub", "Study", "RunInfo", "run", "failed", "inputs_of", "scene_files", "canonical_digest",
-           "register", "get", "public", "set_option", "numbers",
+__all__ = ["Round", "Sub", "Study", "RunInfo", "run", "register", "get", "public", "set_option", "numbers",
            "STUDIES", "REGISTRY", "study_names"]
 
 #: every study by name, in the order the command line lists them: (its module, its class). A module is imported
@@ -172,7 +171,9 @@ class Study:
 
     def digest(self, plan) -> str | None:
         """What makes the folder resumable: a folder of the same study with another digest is refused (by
-        default the plan's fields, its scenes resolved: canonical_digest)."""
+        default the plan's fields, its scenes resolved: fepen.studies.record.canonical_digest)."""
+        from fepen.studies.record import canonical_digest
+
         return canonical_digest(plan)
 
     def prepare(self, plan, out: Path, comm) -> None:
@@ -275,12 +276,12 @@ def run(study: Study, plan, out, comm=None, ranks_per_shot: int = 1, fresh: bool
     from mpi4py import MPI
 
     from fepen.io import files, rundir
-    from fepen.studies import engine
+    from fepen.studies import engine, record
 
     comm = MPI.COMM_WORLD if comm is None else comm
     engine.check_ranks_per_shot(ranks_per_shot, comm.size)
     info = RunInfo(time.perf_counter(), comm.size, ranks_per_shot, say)
-    inputs = inputs_of(study, plan)
+    inputs = record.inputs_of(study, plan)
     with rundir.study_directory(out, comm, fresh, study.name, study.names, digest=inputs["sha256"], inputs=inputs):
         out = files.prepare(Path(out), comm)
         study.prepare(plan, out, comm)
@@ -290,7 +291,7 @@ def run(study: Study, plan, out, comm=None, ranks_per_shot: int = 1, fresh: bool
             _rounds(study, plan, out, comm, info, progress)
         result, failure = None, None
         if comm.rank == 0:
-            failure = failed(info.records)
+            failure = record.failed(info.records)
             if failure is None:
                 result = study.result(plan, info.records, info)
                 study.write(plan, result, out, info)
@@ -304,36 +305,6 @@ def run(study: Study, plan, out, comm=None, ranks_per_shot: int = 1, fresh: bool
         return result
 
 
-def failed(records: list) -> Exception | None:
-    """The error of a study none of whose shots finished (every one refused, stopped or failed), or None.
-
-    Args:
-        records: the rounds' records ({shot: record} each, fepen.studies.engine).
-
-    Returns:
-        InputError (exit 2) when the first failed shot was refused, SimulationError (3) when it stopped,
-        MachineFault (4) when its process failed; its message names the counts and the first shot's reason.
-    """
-    from fepen.errors import InputError, MachineFault, SimulationError
-
-    shots = [r for recs in records if isinstance(recs, dict) for r in recs.values()
-             if isinstance(r, dict) and "status" in r]
-    if not shots or any(r["status"] == "ok" for r in shots):
-        return None
-    first = min(shots, key=lambda r: r.get("shot", 0))
-    counts = {}
-    for r in shots:
-        counts[r["status"]] = counts.get(r["status"], 0) + 1
-    what = ", ".join(f"{n} {k}" for k, n in sorted(counts.items()))
-    reason = first.get("message") or first["status"]
-    message = f"no shot finished ({what}); shot {first.get('shot', 0)}: {reason}"
-    if first["status"] == "bad-input":
-        return InputError("study", message)
-    if first["status"] == "stopped":
-        return SimulationError(message)
-    return MachineFault(message)
-
-
 def _write_what_failed(study: Study, plan, out: Path, info: RunInfo) -> None:
     """The tables of a study none of whose shots finished, as far as its result can be made (each point's
     outcome is in them); a result that cannot be made of failed shots writes nothing more (rank 0)."""
@@ -344,102 +315,6 @@ def _write_what_failed(study: Study, plan, out: Path, info: RunInfo) -> None:
         study.write(plan, result, out, info)
     except Exception as err:  # noqa: BLE001 - the shots' failure is the one to report
         logging.getLogger("fepen").debug(f"no table of the failed shots: {type(err).__name__}: {err}")
-
-
-def inputs_of(study: Study, plan) -> dict:
-    """What a study's results are made of, for its record (run.json "inputs"): the study's own digest (its
-    shots' given keys, fepen.studies.study.Study.digest), fepen's version, every data file fepen ships
-    (fepen.data.digests: the named targets, steels and explosives the shots resolve to) and every file the
-    shots read (a drawn profile, a CAD body) by content; ``sha256`` of them all. A continued study refuses a
-    folder whose inputs differ (fepen.io.rundir), naming what changed, before any shot runs.
-
-    Returns:
-        {"sha256", "study", "fepen", "data": {path: sha}, "files": {path: sha}}.
-    """
-    import hashlib
-    import json
-
-    from fepen import data
-    from fepen.atomic import sha256_file
-    from fepen.errors import InputError
-    from fepen.version import __version__
-
-    files = {}
-    for key, path in scene_files(plan):
-        try:
-            files[path] = sha256_file(path)
-        except OSError as err:
-            raise InputError(key, f"cannot be read: {err.strerror or err} ({path})") from None
-    parts = {"study": study.digest(plan), "fepen": __version__, "data": data.digests(), "files": files}
-    blob = json.dumps(parts, sort_keys=True, default=str)
-    return {"sha256": hashlib.sha256(blob.encode()).hexdigest()[:16], **parts}
-
-
-def scene_files(plan) -> list[tuple[str, str]]:
-    """(key, absolute path) of every file the plan's scenes name (fepen.runs.setup.FILE_KEYS: a drawn profile, a
-    CAD body), found in its fields: Scenes, a sweep's spec (its base and shots), dicts and lists of them."""
-    import os
-    from dataclasses import fields, is_dataclass
-
-    from fepen.runs.setup import FILE_KEYS
-    from fepen.scene import Scene
-
-    found: dict[str, str] = {}
-
-    def given(values: dict) -> None:
-        for k in FILE_KEYS:
-            if isinstance(values.get(k), str) and values[k]:
-                found.setdefault(os.path.abspath(values[k]), k)
-
-    def visit(obj, depth: int = 0) -> None:
-        if depth > 4:
-            return
-        if isinstance(obj, Scene):
-            given({k: obj.get(k) for k in FILE_KEYS})
-        elif isinstance(obj, dict):
-            given(obj)
-            for v in obj.values():
-                if isinstance(v, (Scene, dict, list, tuple)) or is_dataclass(v):
-                    visit(v, depth + 1)
-        elif isinstance(obj, (list, tuple)):
-            for v in obj[:1] if obj and not isinstance(obj[0], (Scene, dict)) else obj:
-                visit(v, depth + 1)
-        elif is_dataclass(obj) and not isinstance(obj, type):
-            for f in fields(obj):
-                visit(getattr(obj, f.name), depth + 1)
-
-    visit(plan)
-    return sorted((k, p) for p, k in found.items())
-
-
-def canonical_digest(*parts) -> str:
-    """A digest of a study's own inputs (its plan's scenes resolved, flat; numbers, texts, lists, dicts) for
-    ``Study.digest``: the same inputs, the same 16 hex digits on any machine."""
-    import hashlib
-    import json
-
-    from fepen.scene import Scene, flatten
-
-    def plain(x):
-        if isinstance(x, Scene):
-            return flatten(x.as_dict())
-        if hasattr(x, "__dataclass_fields__"):
-            return {k: plain(getattr(x, k)) for k in x.__dataclass_fields__}
-        if isinstance(x, dict):
-            return {str(k): plain(v) for k, v in x.items()}
-        if isinstance(x, (list, tuple)):
-            return [plain(v) for v in x]
-        return x
-
-    def other(x):
-        if isinstance(x, Path):
-            return str(x)
-        if hasattr(x, "item") and hasattr(x, "dtype"):  # a numpy scalar
-            return x.item()
-        raise TypeError(f"a study's digest holds plain values, not {type(x).__name__}")
-
-    blob = json.dumps(plain(list(parts)), sort_keys=True, default=other)
-    return hashlib.sha256(blob.encode()).hexdigest()[:16]
 
 
 def public(result: dict) -> dict:

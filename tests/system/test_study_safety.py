@@ -240,7 +240,7 @@ def test_a_continued_study_refuses_other_data_or_another_fepen(tmp_path, capsys,
     covered the given keys only. Now a change of a shipped data file, of fepen's version or of a file the shots
     read is refused before any shot runs, naming it."""
     from fepen import data
-    from fepen.studies import study
+    from fepen.studies import record, study
 
     spec, out = kept_sweep(tmp_path), tmp_path / "s"
     assert fepen(capsys, "sweep", spec, "--out", out, "--workers", "1")[0] == 0
@@ -266,7 +266,7 @@ def test_a_continued_study_refuses_other_data_or_another_fepen(tmp_path, capsys,
     assert fepen(capsys, "study", "ballistic-limit", *base, "--out", tmp_path / "bl")[0] == 0
     plan = study.get("ballistic-limit")().plan(None, ["effects.fidelity=rigid", f"projectile.profile={profile}",
                                                       "target.thickness=0.1"], 100.0, 1500.0, 50.0)
-    assert ("projectile.profile", str(profile)) in study.scene_files(plan)
+    assert ("projectile.profile", str(profile)) in record.scene_files(plan)
     profile.write_text("z_m, r_m, arc_radius_m\n0, 0\n0.039136, 0.0118, 0.0708\n0.124, 0.0118\n0.144, 0.010\n")
     code, _, err = fepen(capsys, "study", "ballistic-limit", *base, "--out", tmp_path / "bl")
     assert code == 2 and f"{profile} changed" in err[0], err
