@@ -166,8 +166,8 @@ def revision() -> str | None:
     try:
         head = subprocess.run(["git", "-C", str(root), "rev-parse", "HEAD"], capture_output=True, text=True,
                               timeout=10).stdout.strip()
-        dirty = subprocess.run(["git", "-C", str(root), "status", "--porcelain", "-uno"], capture_output=True,
-                               text=True, timeout=10).stdout.strip()
+        dirty = subprocess.run(["git", "-C", str(root), "--no-optional-locks", "status", "--porcelain", "-uno"],
+                               capture_output=True, text=True, timeout=10).stdout.strip()  # never .git/index.lock
     except (OSError, subprocess.SubprocessError):
         return None
     return (head + ("+dirty" if dirty else "")) or None

@@ -54,6 +54,7 @@ def write(out: Path, comm, step: int, t: float, arrays: dict, meta: dict) -> Non
     def finish():  # state.json last, then the older steps' files
         files.inject("checkpoint")
         state = {"step": step, "t_s": t, "ranks": comm.size, "fepen": __version__, "sha256": digests, **meta}
+        state["state_sha256"] = _digest(state)  # the state itself: an edited state.json is refused, never read
         with replacing(d / "state.json") as tmp:
             tmp.write_text(json.dumps(state, indent=1) + "\n")
         for f in d.iterdir():  # the older steps' files (a user's file here stays: fepen.io.layout)
@@ -62,6 +63,13 @@ def write(out: Path, comm, step: int, t: float, arrays: dict, meta: dict) -> Non
                 f.unlink()
 
     files.agree(comm, f"{d / 'state.json'}", finish)
+
+
+def _digest(state: dict) -> str:
+    """The SHA-256 of a checkpoint's state (its JSON, keys sorted): what fepen wrote, and nothing else, is read
+    back (odd but well-formed content would otherwise reach the run's components)."""
+    as_read = json.loads(json.dumps(state, default=repr))  # as state.json reads back: tuples lists, keys text
+    return hashlib.sha256(json.dumps(as_read, sort_keys=True).encode()).hexdigest()
 
 
 def read_state(out: Path, comm) -> dict:
@@ -73,12 +81,15 @@ def read_state(out: Path, comm) -> dict:
     try:
         state = json.loads(path.read_text())
         state["ranks"], state["step"]  # noqa: B018 - the fields every checkpoint has
-    except (ValueError, KeyError, TypeError):
+    except (ValueError, KeyError, TypeError, RecursionError):
         raise InputError("--resume", f"{path} is damaged (not the JSON a checkpoint writes); the run cannot be "
                                      "resumed from it: run it again with --force") from None
     if state.get("fepen") != __version__:
         raise InputError("--resume", f"the checkpoint in {out} was written by fepen {state.get('fepen', '< 0.1')}"
                                      f", not this fepen {__version__}: run it again with --force")
+    if state.get("state_sha256") != _digest({k: v for k, v in state.items() if k != "state_sha256"}):
+        raise InputError("--resume", f"{path} does not match its own checksum (edited or damaged since the run wrote "
+                                     "it); the run cannot be resumed from it: run it again with --force")
     if state["ranks"] != comm.size:
         raise InputError("--resume", f"the run in {out} ran on {state['ranks']} ranks; resume it on the same "
                                      f"number (mpirun -n {state['ranks']}), not {comm.size}")

@@ -58,7 +58,7 @@ def test_two_ranks_and_a_resumed_study_give_the_same_table(serial, tmp_path):
         while os.path.exists(f"/proc/{lock}") and time.time() - t0 < 60:
             time.sleep(0.1)
     done = (out / "shots.jsonl").read_text().count("\n")
-    assert 1 <= done < 4, "the study was not stopped part way"
+    assert done >= 1 and not (out / "charge_safety.csv").exists(), "the study was not stopped part way"
     r = run_fepen(*ARGS, "--out", out, ranks=2)
     assert r.returncode == 0, r.stderr
     assert f"{done} done before" in r.stdout

@@ -202,9 +202,15 @@ def test_damaged_or_foreign_checkpoint_is_refused(tmp_path):
     lines = fepen_lines(res.stderr)
     assert res.returncode == 2 and len(lines) == 1 and "checksum" in lines[0] and "Traceback" not in res.stderr
     data[len(data) // 2] ^= 0x01
-    npz.write_bytes(bytes(data))  # repaired, but from another version
+    npz.write_bytes(bytes(data))  # repaired, but edited: well-formed, odd content (before: exit 1 in the restore)
     path = out / "checkpoint" / "state.json"
-    path.write_text(json.dumps({**json.loads(path.read_text()), "fepen": "0.0.9"}))
+    good = path.read_text()
+    for odd in ({"step": "twelve"}, {"components": []}, {"tip": None}, {"field_times_s": {"a": 1}}):
+        path.write_text(json.dumps({**json.loads(good), **odd}))
+        res = run_fepen("run", "--resume", out)
+        lines = fepen_lines(res.stderr)
+        assert res.returncode == 2 and len(lines) == 1 and "its own checksum" in lines[0], (odd, res.stderr[-500:])
+    path.write_text(json.dumps({**json.loads(good), "fepen": "0.0.9"}))  # from another version
     res = run_fepen("run", "--resume", out)
     lines = fepen_lines(res.stderr)
     assert res.returncode == 2 and len(lines) == 1 and "fepen 0.0.9" in lines[0]
