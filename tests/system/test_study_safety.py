@@ -239,7 +239,6 @@ def test_a_continued_study_refuses_other_data_or_another_fepen(tmp_path, capsys,
     covered the given keys only. Now a change of a shipped data file, of fepen's version or of a file the shots
     read is refused before any shot runs, naming it."""
     from fepen import data
-    from fepen.studies import record, study
 
     spec, out = kept_sweep(tmp_path), tmp_path / "s"
     assert fepen(capsys, "sweep", spec, "--out", out, "--workers", "1")[0] == 0
@@ -263,6 +262,8 @@ def test_a_continued_study_refuses_other_data_or_another_fepen(tmp_path, capsys,
     base = ["--set", "effects.fidelity=rigid", "--set", f"projectile.profile={profile}", "--speeds", "100,1500",
             "--tol", "50", "--set", "target.thickness=0.1"]
     assert fepen(capsys, "study", "ballistic-limit", *base, "--out", tmp_path / "bl")[0] == 0
+    from fepen.studies import record, study
+
     plan = study.get("ballistic-limit")().plan(None, ["effects.fidelity=rigid", f"projectile.profile={profile}",
                                                       "target.thickness=0.1"], 100.0, 1500.0, 50.0)
     assert ("projectile.profile", str(profile)) in record.scene_files(plan)
