@@ -101,6 +101,7 @@ def build(sh, comm: MPI.Comm = MPI.COMM_WORLD) -> Model:
         y_c = _nose_zone(s, surf, sh.built.shape) if w.distribution == "nose" else None
         receding = recession.Recession(s, surf, w.friction, w.efficiency, w.enthalpy, w.density, zone_end=y_c)
         load.wear = receding
+        receding.rotation = load.body_rotation  # the recession in the body's frame (theory.md §14.2)
     s.landing = outputs.landing(sh)  # the steps end on the output times
     R, v = sh.rotation, sh.velocity
     s.set_initial(displacement=lambda X: X @ R.T - X, velocity=lambda X: np.tile(v, (len(X), 1)))

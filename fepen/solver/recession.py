@@ -52,6 +52,9 @@ class Recession:
         self.contraction = 1.0  # the nose zone's length factor λ (the "nose" distribution)
         self.mu, self.efficiency, self.enthalpy, self.density = mu, efficiency, enthalpy, density
         self.every, self.layers = every, layers
+        #: () -> the body's turn from its reference axis (3 × 3), the recession's frame (the model sets it from
+        #: the load's tip-tail axis; by default none: the reference frame)
+        self.rotation = lambda: None
         imap = solver.V.dofmap.index_map
         self._vec3 = dx.new_vector(imap, bs=3)
         self._vec1 = dx.new_vector(imap, bs=1)
@@ -184,7 +187,7 @@ class Recession:
         dX = -d[:, None] * unit
         dX = self._relax(dX, on_surface)
         X_old = s.X.copy()
-        reference.change_reference(s, dX)
+        reference.change_reference(s, dX, self.rotation())
         surf.follow_reference(X_old, s.X)
         self.depth += d
         return largest
@@ -208,7 +211,7 @@ class Recession:
         dX = np.zeros_like(s.X)
         dX[zone, 1] = (1.0 - kappa) * (self.zone_end - y[zone])
         X_old = s.X.copy()
-        reference.change_reference(s, dX)
+        reference.change_reference(s, dX, self.rotation())
         surf.follow_reference(X_old, s.X)
         self.depth += dX[:, 1]
         return (1.0 - kappa) * old * self.zone_end

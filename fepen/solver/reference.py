@@ -33,14 +33,18 @@ def remove_cells(solver, cells: np.ndarray) -> None:
     rebuild(s, np.zeros(0, dtype=np.int64))
 
 
-def change_reference(solver, dX: np.ndarray) -> None:
+def change_reference(solver, dX: np.ndarray, rotation: np.ndarray | None = None) -> None:
     """Move the reference positions of nodes by dX (n_nodes, 3), ghosts included and equal on every rank
-    that holds a node: material removed from a receding surface (fepen.solver.recession). The
-    displacement is kept, so the current positions move with the reference ones; the cells touched get
-    their new reference gradients and volumes, the nodes their new masses (collective)."""
+    that holds a node: material removed from a receding surface (fepen.solver.recession). The current
+    positions move by R dX, the recession turned into the body's own frame (R: ``rotation``, the body's turn
+    from its reference axis; None: the identity), so a worn node recedes along the turned body's surface, not
+    along the reference frame's: the displacement gains (R − I) dX. The cells touched get their new reference
+    gradients and volumes, the nodes their new masses (collective)."""
     moved = np.any(dX != 0.0, axis=1)
     cells = np.flatnonzero(moved[solver.dofs].any(axis=1))
     solver.X += dX
+    if rotation is not None:
+        solver.U += dX @ (np.asarray(rotation) - np.eye(3)).T
     rebuild(solver, cells)
 
 

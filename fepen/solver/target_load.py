@@ -14,7 +14,7 @@ import numba
 import numpy as np
 from mpi4py import MPI
 
-from fepen.geometry.frames import unit_axis
+from fepen.geometry.frames import REFERENCE_AXIS, rotation_onto, unit_axis
 from fepen.laws import target as tg
 from fepen.solver import assembly, probes
 from fepen.solver.surface import Surface
@@ -74,6 +74,7 @@ class TargetLoad:
         length = comm.allreduce(float(np.max(surf.X[:, 1], initial=-np.inf)), op=MPI.MAX)
         self.xi_sh, self.length, self.calibre = xi_sh, length, 2.0 * a0
         self.last_force = np.zeros((0, 3))  # the points' forces of the last step (this rank's)
+        self.axis = None  # the body's unit axis, tail to nose, at the last call (every rank's the same)
         #: the target's angular impulse about O (N m s): up to the last history row (the same on every rank),
         #: and this rank's part since then; the moment about O of this rank's points at the last step
         self.angular_impulse = np.zeros(3)
@@ -95,6 +96,13 @@ class TargetLoad:
         self._sum = None  # the facets' NodalSum, rebuilt when the facets change (erosion; collective)
         self._sum_version = -1
 
+    def body_rotation(self) -> np.ndarray | None:
+        """The body's turn from its reference axis onto its tip-tail axis at the last call (3 × 3; None before the
+        first): the frame the nose's wear recedes in (fepen.solver.reference.change_reference)."""
+        if self.axis is None:
+            return None
+        return rotation_onto(REFERENCE_AXIS, self.axis)
+
     def _facet_sum(self, solver) -> assembly.NodalSum:
         if self._sum is None or self._sum_version != self.surf.version:
             tri = self.surf.tri
@@ -112,6 +120,7 @@ class TargetLoad:
         tip, tail = probes.node_values(solver, (self.tip, self.tail), x_all)  # one reduction for both
         comm_s = perf_counter() - t0
         axis = unit_axis(tip, tail)
+        self.axis = axis
         comm = solver.comm
 
         hit = None  # the loaded points (whose force is not zero)

@@ -105,6 +105,41 @@ def test_recession_reproduces_its_closed_form_on_a_constant_velocity_slide():
     assert np.all(s.X[cavity] == X0[cavity])
 
 
+def test_a_turned_body_wears_in_its_own_frame():
+    """A body turned by 30° and worn by a known contraction of its nose keeps its axis: every worn node moves by
+    R dX (dX the reference recession, R the body's turn), so the tip recedes along the current axis, with no
+    lateral move above 1e-9 m. Before (issue 58), the recession was added in the reference frame and the
+    turned nose was sheared sideways by |dX| sin 30°."""
+    from fepen.geometry.frames import unit_axis
+    from fepen.solver import probes
+
+    sc, m = built(["impact.obliquity_deg=0", "impact.attack_deg=0"])
+    s, load, rec = m.solver, m.load, m.recession
+    c, sn = np.cos(np.radians(30.0)), np.sin(np.radians(30.0))
+    R = np.array([[c, -sn, 0.0], [sn, c, 0.0], [0.0, 0.0, 1.0]])
+    s.U[:] = s.X @ R.T - s.X  # the body turned by 30° about z, above the face, at rest
+    s.U[:, 1] += 1.0
+    s.Vel[:] = 0.0
+    s.fext[:] = 0.0
+    load(s, 1e-8)
+    assert np.allclose(load.body_rotation(), R, atol=1e-12)
+    tip0, tail0 = (probes.node_values(s, (m.tip, m.tail), s.X + s.U)[k] for k in (0, 1))
+    axis0 = unit_axis(tip0, tail0)
+    y = s.X[:, 1]
+    zone = y < rec.zone_end
+    dX = np.zeros_like(s.X)
+    dX[zone, 1] = 0.01 * (rec.zone_end - y[zone])  # the nose zone shortened by 1 %: the tip recedes most
+    x0 = s.X + s.U
+    reference.change_reference(s, dX, load.body_rotation())
+    x1 = s.X + s.U
+    assert np.allclose(x1 - x0, dX @ R.T, atol=1e-12)  # every node by R dX
+    tip1 = probes.node_values(s, (m.tip,), x1)[0]
+    move = tip1 - tip0
+    lateral = move - np.dot(move, axis0) * axis0
+    assert np.linalg.norm(move) == pytest.approx(0.01 * rec.zone_end, rel=1e-9)
+    assert np.linalg.norm(lateral) < 1e-9 and np.dot(move, axis0) < 0.0  # straight back along the axis
+
+
 @pytest.mark.parametrize("v0", [500.0, 700.0, 900.0])
 def test_recession_and_scalar_wear_agree_on_a_rigid_path(v0, tmp_path):
     """A CRH 3 nose at normal incidence: the rigid fidelity's scalar wear and the mesh's surface recession,
