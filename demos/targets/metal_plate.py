@@ -64,7 +64,7 @@ rows = []
 for v in (float(x) for x in args.speeds.split(",")):
     # the closed form's own assumptions: no free face, the sharp switches in angle and speed, no tunnel's wall
     scene = fepen.Scene(None, sets=[*ROD, "effects.fidelity=rigid", "effects.free_surface=false",
-                                    "target.onset_angle_deg=0", "target.onset_speed=0", "effects.tunnel=false",
+                                    "effects.tunnel=false",
                                     f"impact.velocity={v}", *args.set])
     depth = fepen.run(scene, out=out / f"rigid-{v:.0f}", comm=comm, force=True).summary["depth_mm"]
     rows.append((v, depth, 1e3 * closed_form(scene)))

@@ -186,10 +186,9 @@ class TargetLaw:
             touching layers (fepen.laws.layers): it loads only points between them, while the free faces of
             the crater, the free-surface rule and the perforation stay those of the block (0, thickness).
             bottom None: thickness.
-        onset_speed: σ_s develops over the first onset_speed (m/s) of a point's speed into the target (its normal
-            speed; at the tunnel's wall its outward speed): a smooth load at vanishing speed (§8.7); 0: at once.
-        face_onset_speed: the same on the open face (m/s); None: onset_speed. A shot sets it to
-            min(onset_speed, ONSET_FRACTION x its striking speed) (at_striking_speed).
+        wall_shear2: the tunnel wall's elastic reload modulus "2G" (Pa): its stiffness under a sideways push is
+            wall_shear2 / a (a the wall's radius; wall_modulus); 0: the wall carries nothing.
+        reload: the tunnel wall's reload strength, the fraction of σ_s that re-expands it (reload_fraction).
     """
 
     density: float
@@ -214,12 +213,11 @@ class TargetLaw:
     crush_strain: float = 0.094
     c_over_a: float = 1.0
     given_sigma_s: bool = False
-    onset: float = 0.0
     top: float = 0.0
     bottom: float | None = None
     surface_range: float = 1.0
-    onset_speed: float = 0.0
-    face_onset_speed: float | None = None
+    wall_shear2: float = 0.0
+    reload: float = 1.0
 
     @property
     def lower(self) -> float | None:
@@ -228,21 +226,46 @@ class TargetLaw:
         return self.thickness if self.bottom is None else self.bottom
 
 
-#: on the open face σ_s develops over at most this fraction of the striking speed (§8.7): a shot that strikes
-#: slower than onset_speed / ONSET_FRACTION is not a damper from its first microsecond (a 0.1 m/s shot would
-#: creep 2 mm into concrete where the rate-independent law stops it in tens of µm)
-ONSET_FRACTION = 0.5
+#: Poisson's ratio of the tunnel's wall: concrete's, rock's and soil's 0.2 (EN 1992-1-1 §3.1.3: uncracked
+#: concrete), a metal's 0.33 (aluminium's; a steel's 0.29 makes its wall 3 % stiffer)
+WALL_POISSON = {"metal": 0.33}
+WALL_POISSON_DEFAULT = 0.2
 
 
-def at_striking_speed(law, speed: float):
-    """The law (a TargetLaw or fepen.laws.layers.Layered) for a shot striking at ``speed`` (m/s): its open
-    face's onset speed min(onset_speed, ONSET_FRACTION speed); the tunnel wall's stays onset_speed."""
-    from dataclasses import replace
+def wall_modulus(E: float, nu: float, cracked: float) -> float:
+    """The tunnel wall's elastic reload modulus "2G_eff" (Pa): a cylindrical cavity of radius a in an elastic
+    medium takes p = 2G u / a (Lamé; Timoshenko and Goodier, thick cylinder of infinite outer radius); with the
+    wall radially cracked out to b = ``cracked`` a (the cracks carry no hoop stress, so the cracked ring is a
+    stack of radial struts, u = p a ln(b/a) / E across it), p = 2G u / [a (1 + ln(b/a) / (1 + ν))].
 
-    if getattr(law, "layered", False):
-        return replace(law, layers=tuple(replace(layer, law=at_striking_speed(layer.law, speed))
-                                         for layer in law.layers))
-    return replace(law, face_onset_speed=min(law.onset_speed, ONSET_FRACTION * float(speed)))
+    Args:
+        E: Young's modulus (Pa). nu: Poisson's ratio. cracked: b/a, the radially cracked ring's outer radius over
+            the cavity's (the cavity expansion's c/a; 1: not cracked).
+
+    Returns:
+        2G / (1 + ln(b/a) / (1 + ν)) (Pa); the wall's stiffness is it over a.
+    """
+    G2 = E / (1.0 + nu)
+    return G2 / (1.0 + math.log(max(cracked, 1.0)) / (1.0 + nu))
+
+
+def reload_fraction(Y: float, lam: float, c_over_a: float) -> float:
+    """The tunnel wall's reload strength, the fraction of the intact cavity-expansion stress that re-expands it
+    (docs/theory.md §8.7): the comminuted ring the nose left (a < r < c) has lost its cohesion and keeps its
+    friction, the cracked and elastic concrete beyond c unchanged; then Forrestal and Tzou's (1997) equilibrium
+    in the ring with the cohesion τ0 removed gives σ_r(a) = Y (c/a)^(αλ), α = 6/(3 + 2λ), against the intact
+    σ_s (cavity_wall_stress). 0.52 for the paper's concrete (λ 0.67, c/a 5.45); 0.46–0.57 over λ 0.5–0.8, c/a 4–6.
+
+    Args:
+        Y: unconfined compressive strength (Pa). lam: λ. c_over_a: the plastic zone's c/a.
+
+    Returns:
+        The fraction (1 when λ = 0: a Tresca medium's cohesion is its strength, nothing to lose but that).
+    """
+    if lam <= 0.0:
+        return 1.0
+    alpha = 6.0 / (3.0 + 2.0 * lam)
+    return float(Y * c_over_a ** (alpha * lam) / quasi_static_stress(Y, 1.0, 1.0, lam, c_over_a))
 
 
 @functools.lru_cache(maxsize=8)
@@ -355,9 +378,8 @@ def _law_numbers(law: TargetLaw) -> np.ndarray:
                      {"none": 0.0, "linear": 1.0, "energy": 2.0}[law.crater], law.k, law.D, float(law.separation),
                      law.phi_min, float(law.free_surface), float(law.friction), law.mu,
                      law.mu if law.mu_dynamic is None else law.mu_dynamic, law.mu_decay, law.lock_density,
-                     law.crush_strain, law.c_over_a, float(law.given_sigma_s), law.onset, law.top,
-                     -1.0 if law.lower is None else law.lower, law.surface_range, law.onset_speed,
-                     law.onset_speed if law.face_onset_speed is None else law.face_onset_speed])
+                     law.crush_strain, law.c_over_a, float(law.given_sigma_s), law.wall_shear2, law.top,
+                     -1.0 if law.lower is None else law.lower, law.surface_range, law.reload])
 
 
 def _bind(lib):

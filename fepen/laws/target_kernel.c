@@ -1,5 +1,6 @@
 /* The target law (docs/theory.md §8) on surface points, its one home: immersion, tunnel stress, wake,
- * separation, free surface, onset, energy crater, sliding friction, and the tunnel's wall (tunnel_kernel.c), at
+ * separation, free surface, energy crater, sliding friction, and the tunnel's elastic-plastic wall
+ * (tunnel_kernel.c), at
  * one point (law_at_point), and on k
  * points (point_forces, which fepen.laws.target.load_on_points calls through fepen.native before its
  * linear-crater scaling). tests/unit/laws/test_target_kernel.py checks it against an independent numpy
@@ -10,20 +11,21 @@
 /* p[]: the TargetLaw as numbers, in this order */
 enum { P_DENSITY, P_Y, P_E, P_T, P_LAM, P_SIGMA_S, P_B, P_THICKNESS /* < 0: none */, P_CRATER /* 2: energy */,
        P_K, P_D, P_SEPARATION, P_PHI_MIN, P_FREE_SURFACE, P_FRICTION, P_MU, P_MU_DYNAMIC, P_MU_DECAY,
-       P_LOCK_DENSITY, P_CRUSH_STRAIN, P_C_OVER_A, P_GIVEN_SIGMA_S, P_ONSET,
+       P_LOCK_DENSITY, P_CRUSH_STRAIN, P_C_OVER_A, P_GIVEN_SIGMA_S,
+       P_WALL_SHEAR2 /* 2G of the tunnel's wall (Pa): its elastic stiffness 2G/a under a sideways push */,
        P_TOP /* the material's own faces in a block of layers */, P_LOWER /* < 0: none */,
        P_SURFACE_RANGE /* the free face's reach in plastic-zone widths */,
-       P_ONSET_SPEED /* sigma_s develops over the first onset_speed of a point's normal speed (m/s); 0: at once */,
-       P_FACE_ONSET /* the same on the open face (m/s): min(onset_speed, ONSET_FRACTION x striking speed) */,
+       P_RELOAD /* the tunnel wall's reload strength: the fraction of sigma_s that re-expands its cracked wall */,
        P_COUNT };
 
 #define SIN_TOL 1e-9
 
 #include "tunnel_kernel.c"
 
-/* A point in the tunnel (tunnel_kernel.c): its penetration of the wall (m) and the outward unit vector */
+/* A point in the tunnel (tunnel_kernel.c): its push into the wall (m), the outward unit vector, and the wall's
+ * radius where it is (m) */
 typedef struct {
-    double delta, er[3];
+    double delta, er[3], a;
 } WallHit;
 
 static double clip01(double x) { return x < 0.0 ? 0.0 : (x > 1.0 ? 1.0 : x); }
@@ -47,14 +49,13 @@ static inline double normal_speed(const double *vi, const double *ni) {
 
 /* What the law needs beyond p[] that is the same at every point: computed once per call by law_constants */
 typedef struct {
-    double thk, sin_min, sin_onset, ref, whole, mu_s, mu_d, decay;
+    double thk, sin_min, ref, whole, mu_s, mu_d, decay;
 } LawConstants;
 
 static LawConstants law_constants(const double *p) {
     LawConstants c;
     c.thk = p[P_THICKNESS];
     c.sin_min = sin(p[P_PHI_MIN]);
-    c.sin_onset = sin(p[P_ONSET]);
     c.ref = p[P_FREE_SURFACE] != 0.0 ? cavity_stress(p, p[P_C_OVER_A]) : 1.0;
     /* the free-surface stress where the plastic zone is whole (ca = c/a): what the rule below gives there */
     c.whole = p[P_GIVEN_SIGMA_S] != 0.0 ? p[P_SIGMA_S] * c.ref / c.ref : c.ref;
@@ -63,6 +64,37 @@ static LawConstants law_constants(const double *p) {
     c.decay = p[P_MU_DECAY];
     return c;
 }
+
+/* The quasi-static stress sigma_s at a point at height y (m; the face y = 0) with surface radius rho (m), the face
+ * cutting the cavity expansion's plastic zone (§8.4) when the law asks: the nose's and the wall's one text */
+static inline double static_stress(const double *p, const LawConstants *c, double y, double radius) {
+    double s = p[P_SIGMA_S];
+    if (p[P_FREE_SURFACE] != 0.0) {
+        /* L_e: the shortest distance to the block's front face, or its rear face when it has one */
+        double depth = fmax(-y, 0.0), Le = c->thk >= 0.0 ? fmin(depth, fmax(c->thk - depth, 0.0)) : depth;
+        double ca = fmin(p[P_C_OVER_A], 1.0 + Le / (p[P_SURFACE_RANGE] * fmax(radius, 1e-12)));
+        if (ca == p[P_C_OVER_A]) s = c->whole;
+        else s = p[P_GIVEN_SIGMA_S] != 0.0 ? p[P_SIGMA_S] * cavity_stress(p, ca) / c->ref : cavity_stress(p, ca);
+    }
+    return s;
+}
+
+/* The tunnel's wall at a point pressed into it (§8.7): elastic, p = (2G/a) delta, up to its reload limit
+ * reload sigma_s + B rho0 u^2 (u: the point's outward speed, while it pushes outward); the limit and the
+ * stiffness 2G/a */
+static inline double wall_limit(const double *p, double s, double u) {
+    double up = u > 0.0 ? u : 0.0;
+    return p[P_RELOAD] * s + p[P_B] * p[P_DENSITY] * up * up;
+}
+
+static inline double wall_stiffness(const double *p, const WallHit *wall) {
+    return p[P_WALL_SHEAR2] / fmax(wall->a, 1e-12);
+}
+
+/* a point's push into the wall (m): its penetration less a round-off's width (1e-9 of the radius), so that a body
+ * on the wall it opened, centred to the last bit or not, carries nothing (the spring's force is continuous) */
+#define WALL_TOL 1e-9
+static inline double wall_push(const WallHit *wall) { return wall->delta - WALL_TOL * wall->a; }
 
 /* THE LAW AT ONE POINT (docs/theory.md §8), its one text: the single rigid path and the deformable load reach it
  * through point_forces below, the batched rigid shots (fepen/runs/rigid_batch.c) include this file and call it.
@@ -76,44 +108,35 @@ static inline int law_at_point(const double *p, const LawConstants *c, const dou
     double y = xi[1];
     double frac = clip01(0.5 - (y + p[P_TOP]) / ell);
     if (p[P_LOWER] >= 0.0) frac *= clip01(0.5 + (y + p[P_LOWER]) / ell);
-    if (wall) frac *= clip01(1.0 + wall->delta / ell); /* in the tunnel: the part of the patch at its wall */
     if (!(frac > 0.0)) return 0;
     double vn = normal_speed(vi, ni);
     double speed = sqrt(vi[0] * vi[0] + vi[1] * vi[1] + vi[2] * vi[2]);
     double sin_phi = speed > 0.0 ? vn / fmax(speed, 1e-300) : 0.0, u = 0.0;
     int loaded;
-    if (wall) { /* in the tunnel (§8.7): loaded while it faces the wall and pushes it outward */
+    if (wall) { /* in the tunnel (§8.7): loaded while it faces the wall and is pressed into it, however it moves */
         u = vi[0] * wall->er[0] + vi[1] * wall->er[1] + vi[2] * wall->er[2];
-        loaded = u > 0.0 && ni[0] * wall->er[0] + ni[1] * wall->er[1] + ni[2] * wall->er[2] > 0.0;
+        loaded = wall_push(wall) > 0.0 && ni[0] * wall->er[0] + ni[1] * wall->er[1] + ni[2] * wall->er[2] > 0.0;
     } else {
-        loaded = sin_phi > SIN_TOL;
+        loaded = sin_phi > SIN_TOL && vn > 0.0;
         /* the wake: moving backward, a point meets the open tunnel, not concrete */
         if (axis) loaded = loaded && (vi[0] * axis[0] + vi[1] * axis[1] + vi[2] * axis[2] > 0.0);
         if (p[P_SEPARATION] != 0.0) loaded = loaded && sin_phi > c->sin_min;
     }
-    if (!loaded || !(vn > 0.0)) return 0;
-    /* L_e: the shortest distance to the block's front face, or its rear face when it has one */
-    double depth = fmax(-y, 0.0), Le = c->thk >= 0.0 ? fmin(depth, fmax(c->thk - depth, 0.0)) : depth;
-    double s = p[P_SIGMA_S];
-    if (p[P_FREE_SURFACE] != 0.0) {
-        double ca = fmin(p[P_C_OVER_A], 1.0 + Le / (p[P_SURFACE_RANGE] * fmax(radius, 1e-12)));
-        if (ca == p[P_C_OVER_A]) s = c->whole;
-        else s = p[P_GIVEN_SIGMA_S] != 0.0 ? p[P_SIGMA_S] * cavity_stress(p, ca) / c->ref : cavity_stress(p, ca);
-    }
-    if (!wall && p[P_ONSET] > 0.0) s *= fmin(sin_phi / c->sin_onset, 1.0);
-    /* at vanishing speed (§8.7): sigma_s develops over the first onset_speed of the point's speed into the target
-     * (its normal speed; at the tunnel's wall its outward speed), so a body coming to rest is not loaded by the
-     * whole rate-independent stress on every point that happens to face its last motion */
-    const double onset_speed = wall ? p[P_ONSET_SPEED] : p[P_FACE_ONSET];
-    if (onset_speed > 0.0) s *= fmin((wall ? u : vn) / onset_speed, 1.0);
-    double sg = (s + p[P_B] * p[P_DENSITY] * vn * vn) * frac;
+    if (!loaded) return 0;
+    const double s = static_stress(p, c, y, radius);
+    /* the nose: the cavity-expansion stress at any speed into the target (sigma_s is its static limit); the
+     * wall: elastic up to its reload limit, so a body pressed into it at rest is held, and let go of as it leaves */
+    double sg = (wall ? fmin(wall_stiffness(p, wall) * wall_push(wall), wall_limit(p, s, u))
+                      : s + p[P_B] * p[P_DENSITY] * vn * vn) * frac;
+    const double vx = wall ? fmax(u, 0.0) : vn; /* the speed that throws the medium out at the crater */
     if (p[P_CRATER] == 2.0 && -y < p[P_K] * p[P_D]) { /* the splash-streamline energy balance (§8.3) */
         double rho = fmax(radius, 1e-12), l = (p[P_C_OVER_A] - 1.0) * rho, integral = 0.0;
         for (int32_t g = 0; g < ng; ++g) {
             double w = 0.5 * l * (gauss[g] + 1.0), q = rho / (rho + w);
             integral += 0.5 * l * gauss[ng + g] * (1.0 + w / Rm) * (1.0 + w * sphi0 / rho) * q * q * q * q;
         }
-        double e_kin = 0.5 * p[P_LOCK_DENSITY] * vn * vn * integral;
+        double depth = fmax(-y, 0.0), Le = c->thk >= 0.0 ? fmin(depth, fmax(c->thk - depth, 0.0)) : depth;
+        double e_kin = 0.5 * p[P_LOCK_DENSITY] * vx * vx * integral;
         double e_str = p[P_CRUSH_STRAIN] * p[P_Y] * (2.0 * rho * Le + Le * Le) / rho;
         if (e_kin - e_str >= 0.0) sg = 0.0;
     }
@@ -143,11 +166,13 @@ static inline int above_face(const double *p, const double *xi, double ell) {
     return !(clip01(0.5 - (xi[1] + p[P_TOP]) / ell) > 0.0);
 }
 
-/* 1 when the point moves into its surface's outside (law_at_point's vn > 0, the same function): no other point
- * is loaded, in the tunnel or not, so the loops skip the others before locating them in the tunnel (half of a
- * shank's points; the station a point is located at does not depend on which points were located before it: no
- * bit changes) */
-static inline int moving_into(const double *vi, const double *ni) { return normal_speed(vi, ni) > 0.0; }
+/* 0 when the point can carry no load: it moves out of its surface's outside (law_at_point's vn > 0 at the nose,
+ * the same function) and cannot be in the tunnel (ahead of the shoulder, or no tunnel), where the elastic wall
+ * holds a point pressed into it however it moves. The loops skip the others before locating them in the tunnel
+ * (a point's station does not depend on which points were located before it: no bit changes) */
+static inline int may_load(const double *vi, const double *ni, const double *T, double xi) {
+    return normal_speed(vi, ni) > 0.0 || (T && xi > T[T_XI_SH] && T[T_M] >= 1.0);
+}
 
 /* The point's wall, when it is in the tunnel T (NULL: no tunnel): the WallHit, or NULL */
 static inline const WallHit *wall_of(const double *T, TunnelEnd *e, const double *xi_point, double xi,
@@ -156,13 +181,31 @@ static inline const WallHit *wall_of(const double *T, TunnelEnd *e, const double
     int32_t kn, sec;
     double rho;
     if (!tunnel_locate(T, e, xi_point, xi, &hit->delta, hit->er, &kn, &sec, &rho)) return 0;
+    hit->a = rho - hit->delta;
     return hit;
+}
+
+/* A step's first stage, after the law: where the wall is pressed past its reload limit it yields, the plastic
+ * cavity opened out to the radius at which the point's elastic push carries the limit (rho - limit k^-1, at the
+ * point's nearest recorded station and sector); pressed within it, the wall stays as it is (§8.7). */
+static void wall_yield(double *T, TunnelEnd *e, const double *p, const LawConstants *c, const double *xi_point,
+                       const double *vi, double radius, double xi) {
+    double delta, er[3], rho;
+    int32_t kn, sec;
+    if (!tunnel_locate(T, e, xi_point, xi, &delta, er, &kn, &sec, &rho) || kn < 0) return;
+    WallHit hit = {delta, {er[0], er[1], er[2]}, rho - delta};
+    const double push = wall_push(&hit);
+    if (!(push > 0.0)) return;
+    const double u = vi[0] * er[0] + vi[1] * er[1] + vi[2] * er[2];
+    const double limit = wall_limit(p, static_stress(p, c, xi_point[1], radius), u);
+    const double k = wall_stiffness(p, &hit);
+    if (k * push > limit) tunnel_widen(T, kn, sec, rho - WALL_TOL * hit.a - limit / k);
 }
 
 /* k points; x, v, n (k, 3); area, radius, Rm, sphi0 (k); axis (3) or NULL; gauss: ng nodes then ng weights;
  * body_xi (k): each point's distance behind the tip in the body frame, and T: the tunnel (tunnel_kernel.c; NULL:
  * none, body_xi unread). A call with T[T_COMMIT] set (a step's first stage) first records a station, then
- * pushes the wall out to the points it loads, and clears the flag.
+ * lets the wall yield where the points press it past its reload limit (wall_yield), and clears the flag.
  * Out: f (k, 3) and sig (k) (zero where not loaded), sums: force (3), loaded count, loaded area.
  * Returns P_COUNT. */
 int32_t point_forces(int32_t k, const double *x, const double *v, const double *n, const double *area,
@@ -180,7 +223,7 @@ int32_t point_forces(int32_t k, const double *x, const double *v, const double *
         fi[0] = fi[1] = fi[2] = 0.0;
         sig[i] = 0.0;
         const double ell = sqrt(area[i]);
-        if (above_face(p, x + 3 * i, ell) || !moving_into(v + 3 * i, n + 3 * i)) continue;
+        if (above_face(p, x + 3 * i, ell) || !may_load(v + 3 * i, n + 3 * i, T, T ? body_xi[i] : 0.0)) continue;
         WallHit hit;
         const WallHit *wall = wall_of(T, &end, x + 3 * i, T ? body_xi[i] : 0.0, &hit);
         if (law_at_point(p, &c, x + 3 * i, v + 3 * i, n + 3 * i, area[i], ell, radius[i], Rm[i], sphi0[i],
@@ -191,7 +234,7 @@ int32_t point_forces(int32_t k, const double *x, const double *v, const double *
     }
     if (commit) {
         for (int32_t i = 0; i < k; ++i)
-            if (sig[i] > 0.0) tunnel_expand(T, &end, x + 3 * i, body_xi[i]);
+            if (sig[i] > 0.0) wall_yield(T, &end, p, &c, x + 3 * i, v + 3 * i, radius[i], body_xi[i]);
         T[T_COMMIT] = 0.0;
     }
     for (int32_t i = 0; i < k; ++i) {

@@ -250,13 +250,10 @@ static void tunnel_record(double *T) {
     T[T_M] = m + 1;
 }
 
-/* A step's first stage, after the law: the wall pushed out to every point the wall loads (the plastic cavity
- * keeps the radius it was opened to), at the point's nearest recorded station and sector. */
-static void tunnel_expand(double *T, TunnelEnd *e, const double *p, double xi) {
-    double delta, er[3], rho;
-    int32_t kn, sec;
-    if (!tunnel_locate(T, e, p, xi, &delta, er, &kn, &sec, &rho) || kn < 0) return;
+/* The plastic cavity at station kn and sector sec opened out to radius r (it keeps the largest it was opened to):
+ * the wall's yield (target_kernel.c's wall_yield) */
+static void tunnel_widen(double *T, int32_t kn, int32_t sec, double r) {
     double *a = tunnel_station(T, kn) + T_STATION + sec;
-    if (rho > *a) *a = rho;
+    if (r > *a) *a = r;
 }
 #endif

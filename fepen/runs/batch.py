@@ -125,7 +125,8 @@ def _shot_numbers(run) -> list[float]:
     return [body.mass, run.dt, run.end, -1.0 if law.thickness is None else law.thickness,
             float(run.rules.until_stopped), run.history.clock.interval, float(crater is not None),
             crater.kd if crater is not None else 0.0, crater.c if crater is not None else 0.0, run.ke0,
-            events.STOP_ENERGY, *run.tip_arm, *(run.tail_ref - body.centre0), *body.I_body_inv.ravel(),
+            events.stop_fraction(body.mass, run.ke0), *run.tip_arm, *(run.tail_ref - body.centre0),
+            *body.I_body_inv.ravel(),
             *_tunnel_numbers(run.tunnel), *(run.shoulder_arm if run.tunnel is not None else np.zeros(3))]
 
 

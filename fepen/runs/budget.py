@@ -207,24 +207,20 @@ def time_scales(mass: float, v0: float, diameter: float, law) -> tuple[float, fl
     return mass * v0 / force, float(np.sqrt(mass * getattr(law, "k", 2.37) * diameter / force))
 
 
-#: the tunnel's wall acts on a body pressing into it as a damper while its outward speed is below the onset
-#: speed (docs/theory.md §8.7): σ_s over the first onset_speed, on up to the body's projected side D L, a time
-#: constant τ = m onset / (σ_s D L). The classical RK4 step is stable below 2.8 τ; measured on the shots that ran
-#: away (26.9 mm, 2.5 x Forrestal's S), at about 3 τ. A rigid run takes onset_speed >= σ_s D L Δt / (ONSET_STEPS m)
-ONSET_STEPS = 2.5
+#: the tunnel's wall is a spring on a body pressed into it (docs/theory.md §8.7): stiffness wall_shear2 / a per unit
+#: of wall, on up to the body's projected side D L, so the body's sideways (and turning) frequency is at most
+#: ω = sqrt(wall_shear2 D L / (a m)). The classical RK4 step is stable below 2.8 / ω; a rigid run's step is at most
+#: WALL_STEPS / ω, which the default shots' steps are far within (C3: 2.7 µs against 9 µs)
+WALL_STEPS = 1.0
 
 
-def stable_onset(law, mass: float, step: float, diameter: float, length: float):
-    """The law with the onset speed the rigid step can integrate (a copy; the law itself if it already is):
-    max(law.onset_speed, σ_s D L Δt / (ONSET_STEPS m)) (ONSET_STEPS), the open face's with it unless the
-    striking speed has set that one lower (fepen.laws.target.at_striking_speed)."""
-    from dataclasses import replace
-
-    need = law.sigma_s * diameter * length * step / (ONSET_STEPS * mass)
-    if law.onset_speed >= need:
-        return law
-    face = law.face_onset_speed  # the open face's follows, unless a slow shot has made it smaller (§8.7)
-    return replace(law, onset_speed=need, face_onset_speed=None if face is None or face >= law.onset_speed else face)
+def wall_step(mass: float, diameter: float, length: float, law) -> float:
+    """The longest RK4 step the tunnel's elastic wall lets a rigid body take (s): WALL_STEPS / ω, ω the body's
+    frequency on the wall's spring over its whole projected side (inf without a wall)."""
+    k = getattr(law, "wall_shear2", 0.0) / (0.5 * diameter)
+    if not k > 0.0:
+        return float("inf")
+    return WALL_STEPS / float(np.sqrt(k * diameter * length / mass))
 
 
 def default_step(mass: float, v0: float, diameter: float, law) -> float:

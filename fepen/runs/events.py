@@ -1,8 +1,8 @@
 """Stop rules, one definition for the rigid and the deformable run (docs/theory.md §11).
 
-    embedded     the centre of mass stops advancing along the axis (V·a ≤ 0), or the kinetic energy of
-                 its motion ½ M |V|² falls to STOP_ENERGY of the striking kinetic energy; checked only
-                 when the scene gives no run.end_time
+    embedded     the centre of mass stops advancing along the axis (V·a ≤ 0), or its speed |V| falls to
+                 END_SPEED (or ½ M |V|² to STOP_ENERGY of the striking kinetic energy, whichever comes first:
+                 stop_fraction); checked only when the scene gives no run.end_time
     perforated   every load point is beyond the rear face of a finite target
     ricochet     after entering, every load point is back above the face and the centre moves away
     rebound      on the rigid wall: no node has touched it for REBOUND_FREE_S after a contact
@@ -26,6 +26,33 @@ from fepen import native
 
 #: the projectile is at rest (embedded) when ½ M |V|² falls to this fraction of the striking kinetic energy
 STOP_ENERGY = 1e-5
+#: ... or when its speed falls to END_SPEED (m/s): the end of the path (docs/theory.md §8.7, §11). At vanishing
+#: speed the rate-independent law is no longer a function of the motion (σ_s, the static limit of the cavity
+#: pressure, on whichever side of the nose the wandering motion turns to, against the tunnel's elastic wall): the
+#: run ends there, short of the rest by at most END_SPEED² M / (2 F), F the nose's static axial force
+#: (end_of_path: 0.024 mm for C3)
+END_SPEED = 5.0
+
+
+def stop_fraction(mass: float, ke0: float) -> float:
+    """The fraction of the striking kinetic energy at which a run ends embedded: STOP_ENERGY, or the kinetic
+    energy ½ M END_SPEED² of the end of the path if larger (a shot striking slower than END_SPEED ends once in).
+
+    Args:
+        mass: the projectile's mass (kg). ke0: its striking kinetic energy (J).
+    """
+    return max(STOP_ENERGY, 0.5 * mass * END_SPEED * END_SPEED / ke0) if ke0 > 0.0 else STOP_ENERGY
+
+
+def end_of_path(mass: float, force: float, speed: float = END_SPEED) -> float:
+    """The most a run ended at ``speed`` is short of the rest (m): M v² / (2 F), the distance the body at v would
+    still cover against at least the force F (the nose's static axial force, σ_s times the projected area of its
+    loaded points: the inertial term only adds to it).
+
+    Args:
+        mass: the body's mass (kg). force: F (N). speed: v (m/s).
+    """
+    return mass * speed * speed / (2.0 * force)
 #: a body off the rigid wall for this long after touching it has rebounded (s)
 REBOUND_FREE_S = 20e-6
 
@@ -54,7 +81,8 @@ def penetration(y_min: float, y_max: float, v_cm: np.ndarray, axis: np.ndarray, 
     a = np.ascontiguousarray(axis, dtype=np.float64)
     code = native.kernel("events").penetration_outcome(
         float(y_min), float(y_max), v.ctypes.data, a.ctypes.data, float(mass), float(ke0),
-        -1.0 if thickness is None else float(thickness), int(until_stopped), STOP_ENERGY, ctypes.byref(flag))
+        -1.0 if thickness is None else float(thickness), int(until_stopped), stop_fraction(mass, ke0),
+        ctypes.byref(flag))
     return OUTCOMES[code], bool(flag.value)
 
 

@@ -22,7 +22,7 @@
 
 
 /* The law (target_kernel.c's law_at_point, with point_forces's tunnel: a step's first stage records a station
- * and pushes the wall out) on k points with one shortcut that changes no bit: ell = sqrt(area) given. f is
+ * and lets the wall yield) on k points with one shortcut that changes no bit: ell = sqrt(area) given. f is
  * written only at the points it loads (their indices into idx, in order; their stresses into sg), and only their
  * forces are summed (the others are zero). Returns how many. */
 __attribute__((noinline)) static int32_t law_points(int32_t k, const double *x, const double *v, const double *n,
@@ -40,7 +40,7 @@ __attribute__((noinline)) static int32_t law_points(int32_t k, const double *x, 
     for (int j = 0; j < 5; ++j) sums[j] = 0.0;
     for (int32_t i = 0; i < k; ++i) {
         double sg = 0.0;
-        if (above_face(p, x + 3 * i, ell[i]) || !moving_into(v + 3 * i, n + 3 * i)) continue;
+        if (above_face(p, x + 3 * i, ell[i]) || !may_load(v + 3 * i, n + 3 * i, T, T ? body_xi[i] : 0.0)) continue;
         WallHit hit;
         const WallHit *wall = wall_of(T, &end, x + 3 * i, T ? body_xi[i] : 0.0, &hit);
         if (!law_at_point(p, &c, x + 3 * i, v + 3 * i, n + 3 * i, area[i], ell[i], radius[i], Rm[i], sphi0[i], axis,
@@ -55,7 +55,8 @@ __attribute__((noinline)) static int32_t law_points(int32_t k, const double *x, 
     }
     if (commit) {
         for (int32_t j = 0; j < m; ++j)
-            if (sgs[j] > 0.0) tunnel_expand(T, &end, x + 3 * idx[j], body_xi[idx[j]]);
+            if (sgs[j] > 0.0)
+                wall_yield(T, &end, p, &c, x + 3 * idx[j], v + 3 * idx[j], radius[idx[j]], body_xi[idx[j]]);
         T[T_COMMIT] = 0.0;
     }
     for (int32_t j = 0; j < m; ++j) {

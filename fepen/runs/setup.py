@@ -124,8 +124,11 @@ def material_law(scene, c: dict, thickness: float | None) -> tg.TargetLaw:
         free_surface=e.free_surface, friction=e.friction, mu=t.friction,
         mu_dynamic=scene.get("target.friction_dynamic"), mu_decay=t.friction_decay,
         lock_density=lock, crush_strain=crush, c_over_a=ca, given_sigma_s=given_flag,
-        onset=math.radians(t.onset_angle_deg), onset_speed=t.onset_speed,
-        surface_range=get("free_surface_range") or SCHEMA["target.free_surface_range"].default)
+        surface_range=get("free_surface_range") or SCHEMA["target.free_surface_range"].default,
+        wall_shear2=tg.wall_modulus(E, tg.WALL_POISSON.get(c.get("family"), tg.WALL_POISSON_DEFAULT),
+                                    1.0 if c.get("family") == "metal" else ca),
+        reload=scene.get("target.tunnel_reload") if scene.get("target.tunnel_reload") is not None else (
+            1.0 if c.get("family") == "metal" else tg.reload_fraction(Y, lam, ca)))
 
 
 #: cavity keys that, when the user gives any of them, fix the cavity (its length is still sized to the mass)

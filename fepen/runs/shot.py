@@ -23,8 +23,7 @@ from fepen.scene import to_toml
 #: the longest a run without run.end_time may last (s): deformable, rigid
 MAX_TIME = {"deformable": 5e-3, "rigid": 5e-2}
 #: a layered target's run without run.end_time lasts at least this many times the time to reach its last
-#: face at the striking speed (20 until the onset speed: a body slowing below it in soft soil creeps on as a
-#: damper, the demo's soil stop at 67 ms where 20 x gave 60 ms)
+#: face at the striking speed (the layered demo's soil stops its body at 67 ms, where 20 x gave 60 ms)
 LAYERED_TIME = 30.0
 
 
@@ -249,8 +248,6 @@ def resolve(scene, toml: bool = True) -> Shot:
     rigid = scene.effects.fidelity == "rigid"
     law = setup.target_law(scene) if scene.target.kind == "concrete" else None
     R, v = setup.placement(scene)
-    if law is not None:
-        law = tg.at_striking_speed(law, float(np.linalg.norm(v)))
     end = scene.get("run.end_time")
     materials = () if rigid else tuple(setup.materials(scene, built))
     from fepen.runs import budget

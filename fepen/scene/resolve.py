@@ -20,7 +20,7 @@ from fepen.errors import InputError
 from fepen.inputs import NotRegularFile, open_input, read_capped, unreadable
 from fepen.laws.target import a_over_c_cubed, cylinder_strength, youngs_modulus_aci
 from fepen.scene.keys import ABSENT, DEPTH_MAX, check_nesting, display_name, shown
-from fepen.scene.schema import SCHEMA, SECTIONS
+from fepen.scene.schema import REMOVED, SCHEMA, SECTIONS
 
 __all__ = ["Section", "Scene", "load", "resolve", "read_toml", "parse_set", "flatten", "unknown_key",
            "cross_check", "registered_checks", "CROSS_CHECKS", "CHECKS_AFTER_RESOLUTION", "CAD_EXCLUDES",
@@ -611,6 +611,8 @@ def unknown_key(name: str) -> InputError:
     Returns:
         The InputError (to raise, or to quote).
     """
+    if name in REMOVED:
+        return InputError(name, REMOVED[name])
     parts = name.split(".")
     if parts[0] in ("grid", "monte_carlo", "table"):  # a sweep's spec given where a scene is read
         return InputError(display_name(name), f"[{parts[0]}] is a sweep's table, not a scene key: run the file "

@@ -20,13 +20,14 @@ def node_at(solver, point) -> tuple[int, int]:
     return owner, (local if solver.comm.rank == owner else -1)
 
 
-def node_values(solver, handles, array: np.ndarray) -> np.ndarray:
-    """The (3,) values of a nodal array at several nodes located with node_at, as (k, 3) on every rank, in
-    one reduction (each owner's value against −inf elsewhere: bit for bit the owner's)."""
-    buf = np.full((len(handles), 3), -np.inf)
+def node_values(solver, handles, *arrays: np.ndarray) -> np.ndarray:
+    """The (3,) values of nodal arrays at several nodes located with node_at, as (k, 3 m) on every rank (m arrays
+    side by side), in one reduction (each owner's value against −inf elsewhere: bit for bit the owner's)."""
+    buf = np.full((len(handles), 3 * len(arrays)), -np.inf)
     for k, (owner, local) in enumerate(handles):
         if solver.comm.rank == owner:
-            buf[k] = array[local]
+            for j, array in enumerate(arrays):
+                buf[k, 3 * j: 3 * j + 3] = array[local]
     if solver.comm.size > 1:
         solver.comm.Allreduce(MPI.IN_PLACE, buf, op=MPI.MAX)
     return buf

@@ -89,8 +89,10 @@ def test_the_angular_momentum_about_O_grows_by_the_targets_angular_impulse(tmp_p
         t, L, M = h["t_s"], h["angular_momentum_z_N_m_s"], h["moment_z_N_m"]
         rate = signals.lowpass(t, np.gradient(L, t), 5e3)
         # measured: 0.24 % of the moment's peak at 5 kHz (1.2 % at 10 kHz; 21 % unfiltered: the load changes
-        # within a step as points enter, and a row samples it at one instant)
-        assert np.abs(rate - signals.lowpass(t, M, 5e3)).max() < 0.01 * np.abs(M).max()
+        # within a step as points enter, and a row samples it at one instant), away from the filter's ends by
+        # two of its periods (the body still rocks in the elastic tunnel when the run ends at 5 m/s)
+        inner = (t > t[0] + 2 / 5e3) & (t < t[-1] - 2 / 5e3)
+        assert np.abs(rate - signals.lowpass(t, M, 5e3))[inner].max() < 0.01 * np.abs(M).max()
     # C3 turns in its plane: the turning component, z, carries the impulse (0.1 N m s rigid to its stop)
     assert peak[2] > 0.01
     assert err[2] < 1e-5 * peak[2], (err, peak)  # measured: 8e-7 rigid, 2e-7 plastic
@@ -99,6 +101,10 @@ def test_the_angular_momentum_about_O_grows_by_the_targets_angular_impulse(tmp_p
     # axis (sin θ, −cos θ, 0) turns toward +x (θ grows) under ω_z = dθ/dt > 0
     assert h["axis_angle_deg"][-1] == pytest.approx(summary["final_axis_angle_deg"], abs=1e-6)
     assert np.all(h["yaw_deg"] >= 0.0) and np.all(h["yaw_deg"] <= 180.0)
-    late = h["t_s"] > 0.5 * h["t_s"][-1]
-    assert h["axis_angle_deg"][late][-1] > h["axis_angle_deg"][late][0]
-    assert np.median(h["angular_velocity_z_rad_s"][late]) > 0.0
+    # the in-plane turn is the integral of ω_z (trapezoids over the rows; the axis stays in the plane)
+    from scipy.integrate import cumulative_trapezoid
+
+    turned = np.degrees(cumulative_trapezoid(h["angular_velocity_z_rad_s"], h["t_s"], initial=0.0))
+    theta = h["axis_angle_deg"] - h["axis_angle_deg"][0]
+    assert np.abs(theta - turned).max() < 0.02 * np.abs(theta).max() + 0.05, np.abs(theta - turned).max()
+    assert np.abs(theta).max() > 0.1  # it turned (C3: 0.45 deg rigid, 0.56 plastic, the tunnel holding it)

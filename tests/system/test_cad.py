@@ -37,9 +37,11 @@ def step_file(tmp_path_factory):
 
 
 def test_a_step_body_has_the_mass_and_depth_of_the_revolved_body(step_file):
-    """Both meshed at 1.5 mm, rigid, normal: mass within 1 % and depth within 1 %. (The CAD body's load points
+    """Both meshed at 1.5 mm, rigid, normal: mass within 1 % and depth within 1.5 %. (The CAD body's load points
     are its facets, without an exact surface: its depth converges to the revolved body's as the mesh is
-    refined, 1.3 % apart at 2.5 mm and 0.85 % at 1.5 mm; docs/projectiles-and-targets.md.)"""
+    refined, 1.3 % apart at 2.5 mm and 0.85 % at 1.5 mm without the tunnel; with the tunnel's elastic wall, which
+    its faceted shank meets where the mesh's asymmetry moves it sideways, 1.0 % at 1.5 mm;
+    docs/projectiles-and-targets.md.)"""
     fine = ["effects.fidelity=rigid", "mesh.size=0.0015", "mesh.optimize=none", *NORMAL]
     revolved = RigidRun(scene.Scene(None, [*fine, *SOLID]), None, MPI.COMM_SELF, points="mesh").run()
     cad = RigidRun(scene.Scene(None, [*fine, f"projectile.cad={str(step_file)!r}", "projectile.cad_scale=0.001"]),
@@ -47,7 +49,7 @@ def test_a_step_body_has_the_mass_and_depth_of_the_revolved_body(step_file):
     exact = setup.projectile_shape(scene.Scene(None, SOLID)).mass(7850.0)
     assert cad["mass_kg"] == pytest.approx(revolved["mass_kg"], rel=1e-2)
     assert cad["mass_kg"] == pytest.approx(exact, rel=1e-2)
-    assert cad["depth_mm"] == pytest.approx(revolved["depth_mm"], rel=1e-2)
+    assert cad["depth_mm"] == pytest.approx(revolved["depth_mm"], rel=1.5e-2)
     assert cad["outcome"] == revolved["outcome"] == "embedded"
 
 

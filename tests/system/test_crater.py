@@ -16,7 +16,7 @@ D, L, MASS, FC = 0.0236, 0.144, 0.367, 40e6
 SIGMA_S = tg.forrestal_S(FC) * FC  # one sigma_s for fepen and the closed form
 NORMAL = ["effects.fidelity=rigid", "projectile.crh={crh}", f"impact.velocity={V0}", "impact.obliquity_deg=0",
           "impact.attack_deg=0", f"target.quasi_static_stress={SIGMA_S}", f"target.compressive_strength={FC}",
-          "target.separation_angle_deg=0", "target.onset_speed=0", "effects.tunnel=false"]  # the whole nose loaded,
+          "target.separation_angle_deg=0", "effects.tunnel=false"]  # the whole nose loaded,
 # with a rate-independent sigma_s and no tunnel's wall, as in the closed forms
 
 

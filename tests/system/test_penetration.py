@@ -11,8 +11,7 @@ from fepen.runs.deformable import DeformableRun
 from fepen.runs.rigid import RigidRun
 
 NORMAL_300 = ["impact.velocity=300", "impact.obliquity_deg=0", "impact.attack_deg=0", "mesh.size=0.004",
-              "run.fields=false", "target.onset_speed=40"]  # one onset speed for both fidelities: the rigid step's
-# stable one at 300 m/s is about 32 m/s (fepen.runs.budget.stable_onset)
+              "run.fields=false"]  # one law for both fidelities (issue 58)
 
 
 def test_stiff_projectile_reproduces_the_rigid_one(tmp_path):

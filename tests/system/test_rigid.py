@@ -21,7 +21,7 @@ from fepen.solver import surface
 SIGMA_S = tg.forrestal_S(40e6) * 40e6  # Forrestal's S fc: the standard check of such codes
 CLOSED_FORM = ["effects.fidelity=rigid", f"target.quasi_static_stress={SIGMA_S}", "target.inertial_factor=1",
                "effects.crater=none", "effects.separation=false", "effects.free_surface=false",
-               "impact.obliquity_deg=0", "impact.attack_deg=0", "target.onset_angle_deg=0", "target.onset_speed=0",
+               "impact.obliquity_deg=0", "impact.attack_deg=0",
                "effects.tunnel=false"]  # the closed forms: a rate-independent sigma_s on the nose alone
 
 

@@ -30,7 +30,7 @@ def test_mesh_facets_give_the_closed_form_nose_force(name):
     """The deformable fidelity's load points (one per outer facet of the default 2.5 mm mesh, on the exact
     surface) on a nose moving along its axis: (π d²/4)(σ_s + N* ρ V²) within 0.5 %."""
     sc = scene.Scene(None, [f"projectile.nose={name.split('-')[0]}", "effects.crater=none",
-                            "effects.free_surface=false", "target.onset_angle_deg=0", "mesh.optimize=none",
+                            "effects.free_surface=false", "mesh.optimize=none",
                             "target.separation_angle_deg=0", *NORMAL,
                             *FAMILIES[name]])
     pts, _, _ = rigid.mesh_points(sc, MPI.COMM_SELF)
@@ -46,7 +46,7 @@ def test_mesh_facets_give_the_closed_form_nose_force(name):
 
 METAL = ["target.material='6061-T6511'", "projectile.diameter=0.0071", "projectile.length=0.071",
          "projectile.cavity_diameter=0", "projectile.material.name='aisi-4340'", "effects.free_surface=false",
-         "target.onset_angle_deg=0", "target.onset_speed=0", "effects.tunnel=false", *NORMAL]
+         "effects.tunnel=false", *NORMAL]
 
 
 def forrestal_warren_depth(sc) -> float:
@@ -94,8 +94,8 @@ def test_a_gap_changes_nothing_but_the_time():
 @pytest.mark.parametrize("h", [0.05, 0.1])
 def test_a_thin_slabs_residual_speed_against_its_closed_form(h):
     """No crater, no free surface: v_r² = (v0² + σ_s/(N* ρ)) exp(−2 π a² N* ρ h / m) − σ_s/(N* ρ)."""
-    sets = ["effects.crater=none", "effects.free_surface=false", "target.onset_angle_deg=0", "impact.velocity=800",
-            "target.separation_angle_deg=0", "target.onset_speed=0", "effects.tunnel=false"]  # the closed form
+    sets = ["effects.crater=none", "effects.free_surface=false", "impact.velocity=800",
+            "target.separation_angle_deg=0", "effects.tunnel=false"]  # the closed form
     sc = scene.Scene(f"[target]\nthickness = {h}\n", NORMAL + sets)
     s = RigidRun(sc, None, MPI.COMM_SELF).run()
     law, shape = setup.target_law(sc), setup.projectile_shape(sc)

@@ -124,7 +124,7 @@ def test_rigid_rings_give_the_closed_form_nose_force(name):
     the axial force is (π d²/4)(σ_s + N* ρ V²) within 0.5 % (the rings do it within 1e-4)."""
     shape = families()[name][0]
     sc = scene.Scene(None, ["effects.fidelity=rigid", "effects.crater=none", "effects.free_surface=false",
-                            "target.onset_angle_deg=0", "target.separation_angle_deg=0", "target.onset_speed=0"])
+                            "target.separation_angle_deg=0"])
     law = setup.target_law(sc)
     pts = rigid.ring_points(shape)
     V = 800.0

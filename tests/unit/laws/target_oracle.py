@@ -145,8 +145,6 @@ def normal_stress(law: TargetLaw, s: SurfaceState, vhat_tol: float = SIN_TOL):
     elif law.free_surface:  # σ_s given: scale it like the cavity-expansion value
         sigma_s = law.sigma_s * quasi_static_stress(law.Y, law.E, law.T, law.lam, ca) / quasi_static_stress(
             law.Y, law.E, law.T, law.lam, law.c_over_a)
-    if law.onset > 0.0:  # σ_s develops over the first `onset` of surface angle (grazing: no expansion)
-        sigma_s = sigma_s * np.minimum(sin_phi / math.sin(law.onset), 1.0)
     sig = np.where(loaded, tunnel_stress(law, vn, sigma_s), 0.0) * frac
     if law.crater == "energy":
         shallow = loaded & (-s.x[:, 1] < law.k * law.D)

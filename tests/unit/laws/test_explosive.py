@@ -6,7 +6,7 @@ import math
 
 import numpy as np
 import pytest
-from hypothesis import given, settings
+from hypothesis import example, given, settings
 from hypothesis import strategies as st
 
 from fepen.laws import explosive
@@ -17,11 +17,15 @@ stress = st.lists(st.floats(-1e9, 1e9, allow_nan=False), min_size=6, max_size=6)
 
 @settings(max_examples=200, deadline=None)
 @given(stress)
+@example([3.6686946964304837e-137, 0.0, 3.6686946964304837e-137, 2055128.0, 0.0, 2.0])
 def test_largest_principal_is_the_largest_eigenvalue(s):
+    """Against LAPACK's general eigenvalue solver (its symmetric one, dsyevd, is 0.22 off on the example: exact
+    sqrt(2055128^2 + 4), with diagonal entries of 1e-137)."""
     xx, yy, zz, xy, yz, xz = s
     A = np.array([[xx, xy, xz], [xy, yy, yz], [xz, yz, zz]])
     scale = max(np.abs(A).max(), 1.0)
-    assert explosive.largest_principal(np.array([s]))[0] == pytest.approx(np.linalg.eigvalsh(A)[-1], abs=1e-7 * scale)
+    expect = np.linalg.eigvals(A).real.max()
+    assert explosive.largest_principal(np.array([s]))[0] == pytest.approx(expect, abs=1e-7 * scale)
 
 
 def test_principal_and_von_mises_of_simple_states():

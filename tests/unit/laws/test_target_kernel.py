@@ -14,12 +14,12 @@ LAWS = {
     "plain": {},
     "tresca, free surface": dict(lam=0.0, free_surface=True),
     "energy crater, free surface": dict(crater="energy", k=2.37, free_surface=True),
-    "given sigma_s, free surface, onset": dict(free_surface=True, given_sigma_s=True, onset=math.radians(2.0)),
+    "given sigma_s, free surface": dict(free_surface=True, given_sigma_s=True),
     "separation, plate": dict(separation=True, phi_min=math.radians(5.0), thickness=0.3),
     "friction mu(v)": dict(friction=True, mu=0.3, mu_dynamic=0.05, mu_decay=0.01),
     "Coulomb friction, energy crater, plate": dict(friction=True, mu=0.1, crater="energy", thickness=0.25),
     "everything": dict(crater="energy", free_surface=True, separation=True, phi_min=0.02, friction=True,
-                       mu=0.2, mu_dynamic=0.1, mu_decay=0.02, thickness=0.4, onset=0.03, given_sigma_s=True,
+                       mu=0.2, mu_dynamic=0.1, mu_decay=0.02, thickness=0.4, given_sigma_s=True,
                        surface_range=2.5),
 }
 

@@ -17,11 +17,17 @@ def outcome(y_min=-0.01, y_max=0.2, v=(0.0, -10.0, 0.0), m=0.4, ke0=0.5 * 0.4 * 
 def test_embedded_when_the_centre_stops_advancing_or_its_energy_is_spent():
     assert outcome() is None
     assert outcome(v=(0.0, 1e-3, 0.0)) == "embedded"  # moving back along the axis
-    assert outcome(v=(5.0, 0.0, 0.0)) == "embedded"  # sideways only: V·a = 0
-    # the energy rule: ½ M V² = STOP_ENERGY KE0 exactly at V = 800 sqrt(STOP_ENERGY)
-    v = 800.0 * np.sqrt(events.STOP_ENERGY)
+    assert outcome(v=(20.0, 0.0, 0.0)) == "embedded"  # sideways only: V·a = 0
+    # the end of the path: |V| = END_SPEED, above the energy rule's 800 sqrt(STOP_ENERGY) = 2.5 m/s
+    v = events.END_SPEED
+    assert 800.0 * np.sqrt(events.STOP_ENERGY) < v
     assert outcome(v=(0.0, -v * (1 - 1e-9), 0.0)) == "embedded"
     assert outcome(v=(0.0, -v * (1 + 1e-6), 0.0)) is None
+    # the energy rule where it comes first: a shot at 3000 m/s, ½ M V² = STOP_ENERGY KE0 at 9.5 m/s
+    v = 3000.0 * np.sqrt(events.STOP_ENERGY)
+    fast = 0.5 * 0.4 * 3000.0**2
+    assert outcome(v=(0.0, -v * (1 - 1e-9), 0.0), ke0=fast) == "embedded"
+    assert outcome(v=(0.0, -v * (1 + 1e-6), 0.0), ke0=fast) is None
     assert outcome(v=(0.0, 1e-3, 0.0), until_stopped=False) is None  # a run with an end time never embeds
 
 
@@ -34,7 +40,7 @@ def test_perforation_needs_a_finite_target_and_every_point_beyond_its_rear_face(
 def test_ricochet_needs_every_point_above_the_face_and_the_centre_moving_away():
     assert outcome(y_min=1e-6, v=(0.0, 3.0, 0.0), entered=True) == "ricochet"
     assert outcome(y_min=1e-6, v=(0.0, 3.0, 0.0), entered=False) is None  # never entered: not a ricochet
-    assert outcome(y_min=1e-6, v=(0.0, -3.0, 0.0), entered=True) is None
+    assert outcome(y_min=1e-6, v=(0.0, -30.0, 0.0), entered=True) is None
 
 
 @pytest.mark.parametrize("until_stopped", [True, False])
