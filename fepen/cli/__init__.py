@@ -137,6 +137,8 @@ def console() -> None:
     try:
         mpi = sys.modules.get("mpi4py.MPI")
         if mpi is not None and mpi.Is_initialized() and not mpi.Is_finalized():
+            if code == 1 and mpi.COMM_WORLD.size > 1:  # a bug on this rank: the others may wait for it for ever
+                mpi.COMM_WORLD.Abort(1)
             mpi.Finalize()
     finally:
         os._exit(code if isinstance(code, int) else 1)

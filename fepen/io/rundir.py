@@ -531,7 +531,8 @@ def own_name(out: Path, name: str) -> None:
     study's groups share OUT: another group's rank may be the first to create OUT/shots (its own claim of OUT
     cannot tell rank 0's), and rank 0's claim, which guards the shots its own group keeps there, would then take
     it for a user's. Nothing is created; a name already there stays whatever it is (a user's is refused as
-    before)."""
+    before), and so does a name the folder's kind does not declare (its shots keep no folders there)."""
     c = atomic.claim_of(out / name)
-    if c is not None and c.dir == Path(os.path.abspath(out)) and not os.path.lexists(out / name):
+    if c is not None and c.dir == Path(os.path.abspath(out)) and not os.path.lexists(out / name) and (
+            c.declared is None or c.declared(name)):
         c.own(name)

@@ -15,11 +15,11 @@ from fepen import native
 
 #: fepen's calibrated "scaled-S" strength model (docs/validation-depth.md: one fit, rigid fidelity, on the
 #: calibration sets listed there); S = coefficient (f_c/MPa)^-exponent / sqrt(1 + D/size)
-SCALED_S_COEFFICIENT = 134.8
+SCALED_S_COEFFICIENT = 134.1
 SCALED_S_EXPONENT = 0.544
-SCALED_S_SIZE = 0.05412
+SCALED_S_SIZE = 0.05404
 #: the same fit with the calibrated nose wear on (effects.wear; docs/wear.md §2: fepen.studies.wear_calibration)
-SCALED_S_WEAR = (125.2, SCALED_S_EXPONENT, 0.06293)
+SCALED_S_WEAR = (124.6, SCALED_S_EXPONENT, 0.06292)
 
 
 # ---------------------------------------------------------------------------------------------------------

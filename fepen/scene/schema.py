@@ -174,7 +174,7 @@ SCHEMA: dict[str, Key] = {
     "projectile.material.taylor_quinney": number(0.9, "", 0.0, 1.0,
                                                  doc="beta: the fraction of the plastic work turned into heat "
                                                      "(effects.thermal)"),
-    "projectile.wear.efficiency": number(0.4438, "", 0.0, 1.0,
+    "projectile.wear.efficiency": number(0.4431, "", 0.0, 1.0,
                                          doc="eta: the fraction of the interface heat that melts the surface off "
                                              "(effects.wear; docs/theory.md §14), calibrated once on the paper's "
                                              "recovered projectiles (docs/wear.md §2)"),
@@ -285,11 +285,11 @@ SCHEMA: dict[str, Key] = {
     "target.S_coefficient": positive(ABSENT, "", 1.0e4,
                                      doc="a of S = a (f_c/MPa)^-b / sqrt(1 + D/S_size), sigma_s = S f_c "
                                          "(strength_model 'scaled-S' or 'forrestal-S'); absent: the model's "
-                                         "(scaled-S 134.8, with effects.wear 125.2; forrestal-S 82.6)"),
+                                         "(scaled-S 134.1, with effects.wear 124.6; forrestal-S 82.6)"),
     "target.S_exponent": number(ABSENT, "", 0.0, 2.0, doc="b of S (above); absent: the strength model's 0.544"),
     "target.S_size": positive(ABSENT, "m", 1.0e6,
                               doc="D0 of S (above), Bazant's size effect in the projectile diameter D; absent: "
-                                  "the model's (scaled-S 0.05412, with wear 0.06293; "
+                                  "the model's (scaled-S 0.05404, with wear 0.06292; "
                                   "forrestal-S none)"),
     "target.quasi_static_stress": positive(ABSENT, "Pa", 1.0e11,
                                            doc="overrides the strength model's sigma_s; absent: computed"),

@@ -352,3 +352,17 @@ def test_a_refusal_after_the_relaunch_is_one_line(tmp_path):
     lines = [ln for ln in r.stderr.splitlines() if ln.strip()]
     assert r.returncode == 2 and len(lines) == 1 and lines[0].startswith("fepen: bad input: --out:"), r.stderr
     assert (out / "sweep.csv").read_text() == "the user's table"
+
+
+@pytest.mark.two_ranks
+def test_a_study_that_keeps_no_shot_folders_runs_on_two_groups(tmp_path):
+    """A study whose shots keep no folder (validate-depth) on two groups: the engine does not claim a shots/
+    folder it would never write (it raised UndeclaredName on rank 0, and the other rank, left waiting in a
+    collective, hung until the job was killed; an internal error on one rank now aborts the job)."""
+    data = tmp_path / "mine.csv"
+    data.write_text("shot,d_mm,m_kg,crh,L_mm,v_ms,fc_mpa,rho_kgm3,depth_m\n"
+                    "a,26.9,0.906,2,242.4,277,35.2,2370,0.173\nb,30.5,1.6,3,305,800,51,2300,0.9\n")
+    r = run_fepen("validate-depth", "--data", data, "--only", "--out", tmp_path / "out", "--workers", "2",
+                  timeout=300)
+    assert r.returncode == 0, r.stderr
+    assert "mine: 2 shots" in r.stdout and not (tmp_path / "out" / "shots").exists()
