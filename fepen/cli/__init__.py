@@ -178,7 +178,7 @@ def _failed(err: BaseException, debug: bool) -> int:
     try:
         if debug:
             traceback.print_exc()
-        _error(line)
+        _error(line, code)
     except MemoryError:
         pass
     return code
@@ -245,14 +245,18 @@ def _quiet() -> None:
     rundir.chatter_to_log()
 
 
-def _error(line: str) -> None:
-    """The one line of an error, on stderr (rank 0), kept for fepen.log. Without MPI when MPI did not load (no
-    memory for it): the rank is then mpirun's (OMPI_COMM_WORLD_RANK, PMI_RANK)."""
+def _error(line: str, code: int = 0) -> None:
+    """The one line of an error, on stderr (rank 0), kept for fepen.log; a bug (code 1) on another rank is said
+    by that rank too, named (the ranks agree on every other error; a bug may be one rank's alone, and that rank
+    then ends the job: console). Without MPI when MPI did not load (no memory for it): the rank is then mpirun's
+    (OMPI_COMM_WORLD_RANK, PMI_RANK)."""
     mpi = sys.modules.get("mpi4py.MPI")
     if mpi is not None and mpi.Is_initialized():
         rank = mpi.COMM_WORLD.rank
     else:
         rank = int(os.environ.get("OMPI_COMM_WORLD_RANK", os.environ.get("PMI_RANK", "0")) or 0)
+    if rank != 0 and code == 1:
+        print(line.replace("fepen:", f"fepen (rank {rank}):", 1), file=sys.stderr, flush=True)
     if rank == 0:
         print(line, file=sys.stderr, flush=True)
         rundir = sys.modules.get("fepen.io.rundir")

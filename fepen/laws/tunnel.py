@@ -3,10 +3,10 @@ home in C (fepen/laws/tunnel_kernel.c, which fepen/laws/target_kernel.c includes
 
 The tunnel is recorded along the path of the body's widest section (the shoulder) as it goes, a station every
 ``spacing`` along the path, each with the radius the cavity has been opened to in ``SECTORS`` angular sectors;
-the wall is pushed out where the body later presses into it. Any surface point behind the shoulder is in the
-tunnel: the target loads it only where it presses into that wall, with the cavity-expansion stress of its own
-normal velocity, whatever the separation angle (its quasi-static part developing over the law's onset_speed
-of outward speed). The nose, ahead of the shoulder, opens the tunnel under the law of the open face.
+the wall yields outward where the body presses it past its reload limit. Any surface point behind the shoulder
+is in the tunnel: the target loads it only where it presses into that wall, elastically (2G/a times its push)
+up to the wall's limit (the reload fraction of σ_s and the inertia of its outward speed), whatever the separation
+angle. The nose, ahead of the shoulder, opens the tunnel under the law of the open face.
 
     t = Tunnel.of_points(X, radius)                from a body's load points (body frame: tip at y = 0, axis +y)
     t.at(shoulder, axis)                           before each force evaluation: where the shoulder is now
