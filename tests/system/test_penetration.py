@@ -15,13 +15,18 @@ NORMAL_300 = ["impact.velocity=300", "impact.obliquity_deg=0", "impact.attack_de
 
 
 def test_stiff_projectile_reproduces_the_rigid_one(tmp_path):
-    """An elastic steel projectile at 300 m/s hardly deforms: its depth equals the rigid fidelity's within
-    0.5 %, and its energy balance closes."""
+    """An elastic steel projectile at 300 m/s hardly deforms: with the same law (issue 58: one law for both
+    fidelities) its depth equals the rigid body's on the same load points (the mesh's facets) within 0.2 %
+    (measured 0.08 %), and the rigid fidelity's own rings within 1 % (the sampling, 0.45 %); its energy balance
+    closes."""
     sc = scene.load(None, ["effects.fidelity=elastic", *NORMAL_300])
     deform = DeformableRun(sc, tmp_path / "elastic", MPI.COMM_SELF).run()
-    rigid = RigidRun(scene.load(None, ["effects.fidelity=rigid", *NORMAL_300]), None, MPI.COMM_SELF).run()
-    assert deform["outcome"] == rigid["outcome"] == "embedded"
-    assert deform["Hy_mm"] == pytest.approx(rigid["Hy_mm"], rel=5e-3)
+    rigid_sc = scene.load(None, ["effects.fidelity=rigid", *NORMAL_300])
+    rigid = RigidRun(rigid_sc, None, MPI.COMM_SELF).run()
+    facets = RigidRun(rigid_sc, None, MPI.COMM_SELF, points="mesh").run()
+    assert deform["outcome"] == rigid["outcome"] == facets["outcome"] == "embedded"
+    assert deform["Hy_mm"] == pytest.approx(facets["Hy_mm"], rel=2e-3)
+    assert deform["Hy_mm"] == pytest.approx(rigid["Hy_mm"], rel=1e-2)
     assert deform["energy_error"] < 1e-3
     assert abs(deform["length_mm"] - 144.0) < 0.5  # elastic: the length comes back
     s = json.loads((tmp_path / "elastic" / "summary.json").read_text())

@@ -369,7 +369,7 @@ def test_a_line_that_cannot_be_said_for_want_of_memory_keeps_exit_4(monkeypatch,
     def no_memory(args):
         raise MemoryError()
 
-    def no_line(line):
+    def no_line(line, code=0):
         raise MemoryError()
 
     monkeypatch.setitem(cli.COMMANDS, "keys", no_memory)
