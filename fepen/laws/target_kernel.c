@@ -22,8 +22,8 @@ enum { P_DENSITY, P_Y, P_E, P_T, P_LAM, P_SIGMA_S, P_B, P_THICKNESS /* < 0: none
 
 #include "tunnel_kernel.c"
 
-/* A point in the tunnel (tunnel_kernel.c): its push into the wall (m), the outward unit vector, and the wall's
- * radius where it is (m) */
+/* A point in the tunnel (tunnel_kernel.c): its push into the wall (m), the outward unit vector, and the cavity's
+ * radius a0 (m), which sets the wall's stiffness */
 typedef struct {
     double delta, er[3], a;
 } WallHit;
@@ -181,25 +181,24 @@ static inline const WallHit *wall_of(const double *T, TunnelEnd *e, const double
     int32_t kn, sec;
     double rho;
     if (!tunnel_locate(T, e, xi_point, xi, &hit->delta, hit->er, &kn, &sec, &rho)) return 0;
-    hit->a = rho - hit->delta;
+    hit->a = T[T_A0];
     return hit;
 }
 
 /* A step's first stage, after the law: where the wall is pressed past its reload limit it yields, the plastic
  * cavity opened out to the radius at which the point's elastic push carries the limit (rho - limit k^-1, at the
- * point's nearest recorded station and sector); pressed within it, the wall stays as it is (§8.7). */
+ * point's nearest recorded station and sector, if wider than it is); pressed within it, the wall stays as it is
+ * (§8.7). The radius a point asks for depends on that point alone (its place, speed and law), not on the
+ * radii other points have just widened: the wall is the same whatever order, or rank, yields it. */
 static void wall_yield(double *T, TunnelEnd *e, const double *p, const LawConstants *c, const double *xi_point,
                        const double *vi, double radius, double xi) {
     double delta, er[3], rho;
     int32_t kn, sec;
     if (!tunnel_locate(T, e, xi_point, xi, &delta, er, &kn, &sec, &rho) || kn < 0) return;
-    WallHit hit = {delta, {er[0], er[1], er[2]}, rho - delta};
-    const double push = wall_push(&hit);
-    if (!(push > 0.0)) return;
+    const WallHit hit = {delta, {er[0], er[1], er[2]}, T[T_A0]};
     const double u = vi[0] * er[0] + vi[1] * er[1] + vi[2] * er[2];
     const double limit = wall_limit(p, static_stress(p, c, xi_point[1], radius), u);
-    const double k = wall_stiffness(p, &hit);
-    if (k * push > limit) tunnel_widen(T, kn, sec, rho - WALL_TOL * hit.a - limit / k);
+    tunnel_widen(T, kn, sec, rho - WALL_TOL * hit.a - limit / wall_stiffness(p, &hit));
 }
 
 /* k points; x, v, n (k, 3); area, radius, Rm, sphi0 (k); axis (3) or NULL; gauss: ng nodes then ng weights;
