@@ -210,7 +210,7 @@ def time_scales(mass: float, v0: float, diameter: float, law) -> tuple[float, fl
 #: the tunnel's wall is a spring on a body pressed into it (docs/theory.md §8.7): stiffness wall_shear2 / a per unit
 #: of wall, on up to the body's projected side D L, so the body's sideways (and turning) frequency is at most
 #: ω = sqrt(wall_shear2 D L / (a m)). The classical RK4 step is stable below 2.8 / ω; a rigid run's step is at most
-#: WALL_STEPS / ω, which the default shots' steps are far within (C3: 2.7 µs against 9 µs)
+#: WALL_STEPS / ω, which the default shots' steps are within (C3: 6.0 µs against 11.8 µs)
 WALL_STEPS = 1.0
 
 

@@ -95,8 +95,20 @@ def test_the_angular_momentum_about_O_grows_by_the_targets_angular_impulse(tmp_p
         assert np.abs(rate - signals.lowpass(t, M, 5e3))[inner].max() < 0.01 * np.abs(M).max()
     # C3 turns in its plane: the turning component, z, carries the impulse (0.1 N m s rigid to its stop)
     assert peak[2] > 0.01
-    assert err[2] < 1e-5 * peak[2], (err, peak)  # measured: 8e-7 rigid, 2e-7 plastic
-    assert np.all(err < 1e-5 * peak[2]), (err, peak)
+    if fidelity == "plastic":
+        assert np.all(err < 1e-5 * peak[2]), (err, peak)  # measured: 2e-7
+    else:  # the body's moment about O is exact in the rates, x_c × M v after an RK4 step only to its truncation:
+        # 1.1e-4 of the peak at the default step (6.0 us), all of it in the last 20 us, where the stopping body
+        # rocks on the wall's spring (a period of 74 us); 3.3e-7 at half the step. Its results do not move (the
+        # final axis 11.00 against 11.02 deg at 2 us)
+        assert np.all(err < 5e-4 * peak[2]), (err, peak)
+        half = RigidRun(scene.load(str(tmp_path / "probes.toml"), [*sets, "run.rigid_step=3e-6"]), tmp_path / "half",
+                        MPI.COMM_SELF)
+        half.run()
+        err2 = balance(tmp_path / "half")[0]
+        assert np.all(err2 < 1e-5 * peak[2]), (err2, peak)
+        assert json.loads((tmp_path / "half" / "summary.json").read_text())["final_axis_angle_deg"] == \
+            pytest.approx(summary["final_axis_angle_deg"], abs=0.1)
     # the angular velocity turns the body the way its axis turns: with y out of the target and z = x × y, the
     # axis (sin θ, −cos θ, 0) turns toward +x (θ grows) under ω_z = dθ/dt > 0
     assert h["axis_angle_deg"][-1] == pytest.approx(summary["final_axis_angle_deg"], abs=1e-6)
