@@ -44,7 +44,8 @@ def fepen(*args, ranks: int = 1) -> float:
     t0 = time.perf_counter()
     r = subprocess.run(cmd, cwd=ROOT, capture_output=True, text=True)
     if r.returncode != 0:
-        raise SystemExit(f"make docs: {' '.join(args[:2])} failed (exit {r.returncode}):\n{r.stderr[-2000:]}")
+        raise SystemExit(f"make docs: {' '.join(args[:2])} failed (exit {r.returncode}):\n{r.stdout[-2000:]}\n"
+                         f"{r.stderr[-2000:]}")
     return time.perf_counter() - t0
 
 

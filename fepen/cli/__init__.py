@@ -138,6 +138,9 @@ def console() -> None:
         mpi = sys.modules.get("mpi4py.MPI")
         if mpi is not None and mpi.Is_initialized() and not mpi.Is_finalized():
             if code == 1 and mpi.COMM_WORLD.size > 1:  # a bug on this rank: the others may wait for it for ever
+                import time
+
+                time.sleep(1.0)  # the launcher forwards the rank's line before the abort ends it (it was lost)
                 mpi.COMM_WORLD.Abort(1)
             mpi.Finalize()
     finally:
