@@ -13,7 +13,7 @@ from fepen.geometry import mesh as fmesh
 from fepen.geometry import revolution, tags
 from fepen.laws import target as tg
 from fepen.runs import outputs, setup, shot
-from fepen.solver import erosion, explicit, probes, recession, rigid_wall, shell_charge, surface, target_load
+from fepen.solver import assembly, erosion, explicit, probes, recession, rigid_wall, shell_charge, surface, target_load
 
 
 # ---------------------------------------------------------------------------------------------------------
@@ -103,8 +103,13 @@ def build(sh, comm: MPI.Comm = MPI.COMM_WORLD) -> Model:
         load.wear = receding
         receding.rotation = load.body_rotation  # the recession in the body's frame (theory.md §14.2)
     s.landing = outputs.landing(sh)  # the steps end on the output times
-    R, v = sh.rotation, sh.velocity
-    s.set_initial(displacement=lambda X: X @ R.T - X, velocity=lambda X: np.tile(v, (len(X), 1)))
+    R, v, w = sh.rotation, sh.velocity, sh.angular_velocity
+    if np.any(w):  # the body turning at impact: v + ω × (x − x_c) about its centre of mass (exact sums)
+        n = s.n_owned
+        xc = assembly.exact_sum(s.mass[:n, None] * s.X[:n], s.comm) / s.total_mass
+        s.set_initial(displacement=lambda X: X @ R.T - X, velocity=lambda X: v + np.cross(w, (X - xc) @ R.T))
+    else:
+        s.set_initial(displacement=lambda X: X @ R.T - X, velocity=lambda X: np.tile(v, (len(X), 1)))
     return Model(pm, s, load, contact, tip, tail, sh.speed, surf, sh.law, mesh_s, time.perf_counter() - t0,
                  eroding, receding)
 

@@ -147,7 +147,7 @@ class RigidRun(Run):
         self.law = sh.law
         R, v = sh.rotation, sh.velocity
         self.v0 = sh.speed
-        self.state = RigidState(R @ c0, matrix_to_quat(R), v.copy(), np.zeros(3))
+        self.state = RigidState(R @ c0, matrix_to_quat(R), v.copy(), R @ inertia @ R.T @ sh.angular_velocity)
         self.crater = sh.crater(self.mass)
         self.dt = sh.rigid_step or budget.default_step(self.mass, self.v0, sh.nominal_diameter, self.law)
         if sh.end_time is None:  # a shot that never stops (a body slower than its first ring's reach) ends

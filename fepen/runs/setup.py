@@ -297,14 +297,19 @@ def projectile_shape(scene) -> Shape | CadBody:
     return projectile(scene).shape
 
 
-def placement(scene) -> tuple[np.ndarray, np.ndarray]:
-    """Rotation (3x3) of the body about the nose tip and its velocity (3,) at impact (docs/theory.md §7):
-    θ = α + ϑ about +z, velocity v0 (sin α, −cos α, 0)."""
-    a = math.radians(scene.impact.obliquity_deg)
-    th = a + math.radians(scene.impact.attack_deg)
-    R = np.array([[math.cos(th), -math.sin(th), 0.0], [math.sin(th), math.cos(th), 0.0], [0.0, 0.0, 1.0]])
-    v = scene.impact.velocity * np.array([math.sin(a), -math.cos(a), 0.0])
-    return R, v
+def placement(scene) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    """Rotation (3x3) of the body about the nose tip, its velocity (3,) and its angular velocity (3, rad/s) at
+    impact (docs/theory.md §7): the velocity v0 (sin α, −cos α, 0); the axis turned from it by ϑ in the plane
+    at φ to the plane of fire (φ = 0: θ = α + ϑ about +z; fepen.geometry.frames.striking_rotation); the pitch
+    rate about z and the yaw rate out of the plane (frames.striking_rate)."""
+    from fepen.geometry import frames
+
+    i = scene.impact
+    a = math.radians(i.obliquity_deg)
+    R = frames.striking_rotation(a, math.radians(i.attack_deg), math.radians(scene.get("impact.attack_plane_deg")))
+    v = i.velocity * np.array([math.sin(a), -math.cos(a), 0.0])
+    w = frames.striking_rate(R, scene.get("impact.pitch_rate_rad_s"), scene.get("impact.yaw_rate_rad_s"))
+    return R, v, w
 
 
 def check_supported(scene, built: Built | None = None) -> Built:

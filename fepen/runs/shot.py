@@ -114,6 +114,7 @@ class Shot:
         built: the projectile (fepen.geometry.shape.Built), built once.
         law: the target law (TargetLaw, or Layered), None on the rigid wall.
         rotation, velocity: the body's rotation about the nose tip (3x3) and its velocity at impact (3,).
+        angular_velocity: the body's angular velocity at impact (3, rad/s, world).
         crh: the nose's calibre-radius-head (for Forrestal's linear crater).
         wear, erosion: their parameters, or None when off.
         end_time: run.end_time (s) or None (until a stop rule fires).
@@ -170,6 +171,7 @@ class Shot:
     envelope: dict = field(repr=False, default_factory=dict)
     inputs: dict = field(repr=False, default_factory=dict)
     safety: SafetyThresholds | None = None
+    angular_velocity: np.ndarray = field(default_factory=lambda: np.zeros(3))
 
     @property
     def rigid(self) -> bool:
@@ -247,7 +249,7 @@ def resolve(scene, toml: bool = True) -> Shot:
     built = setup.check_supported(scene)
     rigid = scene.effects.fidelity == "rigid"
     law = setup.target_law(scene) if scene.target.kind == "concrete" else None
-    R, v = setup.placement(scene)
+    R, v, w = setup.placement(scene)
     end = scene.get("run.end_time")
     materials = () if rigid else tuple(setup.materials(scene, built))
     from fepen.runs import budget
@@ -262,7 +264,8 @@ def resolve(scene, toml: bool = True) -> Shot:
     probes = tuple(scene.get("output.probes") or ())
     run_probes.check_inside(built.shape, probes, scene.effects.charge)
     return Shot(
-        fidelity=scene.effects.fidelity, built=built, law=law, rotation=R, velocity=v, crh=scene.projectile.crh,
+        fidelity=scene.effects.fidelity, built=built, law=law, rotation=R, velocity=v, angular_velocity=w,
+        crh=scene.projectile.crh,
         wear=_wear(scene), erosion=ErosionParameters(e.strain, e.step_ratio) if scene.effects.erosion else None,
         end_time=end, hard_end=_hard_end(law, end, float(np.linalg.norm(v)), "rigid" if rigid else "deformable"),
         failure_strain=scene.get("projectile.failure_strain"), outputs=_outputs(scene), mesh=setup.mesh_request(scene),

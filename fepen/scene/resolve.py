@@ -9,6 +9,7 @@ from __future__ import annotations
 
 import copy
 import difflib
+import math
 import os
 import tomllib
 from collections.abc import Callable
@@ -87,13 +88,19 @@ def _charge_hardening(flat: dict, given: dict) -> None:
                          "(charge.material.*: bilinear hardening H = E Et / (E - Et))")
 
 
-@cross_check("impact.obliquity_deg + impact.attack_deg < 90 deg: the axis points into the target")
+@cross_check("the axis at impact (impact.obliquity_deg, impact.attack_deg in its plane impact.attack_plane_deg) "
+             "< 90 deg from the normal: the axis points into the target")
 def _axis_into_target(flat: dict, given: dict) -> None:
-    theta = flat["impact.obliquity_deg"] + flat["impact.attack_deg"]
-    if theta >= 90.0:
-        raise InputError(_given_one(given, "impact.attack_deg", "impact.obliquity_deg"),
-                         f"obliquity + attack = {theta:g} deg turns the projectile's axis to or past the target "
-                         "face (its tail would start inside the target): the sum must be < 90 deg")
+    from fepen.geometry import frames
+
+    alpha, attack, plane = flat["impact.obliquity_deg"], flat["impact.attack_deg"], flat["impact.attack_plane_deg"]
+    R = frames.striking_rotation(math.radians(alpha), math.radians(attack), math.radians(plane))
+    theta = math.degrees(math.acos(max(-1.0, min(1.0, float(R[1, 1])))))  # the nose R (0, -1, 0) from -y
+    if not theta < 90.0 - 1e-9:
+        key = _given_one(given, "impact.attack_deg", "impact.obliquity_deg")
+        raise InputError(key, f"obliquity {alpha:g} deg with attack {attack:g} deg in the plane at {plane:g} deg "
+                              f"turns the projectile's axis {theta:.4g} deg from the normal, to or past the target "
+                              "face (its tail would start inside the target): it must be < 90 deg")
 
 
 @cross_check("run.rigid_step at most run.end_time, when both are given")

@@ -347,6 +347,17 @@ SCHEMA: dict[str, Key] = {
                                     "positive turns the nose further from the normal, toward +x (the axis at "
                                     "obliquity + attack from the normal), negative back toward the normal "
                                     "(docs/theory.md §7)"),
+    "impact.attack_plane_deg": number(0.0, "deg", -180.0, 180.0,
+                                      doc="the plane of the angle of attack, about the velocity from the plane of "
+                                          "fire: 0 turns the nose in the plane of fire toward +x (as "
+                                          "impact.attack_deg says), 90 out of it toward +z, 180 back toward the "
+                                          "normal (docs/theory.md §7)"),
+    "impact.pitch_rate_rad_s": number(0.0, "rad/s", -1.0e4, 1.0e4,
+                                      doc="the body's angular velocity at impact in the plane of fire (about z): "
+                                          "positive turns the nose toward +x (docs/theory.md §7)"),
+    "impact.yaw_rate_rad_s": number(0.0, "rad/s", -1.0e4, 1.0e4,
+                                    doc="the body's angular velocity at impact out of the plane of fire: positive "
+                                        "turns the nose toward +z (docs/theory.md §7)"),
     "impact.shot": Key(str, ABSENT, choices=tuple(SHOTS),
                        doc="a test of the paper's Table 1: sets the three above to the shot's and compares the "
                            "result with the test (summary.json experiment)"),

@@ -115,9 +115,10 @@ def test_every_named_steel_resolves(steel):
     (["impact.obliquity_deg=80", "impact.attack_deg=10"], "impact.attack_deg"),
     (["impact.obliquity_deg=89.95"], "impact.obliquity_deg"),  # with C3's attack of 0.1 deg
     (["impact.obliquity_deg=45", "impact.attack_deg=45"], "impact.attack_deg"),  # each in range, the sum not
+    (["impact.obliquity_deg=60", "impact.attack_deg=40", "impact.attack_plane_deg=10"], "impact.attack_deg"),
 ])
 def test_axis_must_point_into_the_target(sets, key):
-    msg = refused(sets, key, r"obliquity \+ attack = .* must be < 90 deg")
+    msg = refused(sets, key, r"turns the projectile's axis [\d.]+ deg from the normal, .* must be < 90 deg")
     assert "tail would start inside the target" in msg
 
 
@@ -125,6 +126,9 @@ def test_steep_but_possible_attitudes_are_accepted():
     sc = Scene(None, ["impact.obliquity_deg=80", "impact.attack_deg=9.9"])
     assert sc.impact.obliquity_deg + sc.impact.attack_deg < 90.0
     Scene(None, ["impact.obliquity_deg=85", "impact.attack_deg=-89"])
+    # out of the plane of fire the axis is at acos(cos 60 cos 40) = 67.5 deg from the normal; turned back, 65
+    Scene(None, ["impact.obliquity_deg=60", "impact.attack_deg=40", "impact.attack_plane_deg=90"])
+    Scene(None, ["impact.obliquity_deg=80", "impact.attack_deg=15", "impact.attack_plane_deg=180"])
 
 
 def test_rigid_step_within_the_end_time_when_both_are_given():
