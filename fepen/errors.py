@@ -144,6 +144,24 @@ def start_within_limits() -> None:
         os.environ["OPENBLAS_NUM_THREADS"] = "1"
 
 
+#: the environment variable a relaunching command sets on the ranks it starts (fepen.studies.processes.relaunch)
+RELAUNCHED = "FEPEN_RELAUNCHED"
+#: the stop a relaunched rank was asked for (SIGUSR1) before its study caught signals (fepen.runs.interrupts)
+EARLY_STOP: list[int] = []
+
+
+def catch_early_stop() -> None:
+    """In a rank that a relaunching command started, from its first line (fepen.cli.main): SIGUSR1, the stop that
+    command passes on through mpirun, is recorded (EARLY_STOP) until the study catches signals, which then stops at
+    its first shot boundary. Before, a signal in the second or two while a loaded machine imported MPI and
+    numpy killed the rank (the default action), and mpirun ended with 138 instead of the study with 4."""
+    if os.environ.get(RELAUNCHED) != "1":
+        return
+    import signal
+
+    signal.signal(signal.SIGUSR1, lambda signum, frame: EARLY_STOP.append(signum))
+
+
 def limits_text() -> str:
     """The memory limits set, for a message: "the address-space limit ulimit -v is 750 MiB" ("" when none is)."""
     try:

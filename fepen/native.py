@@ -69,7 +69,8 @@ KERNELS = {
     "target": Kernel("laws/target_kernel.c", (), True, {
         "point_forces": ([_i32, *[_vp] * 10, _i32, _vp, _vp, _vp, _vp, _vp], _i32),
         "cavity_wall_stress": ([_dbl] * 3, _dbl),
-        "tunnel_sectors": ([_i32, _vp, _vp, _i32, _vp, _vp], None)}),
+        "tunnel_sectors": ([_i32, _vp, _vp, _i32, _vp, _vp], None),
+        "strength_field": ([_i32, _vp, _vp, _vp], _i32)}),
     "materials": Kernel("laws/materials_kernel.c", NO_CONTRACT, True, {
         "material_radial_return": ([_dbl] * 5 + [_vp, _vp], _dbl),
         "material_yield_stress": ([_dbl] * 3 + [_vp], _dbl)}),

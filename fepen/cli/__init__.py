@@ -45,6 +45,7 @@ from fepen.errors import (
     Interrupted,
     MachineFault,
     SimulationError,
+    catch_early_stop,
     describe_os_error,
     out_of_memory,
     start_within_limits,
@@ -109,6 +110,7 @@ def main(argv: list[str] | None = None) -> int:
     (fepen.errors): every error is one line on stderr, with its traceback only under --debug."""
     argv = list(sys.argv[1:] if argv is None else argv)
     start_within_limits()  # before numpy, MPI or gmsh is loaded
+    catch_early_stop()  # a relaunched rank: a stop asked for while it loads is kept for its study
     try:  # MPI and numpy load here: a fault of the machine (memory under ulimit -v) is one line already
         from fepen.io import rundir
     except BaseException as err:  # noqa: B036 - every way out is one line and a documented code

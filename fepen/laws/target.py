@@ -189,6 +189,9 @@ class TargetLaw:
         wall_shear2: the tunnel wall's elastic reload modulus "2G" (Pa): its stiffness under a sideways push is
             wall_shear2 / a (a the wall's radius; wall_modulus); 0: the wall carries nothing.
         reload: the tunnel wall's reload strength, the fraction of σ_s that re-expands it (reload_fraction).
+        field_sigma, field_modes: the concrete's random field on σ_s (§8.8; strength_field): the standard
+            deviation of the factor's logarithm and its modes (kx, ky, kz, phase) flattened (random_field_modes);
+            () without a field.
     """
 
     density: float
@@ -218,6 +221,8 @@ class TargetLaw:
     surface_range: float = 1.0
     wall_shear2: float = 0.0
     reload: float = 1.0
+    field_sigma: float = 0.0
+    field_modes: tuple = ()
 
     @property
     def lower(self) -> float | None:
@@ -360,6 +365,42 @@ def crater_gauss() -> np.ndarray:
     return _kernel().gauss
 
 
+#: the modes of the concrete's random field (§8.8): its marginal is a sum of FIELD_MODES cosines, Gaussian to
+#: within a few per cent in its tails
+FIELD_MODES = 64
+
+
+def random_field_modes(seed: int, correlation_length: float, modes: int = FIELD_MODES) -> tuple:
+    """The modes of a Gaussian random field of unit variance with the covariance exp(−r²/(2 ℓ²)), ℓ the
+    correlation length (m), by the spectral representation (docs/theory.md §8.8): wave vectors drawn from the
+    covariance's spectrum, N(0, I/ℓ²), and phases uniform on [0, 2π), from numpy's PCG64 with ``seed``.
+
+    Returns:
+        (kx, ky, kz, phase) per mode, flattened: TargetLaw.field_modes.
+    """
+    rng = np.random.Generator(np.random.PCG64(int(seed)))
+    k = rng.standard_normal((modes, 3)) / correlation_length
+    phase = rng.uniform(0.0, 2.0 * np.pi, modes)
+    return tuple(float(v) for v in np.column_stack([k, phase]).ravel())
+
+
+def field_log_sigma(cv: float) -> float:
+    """The standard deviation of the logarithm of a lognormal factor of mean 1 and coefficient of variation cv:
+    sqrt(ln(1 + cv²))."""
+    return math.sqrt(math.log1p(cv * cv))
+
+
+def strength_field(law: TargetLaw, x: np.ndarray) -> np.ndarray:
+    """The law's strength factor on σ_s at target points x (k, 3) (m; 1 without a field): target_kernel.c's
+    field_factor, the factor the law applies there."""
+    x = np.ascontiguousarray(x, dtype=float).reshape(-1, 3)
+    p = _law_numbers(law)
+    out = np.empty(len(x))
+    lib = native.kernel("target")
+    assert lib.strength_field(len(x), x.ctypes.data, p.ctypes.data, out.ctypes.data) == len(p)
+    return out
+
+
 _KERNEL: dict = {}
 
 
@@ -379,7 +420,8 @@ def _law_numbers(law: TargetLaw) -> np.ndarray:
                      law.phi_min, float(law.free_surface), float(law.friction), law.mu,
                      law.mu if law.mu_dynamic is None else law.mu_dynamic, law.mu_decay, law.lock_density,
                      law.crush_strain, law.c_over_a, float(law.given_sigma_s), law.wall_shear2, law.top,
-                     -1.0 if law.lower is None else law.lower, law.surface_range, law.reload])
+                     -1.0 if law.lower is None else law.lower, law.surface_range, law.reload, law.field_sigma,
+                     len(law.field_modes) // 4, *law.field_modes])
 
 
 def _bind(lib):

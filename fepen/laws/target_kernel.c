@@ -16,6 +16,8 @@ enum { P_DENSITY, P_Y, P_E, P_T, P_LAM, P_SIGMA_S, P_B, P_THICKNESS /* < 0: none
        P_TOP /* the material's own faces in a block of layers */, P_LOWER /* < 0: none */,
        P_SURFACE_RANGE /* the free face's reach in plastic-zone widths */,
        P_RELOAD /* the tunnel wall's reload strength: the fraction of sigma_s that re-expands its cracked wall */,
+       P_FIELD_SIGMA /* the concrete's random field on sigma_s (§8.8): the standard deviation of its logarithm */,
+       P_FIELD_MODES /* its number of modes N; 0: none. The modes follow P_COUNT: (kx, ky, kz, phase) each */,
        P_COUNT };
 
 #define SIN_TOL 1e-9
@@ -65,8 +67,26 @@ static LawConstants law_constants(const double *p) {
     return c;
 }
 
-/* The quasi-static stress sigma_s at a point at height y (m; the face y = 0) with surface radius rho (m), the face
- * cutting the cavity expansion's plastic zone (§8.4) when the law asks: the nose's and the wall's one text */
+/* The concrete's strength factor at a target point x (3, m; §8.8): exp(s g(x) - s^2/2), g(x) = sqrt(2/N)
+ * sum_j cos(k_j . x + phase_j) a Gaussian field of unit variance (the spectral representation), so the factor is
+ * lognormal of mean 1; 1 without a field. A function of the point alone: the same on any rank, in any order.
+ * Not inlined: inlined, its cos and exp changed how GCC compiled the law around it, and the plain concrete's
+ * forces moved by an ulp (tests/unit/runs/test_batch.py holds them to the batch's bits). */
+__attribute__((noinline)) static double field_factor(const double *p, const double *x) {
+    const int32_t nm = (int32_t)p[P_FIELD_MODES];
+    if (nm <= 0) return 1.0;
+    const double *m = p + P_COUNT, s = p[P_FIELD_SIGMA];
+    double g = 0.0;
+    for (int32_t j = 0; j < nm; ++j, m += 4) g += cos(m[0] * x[0] + m[1] * x[1] + m[2] * x[2] + m[3]);
+    return exp(s * sqrt(2.0 / nm) * g - 0.5 * s * s);
+}
+
+/* The numbers a law p holds: P_COUNT and its field's modes */
+static inline int32_t law_length(const double *p) { return P_COUNT + 4 * (int32_t)p[P_FIELD_MODES]; }
+
+/* The quasi-static stress sigma_s at height y (m; the face y = 0) of a point with surface radius rho (m), the face
+ * cutting the cavity expansion's plastic zone (§8.4) when the law asks (the concrete's random field, §8.8, is
+ * local_stress's) */
 static inline double static_stress(const double *p, const LawConstants *c, double y, double radius) {
     double s = p[P_SIGMA_S];
     if (p[P_FREE_SURFACE] != 0.0) {
@@ -77,6 +97,13 @@ static inline double static_stress(const double *p, const LawConstants *c, doubl
         else s = p[P_GIVEN_SIGMA_S] != 0.0 ? p[P_SIGMA_S] * cavity_stress(p, ca) / c->ref : cavity_stress(p, ca);
     }
     return s;
+}
+
+/* sigma_s at the target point x (3, m): static_stress times the concrete's random field there (§8.8; without a
+ * field, static_stress to the last bit): the nose's and the wall's one text */
+static inline double local_stress(const double *p, const LawConstants *c, const double *x, double radius) {
+    const double s = static_stress(p, c, x[1], radius);
+    return p[P_FIELD_MODES] > 0.0 ? s * field_factor(p, x) : s;
 }
 
 /* The tunnel's wall at a point pressed into it (§8.7): elastic, p = (2G/a) delta, up to its reload limit
@@ -123,7 +150,7 @@ static inline int law_at_point(const double *p, const LawConstants *c, const dou
         if (p[P_SEPARATION] != 0.0) loaded = loaded && sin_phi > c->sin_min;
     }
     if (!loaded) return 0;
-    const double s = static_stress(p, c, y, radius);
+    const double s = local_stress(p, c, xi, radius);
     /* the nose: the cavity-expansion stress at any speed into the target (sigma_s is its static limit); the
      * wall: elastic up to its reload limit, so a body pressed into it at rest is held, and let go of as it leaves */
     double sg = (wall ? fmin(wall_stiffness(p, wall) * wall_push(wall), wall_limit(p, s, u))
@@ -197,7 +224,7 @@ static void wall_yield(double *T, TunnelEnd *e, const double *p, const LawConsta
     if (!tunnel_locate(T, e, xi_point, xi, &delta, er, &kn, &sec, &rho) || kn < 0) return;
     const WallHit hit = {delta, {er[0], er[1], er[2]}, T[T_A0]};
     const double u = vi[0] * er[0] + vi[1] * er[1] + vi[2] * er[2];
-    const double limit = wall_limit(p, static_stress(p, c, xi_point[1], radius), u);
+    const double limit = wall_limit(p, local_stress(p, c, xi_point, radius), u);
     tunnel_widen(T, kn, sec, rho - WALL_TOL * hit.a - limit / wall_stiffness(p, &hit));
 }
 
@@ -206,7 +233,7 @@ static void wall_yield(double *T, TunnelEnd *e, const double *p, const LawConsta
  * none, body_xi unread). A call with T[T_COMMIT] set (a step's first stage) first records a station, then
  * lets the wall yield where the points press it past its reload limit (wall_yield), and clears the flag.
  * Out: f (k, 3) and sig (k) (zero where not loaded), sums: force (3), loaded count, loaded area.
- * Returns P_COUNT. */
+ * Returns the numbers of the law it read (law_length). */
 int32_t point_forces(int32_t k, const double *x, const double *v, const double *n, const double *area,
                      const double *radius, const double *Rm, const double *sphi0, const double *axis,
                      const double *p, const double *gauss, int32_t ng, double *f, double *sig, double *sums,
@@ -241,7 +268,14 @@ int32_t point_forces(int32_t k, const double *x, const double *v, const double *
         sums[1] += f[3 * i + 1];
         sums[2] += f[3 * i + 2];
     }
-    return P_COUNT;
+    return law_length(p);
+}
+
+/* The strength factor of the law p's random field at k target points x (k, 3) into out (k); returns the numbers
+ * of the law it read */
+int32_t strength_field(int32_t k, const double *x, const double *p, double *out) {
+    for (int32_t i = 0; i < k; ++i) out[i] = field_factor(p, x + 3 * i);
+    return law_length(p);
 }
 
 /* The sectors of k points' offsets r (k, 3) about unit axes t (k, 3), S sectors: q as tunnel_locate takes it (the

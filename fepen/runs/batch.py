@@ -154,7 +154,10 @@ def _integrate(runs: list) -> list:
     const = [np.ascontiguousarray(a, dtype=float) for a in (body.r0, body.N0, g["area0"], np.sqrt(g["area0"]),
                                                               g["radius"], g["R_meridian"], g["sin_phi0"])]
     sp = np.ascontiguousarray([_shot_numbers(r) for r in runs], dtype=float)
-    laws = np.ascontiguousarray([tg._law_numbers(r.law) for r in runs], dtype=float)
+    numbers = [tg._law_numbers(r.law) for r in runs]  # padded to the longest (the random fields' modes)
+    laws = np.zeros((n, max(len(a) for a in numbers)))
+    for row, a in zip(laws, numbers):
+        row[:len(a)] = a
     y = np.ascontiguousarray([r.state.as_array() for r in runs], dtype=float)
     res = np.zeros((n, len(RESULTS)))
     cap = _tunnel_room(runs)

@@ -42,6 +42,11 @@ class Interrupts:
             for sig in SIGNALS:
                 self._previous[sig] = signal.signal(sig, self._catch)
             self.outer, _active = _active, self
+            from fepen import errors
+
+            if errors.EARLY_STOP:  # asked for while the rank loaded (errors.catch_early_stop)
+                self.caught = errors.EARLY_STOP[0]
+                errors.EARLY_STOP.clear()
         return self
 
     def __exit__(self, *exc) -> None:

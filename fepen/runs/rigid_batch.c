@@ -334,9 +334,10 @@ static void one_shot(Body *b, const double *sp, const double *law, double *y, do
 
 /* n shots sharing k load points (r0, N0: body-frame arms and normals; area, ell = sqrt(area), radius, Rm,
  * sphi0: the law's per-point constants; gauss: ng nodes then ng weights; points, moment: rigid_kernel.c's
- * rigid_points and force_moment). Per shot: sp (n, S_COUNT), laws (n, nlaw) the TargetLaw's numbers (P_COUNT of them), y (n, 13)
- * the initial state, overwritten by the final one; res (n, R_COUNT). Returns S_COUNT * 10000 + R_COUNT * 100 +
- * P_COUNT (the caller checks the layouts), or -1 when the scratch is not allocated. */
+ * rigid_points and force_moment). Per shot: sp (n, S_COUNT), laws (n, nlaw) the TargetLaw's numbers (P_COUNT and
+ * its random field's modes, padded to the longest), y (n, 13) the initial state, overwritten by the final one;
+ * res (n, R_COUNT). Returns S_COUNT * 10000 + R_COUNT * 100 + nlaw (the caller checks the layouts), or -1 when
+ * the scratch is not allocated or a law is longer than nlaw. */
 int32_t rigid_batch(int32_t n, int32_t k, const double *r0, const double *N0, const double *area, const double *ell,
                     const double *radius, const double *Rm, const double *sphi0, const double *gauss, int32_t ng,
                     void *points, void *moment, const double *sp, const double *laws, int32_t nlaw, double *y,
@@ -346,7 +347,9 @@ int32_t rigid_batch(int32_t n, int32_t k, const double *r0, const double *N0, co
     size_t kk = (size_t)(k > 0 ? k : 1);
     double *scratch = calloc(16 * kk, sizeof(double));
     int32_t *idx = malloc(sizeof(int32_t) * kk);
-    if (!scratch || !idx || nlaw != P_COUNT) {
+    int32_t fits = nlaw >= P_COUNT;
+    for (int32_t s = 0; fits && s < n; ++s) fits = law_length(laws + (size_t)s * nlaw) <= nlaw;
+    if (!scratch || !idx || !fits) {
         free(scratch);
         free(idx);
         return -1;
@@ -360,7 +363,7 @@ int32_t rigid_batch(int32_t n, int32_t k, const double *r0, const double *N0, co
     }
     free(scratch);
     free(idx);
-    return S_COUNT * 10000 + R_COUNT * 100 + P_COUNT;
+    return S_COUNT * 10000 + R_COUNT * 100 + nlaw;
 }
 
 /* The batch's law on one set of points, for the tests against point_forces: f (k, 3) (zero where not loaded)

@@ -128,7 +128,18 @@ def material_law(scene, c: dict, thickness: float | None) -> tg.TargetLaw:
         wall_shear2=tg.wall_modulus(E, tg.WALL_POISSON.get(c.get("family"), tg.WALL_POISSON_DEFAULT),
                                     1.0 if c.get("family") == "metal" else ca),
         reload=scene.get("target.tunnel_reload") if scene.get("target.tunnel_reload") is not None else (
-            1.0 if c.get("family") == "metal" else tg.reload_fraction(Y, lam, ca)))
+            1.0 if c.get("family") == "metal" else tg.reload_fraction(Y, lam, ca)),
+        **strength_field(scene))
+
+
+def strength_field(scene) -> dict:
+    """The TargetLaw's random field on σ_s (docs/theory.md §8.8) of target.heterogeneity_*: none at cv 0."""
+    cv = scene.get("target.heterogeneity_cv")
+    if not cv > 0.0:
+        return {}
+    return {"field_sigma": tg.field_log_sigma(cv),
+            "field_modes": tg.random_field_modes(scene.get("target.heterogeneity_seed"),
+                                                 scene.get("target.heterogeneity_length"))}
 
 
 #: cavity keys that, when the user gives any of them, fix the cavity (its length is still sized to the mass)

@@ -329,6 +329,16 @@ SCHEMA: dict[str, Key] = {
                                        "the cracked wall the nose left (effects.tunnel); absent: the cavity "
                                        "expansion with the comminuted ring's cohesion removed, 0.52 for the "
                                        "default concrete; a metal's 1 (docs/theory.md §8.7)"),
+    "target.heterogeneity_cv": number(0.0, "", 0.0, 2.0,
+                                      doc="the concrete's heterogeneity: the coefficient of variation of a "
+                                          "lognormal random field of mean 1 on sigma_s, fixed in the target and "
+                                          "seeded (target.heterogeneity_seed); 0: none (docs/theory.md §8.8)"),
+    "target.heterogeneity_length": number(0.02, "m", 0.0, 10.0, lo_open=True,
+                                          doc="the field's correlation length: its covariance exp(-r^2/(2 l^2)), "
+                                              "of the order of the largest aggregate (docs/theory.md §8.8)"),
+    "target.heterogeneity_seed": Key(int, 0, "", 0, 2**32 - 1,
+                                     doc="the seed of the field's modes (numpy's PCG64): the same seed, the "
+                                         "same concrete, on any rank count"),
     "target.free_surface_range": number(1.0, "", 0.0, 20.0, lo_open=True,
                                         doc="reach of the free face on sigma_s, in plastic-zone widths "
                                             "(effects.free_surface; docs/theory.md §8.4); the default "

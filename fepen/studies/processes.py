@@ -129,7 +129,9 @@ def relaunch(argv: list, workers: int) -> int:
     Returns:
         The launcher's exit code.
     """
-    proc = subprocess.Popen(command([*map(str, argv), "--workers", "1"], workers), env=mpi_env(),
+    from fepen.errors import RELAUNCHED
+
+    proc = subprocess.Popen(command([*map(str, argv), "--workers", "1"], workers), env=mpi_env(**{RELAUNCHED: "1"}),
                             start_new_session=True, preexec_fn=_usr1_when_parent_dies)
     caught: list[int] = []
 

@@ -81,3 +81,23 @@ def test_the_body_strikes_with_its_angular_velocity(tmp_path, fidelity):
     # the history's kinetic_J of 62 kJ carries 1e-4 J: the difference to that
     assert h["kinetic_J"][0] - h0["kinetic_J"][0] == pytest.approx(spin, abs=2e-4)
     assert still["outcome"] == turning["outcome"]
+
+
+def test_the_concrete_s_field_is_set_by_its_seed():
+    """C3 into a heterogeneous concrete (cv 0.3, the default 20 mm correlation length): the same seed, the same
+    path to the last bit; another seed, another path (the field kicks the nose sideways: the final axes of four
+    seeds spread by more than 0.1 deg); a vanishing cv, the plain concrete's path."""
+    def final(*sets):
+        return RigidRun(scene.load(None, [*RIGID, *sets]), None, MPI.COMM_SELF).run()
+
+    plain = final()
+    a = final("target.heterogeneity_cv=0.3", "target.heterogeneity_seed=1")
+    again = final("target.heterogeneity_cv=0.3", "target.heterogeneity_seed=1")
+    for k in ("Hx_mm", "Hy_mm", "Tx_mm", "Ty_mm", "final_axis_angle_deg", "nose_offset_mm"):
+        assert again[k] == a[k], k
+    axes = [final("target.heterogeneity_cv=0.3", f"target.heterogeneity_seed={s}")["final_axis_angle_deg"]
+            for s in range(4)]
+    assert np.ptp(axes) > 0.1
+    faint = final("target.heterogeneity_cv=1e-9", "target.heterogeneity_seed=1")
+    assert faint["Hy_mm"] == pytest.approx(plain["Hy_mm"], rel=1e-6)
+    assert faint["final_axis_angle_deg"] == pytest.approx(plain["final_axis_angle_deg"], abs=1e-4)
