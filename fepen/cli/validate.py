@@ -1,6 +1,7 @@
-"""``fepen validate [SCENE.toml] [--out DIR] [--set KEY=VALUE ...] [--workers W] [--fresh]``: the eight Table 1 shots
-(fepen.studies.validate.Validate), one line per shot; its deformable shots side by side under ``mpirun -n W``
-when started without mpirun (one rank each)."""
+"""``fepen validate [SCENE.toml] [--out DIR] [--set KEY=VALUE ...] [--workers W] [--fresh] [--samples N [--seed S]]``:
+the eight Table 1 shots (fepen.studies.validate.Validate), one line per shot; its deformable shots side by side
+under ``mpirun -n W`` when started without mpirun (one rank each). With --samples, each shot as an ensemble of N
+rigid members over its unmeasured inputs (fepen.studies.bands.Bands): bands.csv, bands.md, bands.png."""
 
 from __future__ import annotations
 
@@ -13,6 +14,10 @@ def add_arguments(parser) -> None:
     scene_arguments(parser, "results/validation")
     workers_argument(parser, "deformable shots at once, each on one rank under mpirun (default: one per core)")
     fresh_argument(parser)
+    parser.add_argument("--samples", type=int, default=None, metavar="N",
+                        help="each shot as N rigid members drawn over its unmeasured inputs (docs/uncertainty.md): "
+                             "bands.csv, bands.md, bands.png")
+    parser.add_argument("--seed", type=int, default=0, help="the members' seed (with --samples; default 0)")
 
 
 def run(args) -> int:
@@ -25,9 +30,24 @@ def run(args) -> int:
     from fepen.cli.common import written_line
     from fepen.studies import processes, study, validate
 
+    workers = workers_count(args)
+    if args.samples is not None:
+        from fepen.studies import bands
+
+        st = bands.Bands()
+        out = args.out if args.out != "results/validation" else st.out
+        plan = st.plan(args.scene, args.sets, args.samples, args.seed)  # bad input here
+        if MPI.COMM_WORLD.size == 1 and workers > 1 and processes.launcher():
+            os.environ.setdefault("FEPEN_PROGRESS", "1" if sys.stderr.isatty() else "0")
+            argv = ["validate", *([args.scene] if args.scene else []), "--out", out,
+                    *[f"--set={s}" for s in args.sets], *(["--fresh"] if args.fresh else []),
+                    "--samples", str(args.samples), "--seed", str(args.seed)]
+            return processes.relaunch(argv, workers)
+        study.run(st, plan, out, MPI.COMM_WORLD, 1, args.fresh, say)
+        say(written_line(out))
+        return 0
     st = validate.Validate()
     plan = st.plan(args.scene, args.sets)  # bad input here, before anything is written
-    workers = workers_count(args)
     deformable = next(iter(plan.scenes.values())).effects.fidelity != "rigid"
     if MPI.COMM_WORLD.size == 1 and deformable and workers > 1 and processes.launcher():
         os.environ.setdefault("FEPEN_PROGRESS", "1" if sys.stderr.isatty() else "0")

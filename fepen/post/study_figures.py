@@ -375,3 +375,26 @@ def pareto(fig, rows) -> None:
     axes[0].legend(handles=handles, fontsize=8)
     fig.suptitle("fepen: accuracy against time (shots C3 and C7)")
     fig.tight_layout()
+
+
+def fans(fig, fans: dict, tests: dict) -> None:
+    """bands.png: each shot's ensemble of final bodies in the plane of fire (nose to tail, one faint line per
+    member: fepen.studies.bands) with the test's final body in black (fig: 15 x 6.5 in)."""
+    names = list(fans)
+    axes = fig.subplots(2, (len(names) + 1) // 2).ravel()
+    for ax, name in zip(axes, names):
+        f = np.asarray(fans[name], dtype=float)
+        for hx, hy, tx, ty in f:
+            ax.plot([tx, hx], [ty, hy], color="tab:blue", alpha=0.08, lw=1)
+        ax.plot(f[:, 0], f[:, 1], ".", color="tab:blue", ms=2)
+        t = tests[name]
+        ax.plot([t["Tx_mm"], t["Hx_mm"]], [t["Ty_mm"], t["Hy_mm"]], "k-", lw=2, label="test")
+        ax.plot([t["Hx_mm"]], [t["Hy_mm"]], "ko", ms=4)
+        ax.set_title(name)
+        ax.set_xlabel("x (mm)")
+        ax.set_ylabel("depth (mm)")
+        ax.invert_yaxis()
+        ax.set_aspect("equal", adjustable="datalim")
+    for ax in axes[len(names):]:
+        ax.set_visible(False)
+    axes[0].legend(loc="lower left", fontsize=8)

@@ -34,6 +34,7 @@ __all__ = ["Round", "Sub", "Study", "RunInfo", "run", "register", "get", "public
 STUDIES = {
     "sweep": ("fepen.studies.sweep", "SweepStudy"),
     "validate": ("fepen.studies.validate", "Validate"),
+    "validate-bands": ("fepen.studies.bands", "Bands"),
     "validate-depth": ("fepen.studies.depth", "ValidateDepth"),
     "accuracy-cost": ("fepen.studies.accuracy_cost", "AccuracyCost"),
     "ballistic-limit": ("fepen.studies.limits", "BallisticLimit"),

@@ -18,11 +18,11 @@ def test_help_lists_every_command_and_exits_0(capsys):
 
 
 def test_every_study_runs_from_the_command_line(capsys):
-    """fepen study --help names every registered study the CLI's one handler runs; sweep, validate and
-    validate-depth have commands of their own."""
+    """fepen study --help names every registered study the CLI's one handler runs; sweep, validate (and its
+    ensembles, validate --samples) and validate-depth have commands of their own."""
     assert cli.main(["study", "--help"]) == 0
     text = capsys.readouterr().out
-    own = {"sweep", "validate", "validate-depth"}
+    own = {"sweep", "validate", "validate-bands", "validate-depth"}
     for name in study.study_names():
         assert name in own or name in text, name
 
