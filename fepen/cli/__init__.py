@@ -111,7 +111,12 @@ def main(argv: list[str] | None = None) -> int:
     argv = list(sys.argv[1:] if argv is None else argv)
     start_within_limits()  # before numpy, MPI or gmsh is loaded
     catch_early_stop()  # a relaunched rank: a stop asked for while it loads is kept for its study
-    try:  # MPI and numpy load here: a fault of the machine (memory under ulimit -v) is one line already
+    # MPI and numpy load here: a fault of the machine (memory under ulimit -v) is one line already. numpy first:
+    # under a small ulimit -v its LAPACK fails first, an error said in one line, where MPI's own failure to map its
+    # shared memory aborts the process (exit 1: CI saw it at 100 MiB)
+    try:
+        import numpy  # noqa: F401
+
         from fepen.io import rundir
     except BaseException as err:  # noqa: B036 - every way out is one line and a documented code
         return _failed(err, "--debug" in argv)

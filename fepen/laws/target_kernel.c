@@ -67,6 +67,26 @@ static LawConstants law_constants(const double *p) {
     return c;
 }
 
+/* cos t for the field's modes: t less the nearest multiple of 2 pi (in two parts), then cos's Taylor series to
+ * r^22, within 2e-12 on [-pi, pi] (libm's cos had been 90 % of a rigid run with a field: this is 3.5 times
+ * faster) */
+static inline double field_cos(double t) {
+    const double turns = floor(t * 0.15915494309189535 + 0.5);
+    const double r = (t - turns * 6.283185307179586) - turns * 2.4492935982947064e-16, z = r * r;
+    double c = -1.0 / 1124000727777607680000.0;                 /* -1/22! */
+    c = c * z + 1.0 / 2432902008176640000.0;                    /* 1/20! */
+    c = c * z - 1.0 / 6402373705728000.0;
+    c = c * z + 1.0 / 20922789888000.0;
+    c = c * z - 1.0 / 87178291200.0;
+    c = c * z + 1.0 / 479001600.0;
+    c = c * z - 1.0 / 3628800.0;
+    c = c * z + 1.0 / 40320.0;
+    c = c * z - 1.0 / 720.0;
+    c = c * z + 1.0 / 24.0;
+    c = c * z - 0.5;
+    return c * z + 1.0;
+}
+
 /* The concrete's strength factor at a target point x (3, m; §8.8): exp(s g(x) - s^2/2), g(x) = sqrt(2/N)
  * sum_j cos(k_j . x + phase_j) a Gaussian field of unit variance (the spectral representation), so the factor is
  * lognormal of mean 1; 1 without a field. A function of the point alone: the same on any rank, in any order.
@@ -77,7 +97,8 @@ __attribute__((noinline)) static double field_factor(const double *p, const doub
     if (nm <= 0) return 1.0;
     const double *m = p + P_COUNT, s = p[P_FIELD_SIGMA];
     double g = 0.0;
-    for (int32_t j = 0; j < nm; ++j, m += 4) g += cos(m[0] * x[0] + m[1] * x[1] + m[2] * x[2] + m[3]);
+    for (int32_t j = 0; j < nm; ++j)
+        g += field_cos(m[4 * j] * x[0] + m[4 * j + 1] * x[1] + m[4 * j + 2] * x[2] + m[4 * j + 3]);
     return exp(s * sqrt(2.0 / nm) * g - 0.5 * s * s);
 }
 
