@@ -144,6 +144,23 @@ def start_within_limits() -> None:
         os.environ["OPENBLAS_NUM_THREADS"] = "1"
 
 
+#: the least address space fepen's libraries load in (MiB): numpy, MPI and numba's LLVM. Measured on Debian's
+#: stack: a rigid run under ulimit -v 450 MiB runs; under 300-400 MiB LLVM or an allocation fails as it loads (a
+#: line, exit 4); under 250 MiB Open MPI segfaults loading its components, and at 100-200 MiB its PMIx aborts
+#: the process on its shared store (exit 1, both) - whichever library maps first. Below the floor the command
+#: stops before loading any of them.
+LOAD_FLOOR_MIB = 400
+
+
+def below_load_floor() -> MemoryError | None:
+    """A MemoryError saying why when an address-space limit (ulimit -v) is below LOAD_FLOOR_MIB, else None."""
+    for _name, what, limit, _ in _rlimits():
+        if what == "address-space" and limit < LOAD_FLOOR_MIB * _MIB:
+            return MemoryError(f"fepen's libraries (numpy, MPI, numba) need about {LOAD_FLOOR_MIB} MiB of address "
+                               "space to load")
+    return None
+
+
 #: the environment variable a relaunching command sets on the ranks it starts (fepen.studies.processes.relaunch)
 RELAUNCHED = "FEPEN_RELAUNCHED"
 #: the stop a relaunched rank was asked for (SIGUSR1) before its study caught signals (fepen.runs.interrupts)

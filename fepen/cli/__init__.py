@@ -45,6 +45,7 @@ from fepen.errors import (
     Interrupted,
     MachineFault,
     SimulationError,
+    below_load_floor,
     catch_early_stop,
     describe_os_error,
     out_of_memory,
@@ -110,13 +111,11 @@ def main(argv: list[str] | None = None) -> int:
     (fepen.errors): every error is one line on stderr, with its traceback only under --debug."""
     argv = list(sys.argv[1:] if argv is None else argv)
     start_within_limits()  # before numpy, MPI or gmsh is loaded
+    too_small = below_load_floor()
+    if too_small is not None:  # MPI would abort or crash as it loads, not say why
+        return _failed(too_small, "--debug" in argv)
     catch_early_stop()  # a relaunched rank: a stop asked for while it loads is kept for its study
-    # MPI and numpy load here: a fault of the machine (memory under ulimit -v) is one line already. numpy first:
-    # under a small ulimit -v its LAPACK fails first, an error said in one line, where MPI's own failure to map its
-    # shared memory aborts the process (exit 1: CI saw it at 100 MiB)
-    try:
-        import numpy  # noqa: F401
-
+    try:  # MPI and numpy load here: a fault of the machine (memory under ulimit -v) is one line already
         from fepen.io import rundir
     except BaseException as err:  # noqa: B036 - every way out is one line and a documented code
         return _failed(err, "--debug" in argv)
