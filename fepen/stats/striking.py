@@ -78,6 +78,7 @@ def draw(prior: StrikingPrior, velocity: float, obliquity_deg: float, attack_deg
               "impact.obliquity_deg": min(max(obliquity_deg + prior.obliquity_error_deg * z[3], 0.0), 89.0),
               "impact.attack_deg": attack, "impact.attack_plane_deg": plane if attack > 0.0 else 0.0,
               "impact.pitch_rate_rad_s": prior.rate_rad_s * z[4], "impact.yaw_rate_rad_s": prior.rate_rad_s * z[5]}
+    values = {k: float(v) for k, v in values.items()}  # plain numbers (numpy 2's repr is np.float64(...))
     seed = int(rng.integers(0, 2**32 - 1))
     if prior.concrete_cv > 0.0:
         values.update({"target.heterogeneity_cv": prior.concrete_cv,

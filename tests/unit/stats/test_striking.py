@@ -45,5 +45,6 @@ def test_a_prior_of_no_width_draws_the_recorded_shot():
     zero = striking.StrikingPrior(0.0, 0.0, 0.0, 0.0, 0.0, 0.0, 0.02)
     assert zero.zero and not striking.PRIOR.zero
     d = striking.draw(zero, 516.8, 5.96, 0.46, striking.member_rng(0, "C1", 0))
+    assert all(type(v) in (float, int) for v in d.values())  # as a --set line writes them (numpy 2's repr)
     assert d == {"impact.velocity": 516.8, "impact.obliquity_deg": 5.96, "impact.attack_deg": 0.46,
                  "impact.attack_plane_deg": 0.0, "impact.pitch_rate_rad_s": 0.0, "impact.yaw_rate_rad_s": 0.0}
