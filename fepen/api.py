@@ -141,7 +141,7 @@ def _record_call(name: str, scene, **kwargs) -> None:
     rundir.api_call([f"fepen.{name}({args})", f"# from {_caller()}"])
 
 
-def run(scene, out=None, comm=None, progress: bool = False, force: bool = False) -> Result:
+def run(scene, out=None, comm=None, progress: bool = False, force: bool = False, sensitivity: bool = True) -> Result:
     """Run one scene, as ``fepen run`` does, and return its Result.
 
     Args:
@@ -150,6 +150,8 @@ def run(scene, out=None, comm=None, progress: bool = False, force: bool = False)
         comm: the MPI communicator of the run; None: COMM_WORLD.
         progress: a progress bar on rank 0.
         force: when ``out`` holds another run's results, remove them first (else InputError).
+        sensitivity: also run two rigid shots at the in-plane attack ± the declared unmeasured yaw and keep the
+            final axis's gain in summary.json's ``attitude_sensitivity`` (fepen.runs.sensitivity).
 
     Returns:
         The Result.
@@ -163,14 +165,20 @@ def run(scene, out=None, comm=None, progress: bool = False, force: bool = False)
     from fepen.runs import resolve, run_in_directory, setup
 
     comm = _comm(comm)
-    _record_call("run", scene, out=None if out is None else str(out), **({"force": True} if force else {}))
+    _record_call("run", scene, out=None if out is None else str(out), **({"force": True} if force else {}),
+                 **({"sensitivity": False} if not sensitivity else {}))
     sc = scene if isinstance(scene, Scene) else Scene(scene)
     sh = resolve(sc)  # bad input before anything is written; the projectile built once
     setup.announce(sc, comm, sh.built)
+    blocks = {}
+    if sensitivity:
+        from fepen.runs import sensitivity as fsens
+
+        blocks["attitude_sensitivity"] = comm.bcast(fsens.attitude(sc) if comm.rank == 0 else None, root=0)
     if out is None:
         out = comm.bcast(tempfile.mkdtemp(prefix="fepen-") if comm.rank == 0 else None, root=0)
     out = Path(out)
-    run_in_directory(sc, out, comm, "force" if force else "new", progress=progress, sh=sh)
+    run_in_directory(sc, out, comm, "force" if force else "new", progress=progress, sh=sh, blocks=blocks)
     return load(out)
 
 

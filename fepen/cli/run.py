@@ -1,5 +1,6 @@
-"""``fepen run SCENE.toml [--out DIR] [--set KEY=VALUE ...] [--force]`` and ``fepen run --resume DIR``: one
-simulation (fepen.api.run, fepen.api.resume), its summary printed."""
+"""``fepen run SCENE.toml [--out DIR] [--set KEY=VALUE ...] [--force] [--no-sensitivity]`` and ``fepen run --resume
+DIR``: one simulation (fepen.api.run, fepen.api.resume), its summary printed, with how far its final axis moves
+for the yaw a test does not record (fepen.runs.sensitivity)."""
 
 from __future__ import annotations
 
@@ -16,6 +17,9 @@ def add_arguments(parser) -> None:
                              "same ranks)")
     parser.add_argument("--force", action="store_true",
                         help="when --out holds another run's results, remove them first (only what fepen writes)")
+    parser.add_argument("--no-sensitivity", dest="sensitivity", action="store_false",
+                        help="skip the two rigid shots at the in-plane attack -/+ the declared yaw "
+                             "(summary.json's attitude_sensitivity; docs/uncertainty.md)")
 
 
 def run(args) -> int:
@@ -23,18 +27,20 @@ def run(args) -> int:
     from fepen import api
 
     if args.resume is not None:
-        if args.scene is not None or args.sets or args.force:
+        if args.scene is not None or args.sets or args.force or not args.sensitivity:
             raise InputError("--resume", "takes the scene of the run it continues (DIR/scene.toml): give no "
                                          "scene file, no --set and no --force")
         result = api.resume(args.resume, progress=True)
     else:
-        result = api.run(api.Scene(args.scene, sets=args.sets), out=args.out, progress=True, force=args.force)
+        result = api.run(api.Scene(args.scene, sets=args.sets), out=args.out, progress=True, force=args.force,
+                         sensitivity=args.sensitivity)
     summary, out = result.summary, result.out
     keys = ("outcome", "depth_mm", "Hx_mm", "Hy_mm", "Tx_mm", "Ty_mm", "length_mm", "residual_speed_m_s",
             *(("max_peeq",) if summary.get("fidelity") != "rigid" else ()), "energy_error", "steps", "dt_s", "wall_s")
     keys += tuple(k for k in ("mass_loss_kg", "mass_loss_percent") if k in summary)
     say(*(f"{k} = {summary[k]:.6g}" if isinstance(summary[k], float) else f"{k} = {summary[k]}"
-          for k in keys), *experiment_lines(summary), *safety_lines(summary), *prediction_lines(summary),
+          for k in keys), *experiment_lines(summary), *sensitivity_lines(summary), *safety_lines(summary),
+        *prediction_lines(summary),
         written_line(out))
     return 0
 
@@ -48,6 +54,14 @@ def experiment_lines(summary: dict) -> list[str]:
             f"{100 * e['tail_error']:.1f} %, final axis {summary['final_axis_angle_deg']:.1f} deg (test "
             f"{e['final_axis_angle_deg']:.1f}), nose offset {summary['nose_offset_mm']:.0f} mm (test "
             f"{e['nose_offset_mm']:.0f})"]
+
+
+def sensitivity_lines(summary: dict) -> list[str]:
+    """How far the final axis moves for the unrecorded yaw, one line (fepen.runs.sensitivity)."""
+    from fepen.runs.sensitivity import line
+
+    got = line(summary)
+    return [got] if got else []
 
 
 def safety_lines(summary: dict) -> list[str]:

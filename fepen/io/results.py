@@ -232,6 +232,9 @@ def summary(scene: dict, experiment: str | None, rows, outcome: str, extra: dict
            "depth_mm": max(r[COL["nose_y_mm"]] for r in rows), "length_mm": last[COL["length_mm"]],
            "residual_speed_m_s": last[COL["speed_m_s"]], "outcome": outcome,
            "energy_error": max(r[COL["energy_error"]] for r in rows), "max_peeq": last[COL["max_peeq"]]}
+    if len(last) >= len(HISTORY_COLUMNS) + len(ATTITUDE_COLUMNS):  # across the plane of fire (z), signed
+        a = len(last) - len(ATTITUDE_COLUMNS)
+        out["Hz_mm"], out["Tz_mm"] = float(last[a]), float(last[a + 1])
     out["final_axis_angle_deg"] = float(final_axis_deg(last[COL["nose_x_mm"]], last[COL["nose_y_mm"]],
                                                        last[COL["tail_x_mm"]], last[COL["tail_y_mm"]]))
     out["nose_offset_mm"] = nose_offset_mm(last[COL["nose_x_mm"]], last[COL["nose_y_mm"]],

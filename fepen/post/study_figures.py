@@ -378,20 +378,24 @@ def pareto(fig, rows) -> None:
 
 
 def fans(fig, fans: dict, tests: dict) -> None:
-    """bands.png: each shot's ensemble of final bodies in the plane of fire (nose to tail, one faint line per
-    member: fepen.studies.bands) with the test's final body in black (fig: 15 x 6.5 in)."""
+    """bands.png: each shot's ensemble of final bodies (nose to tail, one faint line per member:
+    fepen.studies.bands), in the plane of fire (x, blue) and across it (z, orange) against the depth, with the
+    test's final body in the plane of fire in black (its z was not measured) (fig: 15 x 6.5 in)."""
     names = list(fans)
-    axes = fig.subplots(2, (len(names) + 1) // 2).ravel()
+    axes = np.atleast_1d(fig.subplots(2, (len(names) + 1) // 2) if len(names) > 3 else fig.subplots(1, len(names)))
+    axes = axes.ravel()
     for ax, name in zip(axes, names):
         f = np.asarray(fans[name], dtype=float)
-        for hx, hy, tx, ty in f:
-            ax.plot([tx, hx], [ty, hy], color="tab:blue", alpha=0.08, lw=1)
-        ax.plot(f[:, 0], f[:, 1], ".", color="tab:blue", ms=2)
+        for (hx, hy, tx, ty), colour in ((f[:, :4].T, "tab:blue"), (f[:, [4, 1, 5, 3]].T, "tab:orange")):
+            ax.plot(np.array([tx, hx]), np.array([ty, hy]), color=colour, alpha=0.08, lw=1)
+            ax.plot(hx, hy, ".", color=colour, ms=2)
+        ax.plot([], [], "-", color="tab:blue", label="in the plane of fire (x)")
+        ax.plot([], [], "-", color="tab:orange", label="across it (z)")
         t = tests[name]
-        ax.plot([t["Tx_mm"], t["Hx_mm"]], [t["Ty_mm"], t["Hy_mm"]], "k-", lw=2, label="test")
+        ax.plot([t["Tx_mm"], t["Hx_mm"]], [t["Ty_mm"], t["Hy_mm"]], "k-", lw=2, label="test (x)")
         ax.plot([t["Hx_mm"]], [t["Hy_mm"]], "ko", ms=4)
         ax.set_title(name)
-        ax.set_xlabel("x (mm)")
+        ax.set_xlabel("x or z (mm)")
         ax.set_ylabel("depth (mm)")
         ax.invert_yaxis()
         ax.set_aspect("equal", adjustable="datalim")

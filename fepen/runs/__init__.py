@@ -25,8 +25,8 @@ from fepen.runs import setup, shot
 from fepen.runs.rigid import RigidRun
 from fepen.runs.shot import Shot, resolve
 
-__all__ = ["shot", "budget", "setup", "run", "rigid", "batch", "model", "deformable", "closing", "charge_safety",
-           "events", "outputs",
+__all__ = ["shot", "budget", "setup", "run", "rigid", "batch", "sensitivity", "model", "deformable", "closing",
+           "charge_safety", "events", "outputs",
            "probes", "checkpoint", "interrupts", "run_scene", "run_in_directory", "expected_end", "resolve", "Shot",
            "RigidRun"]
 
@@ -44,7 +44,7 @@ def expected_end(scene, sh: Shot) -> float:
 
 
 def run_scene(scene, out, comm=MPI.COMM_WORLD, progress: bool = False, resume: dict | None = None,
-              sh: Shot | None = None) -> dict:
+              sh: Shot | None = None, blocks: dict | None = None) -> dict:
     """Run one scene into a results directory, with the rigid or the deformable projectile.
 
     Args:
@@ -55,24 +55,28 @@ def run_scene(scene, out, comm=MPI.COMM_WORLD, progress: bool = False, resume: d
             time; rigid runs: the simulated time).
         resume: a checkpoint's state (fepen.runs.checkpoint.read_state) to continue from (deformable runs).
         sh: the scene's Shot when already resolved.
+        blocks: further summary blocks, the same on every rank (fepen.api.run: attitude_sensitivity).
 
     Returns:
         The summary (the content of summary.json).
     """
     sh = sh or resolve(scene)
     if sh.rigid:
-        return RigidRun(sh, out, comm, progress=progress).run()
+        run = RigidRun(sh, out, comm, progress=progress)
+        run.summary_blocks = dict(blocks or {})
+        return run.run()
     from fepen.geometry import mesh as fmesh
     from fepen.runs.deformable import DeformableRun  # dolfinx: only a deformable run pays for importing it
 
     end = expected_end(scene, sh) if progress and comm.rank == 0 else None
     with fmesh.progress(progress):  # gmsh's stages, when it meshes
         run = DeformableRun(sh, out, comm, end, resume)
+    run.summary_blocks = dict(blocks or {})
     return run.run()
 
 
 def run_in_directory(scene, out, comm=MPI.COMM_WORLD, mode: str = "new", progress: bool = False,
-                     resume: dict | None = None, sh: Shot | None = None) -> dict:
+                     resume: dict | None = None, sh: Shot | None = None, blocks: dict | None = None) -> dict:
     """Run a scene into its results directory as ``fepen run`` does (fepen.api.run and resume, the studies'
     shots): claim OUT (fepen.io.rundir.RunDirectory: lock, run.json, fepen.log), write scene.toml unless
     resuming, run_scene, and draw history.png of whatever history.csv holds, even after a stop.
@@ -81,7 +85,7 @@ def run_in_directory(scene, out, comm=MPI.COMM_WORLD, mode: str = "new", progres
         scene: a resolved Scene, resolved to its Shot by the caller (``sh``) before OUT is claimed, so that
             bad input writes nothing. out: the results directory. comm: the communicator of the run.
         mode: "new" (refuse a directory holding another run's results), "force" (clear them first) or "resume".
-        progress, resume, sh: as for run_scene.
+        progress, resume, sh, blocks: as for run_scene.
 
     Returns:
         The summary (the content of summary.json).
@@ -97,7 +101,7 @@ def run_in_directory(scene, out, comm=MPI.COMM_WORLD, mode: str = "new", progres
         if mode != "resume":
             files.agree(comm, "scene.toml", lambda: files.write_text(out / "scene.toml", sh.scene_toml, comm))
         try:
-            summary = run_scene(scene, out, comm, progress=progress, resume=resume, sh=sh)
+            summary = run_scene(scene, out, comm, progress=progress, resume=resume, sh=sh, blocks=blocks)
         except BaseException:
             if comm.rank == 0 and sh.outputs.figures and (out / "history.csv").is_file():  # the history a stop left
                 try:

@@ -286,6 +286,8 @@ class Run:
                 "wear_heat_J": r.heat_J, "removed_kinetic_J": r.kinetic_J, "removed_elastic_J": r.elastic_J}
 
     initial_mass: float
+    #: further summary blocks the caller computed (fepen.api.run: attitude_sensitivity)
+    summary_blocks: dict = {}
     #: history.png drawn by the closing analyses (beside the other figures), not again by write_summary
     history_drawn: bool = False
 
@@ -297,6 +299,7 @@ class Run:
         extra.update(self.summary_extra(loop_s))
         _whole_process(extra, self.wall_before)
         extra.update(self.removal_summary())
+        extra.update(self.summary_blocks)
         summary = results.summary(self.shot.scene, self.shot.experiment, self.rows, outcome, extra)
         if self.crossings is not None:
             summary.update(self.crossings.summary(self.shot.law, 1e-3 * summary["depth_mm"]))

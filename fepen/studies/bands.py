@@ -1,7 +1,8 @@
 """``fepen validate --samples N [--seed S]``: Table 1's shots as the distributions they are (issue 59). Each shot
 runs N members whose unmeasured inputs are drawn from their declared distributions (fepen.stats.striking: the yaw
 out of the plane of fire, the recorded attack's reading error, the angular rates, the speed and obliquity errors,
-the concrete's random field); the members are rigid shots batched on the one executor. For each shot and
+the concrete's random field); the members are rigid shots batched on the one executor, or deformable ones (--set
+effects.fidelity=plastic, on a subset of the shots with --shots) one per rank. For each shot and
 quantity the 10, 50 and 90 % points of its members, the test's value and whether it lies inside.
 
 Writes to DIR: bands.csv (shot, quantity, p10, p50, p90, test, inside), bands.md (the table, coverage and the
@@ -71,11 +72,13 @@ class Bands(Study):
     name = "validate-bands"
     command = ""  # fepen validate --samples N
     help = "Table 1's shots as ensembles: bands.csv, bands.md, bands.png"
-    names = ("shots.jsonl", "bands.csv", "bands.md", "bands.png")
+    names = ("shots.jsonl", "shots", "bands.csv", "bands.md", "bands.png")
     out = "results/validation-bands"
 
     def plan(self, scene_path=None, sets=(), samples: int = 200, seed: int = 0,
-             prior: striking.StrikingPrior = striking.PRIOR) -> BandsPlan:
+             prior: striking.StrikingPrior = striking.PRIOR, shots=None) -> BandsPlan:
+        """The members' scenes of each shot (all of Table 1, or ``shots``: names), rigid unless --set
+        effects.fidelity says otherwise; InputError before anything runs."""
         if not 1 <= samples <= MAX_SAMPLES:
             raise InputError("--samples", f"got {samples}, expected an integer in [1, {MAX_SAMPLES}]")
         if not 0 <= seed < 2**32:
@@ -85,16 +88,25 @@ class Bands(Study):
             if key.startswith("impact.") or key.startswith("target.heterogeneity_"):
                 raise InputError(key, "validate --samples draws impact.* and target.heterogeneity_* for each member "
                                       "(docs/uncertainty.md); drop this --set")
-        base = fscene.load(scene_path, ["effects.fidelity=rigid", *sets])
-        if base.effects.fidelity != "rigid":
-            raise InputError("effects.fidelity", "validate --samples runs rigid members; drop the --set")
+        names = list(SHOTS) if not shots else list(dict.fromkeys(shots))
+        for name in names:
+            if name not in SHOTS:
+                raise InputError("--shots", f"got {name!r}, expected names of Table 1's shots ({', '.join(SHOTS)})")
+        base = fscene.load(scene_path, ["effects.fidelity=rigid", *sets])  # a bad --set here, once
+        # a deformable member keeps its folder (shots/NNNNN: its summary, history and log), not its fields
+        quiet = [] if base.effects.fidelity == "rigid" else ["run.fields=false", "run.figures=false"]
         members = {}
-        for name, e in SHOTS.items():
+        for name in names:
+            e = SHOTS[name]
             members[name] = [fscene.load(scene_path, [
-                "effects.fidelity=rigid", *sets, *[f"{k}={v!r}" for k, v in striking.draw(
+                "effects.fidelity=rigid", *quiet, *sets, *[f"{k}={v!r}" for k, v in striking.draw(
                     prior, e.v0, e.obliquity_deg, e.attack_deg, striking.member_rng(seed, name, i)).items()]])
                 for i in range(samples)]
         return BandsPlan(tuple(sets), members, prior, seed)
+
+    def fidelity(self, plan: BandsPlan) -> str:
+        """The members' fidelity."""
+        return next(iter(plan.members.values()))[0].effects.fidelity
 
     def digest(self, plan: BandsPlan) -> str:
         from fepen.studies.record import canonical_digest
@@ -103,7 +115,7 @@ class Bands(Study):
 
     def rounds(self, plan: BandsPlan):
         scenes = [sc for shots in plan.members.values() for sc in shots]
-        yield Round(scenes, keep=lambda sc: False, label="members")
+        yield Round(scenes, keep=lambda sc: sc.effects.fidelity != "rigid", label="members")
 
     def result(self, plan: BandsPlan, records: list, info) -> dict:
         rows, fans, i = [], {}, 0
@@ -119,11 +131,11 @@ class Bands(Study):
                 s = rec["summary"]
                 for q in QUANTITIES:
                     values[q].append(s[q])
-                fan.append((s["Hx_mm"], s["Hy_mm"], s["Tx_mm"], s["Ty_mm"]))
+                fan.append((s["Hx_mm"], s["Hy_mm"], s["Tx_mm"], s["Ty_mm"], s.get("Hz_mm", 0.0), s.get("Tz_mm", 0.0)))
             rows += [{"shot": name, **r} for r in band_rows(values, test_values(name))]
             fans[name] = fan
         return {"rows": rows, "samples": len(next(iter(plan.members.values()))), "seed": plan.seed,
-                "prior": plan.prior.__dict__, "_fans": fans}
+                "prior": plan.prior.__dict__, "fidelity": self.fidelity(plan), "_fans": fans}
 
     def write(self, plan: BandsPlan, result: dict, out: Path, info) -> None:
         from mpi4py import MPI
@@ -169,7 +181,8 @@ def summary_lines(result: dict) -> list[str]:
 def report(result: dict) -> str:
     """bands.md: the bands per shot and quantity, the coverage and the widths."""
     p = result["prior"]
-    lines = [f"# Table 1 as distributions: {result['samples']} rigid members per shot, seed {result['seed']}", "",
+    lines = [f"# Table 1 as distributions: {result['samples']} {result.get('fidelity', 'rigid')} members per shot, "
+             f"seed {result['seed']}", "",
              f"Drawn per member (docs/uncertainty.md): yaw out of the plane of fire N(0, {p['yaw_deg']:g}°); the "
              f"recorded in-plane attack's error N(0, {p['attack_error_deg']:g}°); pitch and yaw rates "
              f"N(0, {p['rate_rad_s']:g} rad/s); the speed's error {100 * p['speed_fraction']:g} %; the "

@@ -42,3 +42,19 @@ def test_the_bands_are_the_same_from_their_seed_on_one_and_two_ranks(tmp_path_fa
         alone = run_bands(Path(root) / "alone", 3)
         assert world["rows"] == alone["rows"]
         assert any(r["p90"] > r["p10"] for r in alone["rows"])  # the members differ
+
+
+def test_a_subset_of_shots_draws_the_same_members_as_the_whole_table():
+    """--shots C8,C2: each member's draw depends on (seed, shot, member) alone, so the subset's members are the
+    whole table's; a name not in Table 1 is refused before anything runs."""
+    from fepen.errors import InputError
+
+    st = bands.Bands()
+    whole, part = st.plan(None, (), 3, 7), st.plan(None, (), 3, 7, shots=["C8", "C2"])
+    assert list(part.members) == ["C8", "C2"]
+    for name in part.members:
+        assert [m.as_dict() for m in part.members[name]] == [m.as_dict() for m in whole.members[name]]
+    with pytest.raises(InputError, match="--shots"):
+        st.plan(None, (), 3, 7, shots=["C9"])
+    plastic = st.plan(None, ("effects.fidelity=plastic",), 2, 7, shots=["C2"])
+    assert st.fidelity(plastic) == "plastic" and plastic.members["C2"][0].run.fields is False

@@ -36,6 +36,9 @@ def test_an_attack_out_of_the_plane_is_the_in_plane_attack_turned_about_the_line
         assert np.abs(h90[a]).max() < 1e-9 and np.abs(h0[b]).max() < 1e-9
     assert h90["nose_y_mm"] == pytest.approx(h0["nose_y_mm"], rel=1e-12)
     assert s90["final_axis_angle_deg"] == pytest.approx(0.0, abs=1e-9)  # the in-plane axis stays on the normal
+    # the summary's z across the plane of fire is the history's last row, and the in-plane shot's x
+    assert [s90["Hz_mm"], s90["Tz_mm"]] == pytest.approx([h90["nose_z_mm"][-1], h90["tail_z_mm"][-1]], rel=1e-6)
+    assert s90["Hz_mm"] == pytest.approx(s0["Hx_mm"], rel=1e-9) and abs(s0["Hz_mm"]) < 1e-9
 
 
 def test_an_attack_out_of_the_plane_leaves_the_in_plane_axis_of_an_oblique_shot():
