@@ -17,14 +17,15 @@ __all__ = ["OUTCOME_COLOURS", "SHOWN_UNITS", "column", "quantiles", "summarised"
 
 OUTCOME_COLOURS = {"embedded": "tab:blue", "perforated": "tab:green", "ricochet": "tab:red", "ended": "tab:grey"}
 #: the figures summarised by quantiles and histograms when present
-FIGURES = ("depth_mm", "Hx_mm", "residual_speed_m_s", "charge_peak_acceleration_m_s2",
-           "peak_acceleration_m_s2", "max_peeq", "mass_loss_percent")
+FIGURES = ("depth_mm", "Hx_mm", "final_axis_angle_deg", "residual_speed_m_s", "charge_peak_acceleration_m_s2",
+           "peak_acceleration_m_s2", "max_peeq", "mass_loss_percent", "nose_offset_mm")
 #: axis labels of the summary figures, with their units
 FIGURE_LABELS = {"depth_mm": "depth of penetration (mm)", "Hx_mm": "final nose x along the face (mm)",
                  "residual_speed_m_s": "residual speed (m/s)",
                  "charge_peak_acceleration_m_s2": "charge's peak acceleration (m/s²)",
                  "peak_acceleration_m_s2": "peak deceleration (m/s²)", "max_peeq": "largest PEEQ (−)",
-                 "mass_loss_percent": "mass loss (%)"}
+                 "mass_loss_percent": "mass loss (%)", "final_axis_angle_deg": "final axis from the normal (°)",
+                 "nose_offset_mm": "nose's offset from the line of fire (mm)"}
 #: a scene unit: (the unit shown, the factor from the scene's value)
 SHOWN_UNITS = {"Pa": ("MPa", 1e-6), "m": ("mm", 1e3), "kg": ("g", 1e3), "deg": ("°", 1.0)}
 #: a varied key of names (impact.shot, target.material) is drawn when it has at most this many
@@ -198,11 +199,53 @@ def ricochet(fig, res: dict, line: str | None) -> None:
 
 
 # ------------------------------------------------------------------------------------------------- uncertainty
-def uncertainty(fig, res: dict, depths: dict) -> None:
-    """uncertainty.png: the depth histograms of both samples with their P10 and P90, the slab and the test; and
-    P(perforation) with its intervals (a finite target) or the depth's CDF (fig: 12 x 4.8 in). depths: the depth
-    (mm) arrays by sample name ("combined", "inputs"), +inf for a shot through the target."""
-    ax, ax2 = fig.subplots(1, 2)
+def _probabilities(res: dict) -> list:
+    """(sample, what, entry) of every probability uncertainty.json holds."""
+    probs = []
+    for name in ("combined", "inputs"):
+        e = res["samples"].get(name)
+        if e is None:
+            continue
+        if "perforation" in e and e["perforation"].get("shots"):
+            probs.append((name, "target", e["perforation"]))
+        for lay in e.get("layers", []):
+            if lay.get("shots"):
+                probs.append((name, f"layer {lay['layer']}", lay))
+        if e.get("ricochet", {}).get("shots"):
+            probs.append((name, "ricochet", e["ricochet"]))
+        if e.get("axis_beyond", {}).get("shots"):
+            probs.append((name, f"|axis| > {e['axis_beyond']['angle_deg']:g}°", e["axis_beyond"]))
+    return probs
+
+
+def _fans_panel(ax3, res: dict, fans: dict, colours: dict, names: dict) -> None:
+    """uncertainty.png's fan of final bodies, nose to tail, in the plane of fire and across it."""
+    for name, f in (fans or {}).items():
+        f = np.asarray(f, float).reshape(-1, 6)
+        for cols, colour, plane in (((0, 1, 2, 3), colours[name], "in the plane of fire (x)"),
+                                    ((4, 1, 5, 3), {"combined": "tab:purple", "inputs": "tab:brown"}[name],
+                                     "across it (z)")):
+            hx, hy, tx, ty = f[:, cols].T
+            ax3.plot(np.array([tx, hx]), np.array([ty, hy]), color=colour, alpha=0.08, lw=1)
+            ax3.plot([], [], color=colour, label=f"{names[name]}, {plane}")
+    t = res["scene"]["test"]
+    if t and "Hx_mm" in t:
+        ax3.plot([t["Tx_mm"], t["Hx_mm"]], [t["Ty_mm"], t["Hy_mm"]], "k-", lw=2, label=f"test {t['shot']} (x)")
+    ax3.set_xlabel("x or z (mm)")
+    ax3.set_ylabel("depth (mm)")
+    ax3.invert_yaxis()
+    ax3.set_title("final bodies, nose to tail")
+    if fans:
+        ax3.legend(fontsize=7)
+
+
+def uncertainty(fig, res: dict, depths: dict, fans: dict | None = None) -> None:
+    """uncertainty.png: the depth histograms of both samples with their P10 and P90, the slab and the test; the
+    probabilities a designer asks (perforation of a finite target and of its layers, ricochet, the final axis
+    beyond an angle) with their intervals, or the depth's CDF without them; and the fan of final bodies in the
+    plane of fire and across it (fig: 17 x 4.8 in). depths: the depth (mm) arrays by sample name ("combined",
+    "inputs"), +inf for a shot through the target; fans: (Hx, Hy, Tx, Ty, Hz, Tz) rows by sample name."""
+    ax, ax2, ax3 = fig.subplots(1, 3)
     colours = {"combined": "tab:blue", "inputs": "tab:orange"}
     names = {"combined": "inputs and model", "inputs": "inputs alone"}
     finite = [d[np.isfinite(d)] for d in depths.values()]
@@ -229,31 +272,24 @@ def uncertainty(fig, res: dict, depths: dict) -> None:
     ax.set_ylabel("samples")
     ax.set_title("depth; dashed: P10 and P90")
     ax.legend(fontsize=8)
-    probs = []
-    for name in ("combined", "inputs"):
-        e = res["samples"].get(name)
-        if e is None:
-            continue
-        if "perforation" in e and e["perforation"].get("shots"):
-            probs.append((name, "target", e["perforation"]))
-        for lay in e.get("layers", []):
-            if lay.get("shots"):
-                probs.append((name, f"layer {lay['layer']}", lay))
+    probs = _probabilities(res)
     if probs:
         for j, (name, what, e) in enumerate(probs):
             lo, hi = e["wilson95"]
-            ax2.errorbar([j], [e["probability"]], yerr=[[e["probability"] - lo], [hi - e["probability"]]],
+            ax2.errorbar([j], [e["probability"]], yerr=[[max(e["probability"] - lo, 0.0)],
+                                                       [max(hi - e["probability"], 0.0)]],
                          fmt="o", color=colours[name], capsize=6, label=f"{names[name]}: Wilson 95 %"
-                         if what in ("target", "layer 0") else None)
+                         if (name, what) == next((n, w) for n, w, _ in probs if n == name) else None)
             if "systematic" in e:
                 a, b = e["systematic"]["probability"]
                 ax2.fill_between([j - 0.25, j + 0.25], [a, a], [b, b], color=colours[name], alpha=0.2,
-                                 label="systematic band (b at 10 %, 90 %)" if what in ("target", "layer 0") else None)
+                                 label="systematic band (b at 10 %, 90 %)" if j == next(
+                                     i for i, q in enumerate(probs) if "systematic" in q[2]) else None)
         ax2.set_xticks(range(len(probs)), [f"{what}\n{names[name]}" for name, what, _ in probs], fontsize=8)
         ax2.set_xlim(-0.6, len(probs) - 0.4)
         ax2.set_ylim(-0.02, 1.02)
-        ax2.set_ylabel("probability of perforation (−)")
-        ax2.set_title("P(perforation)")
+        ax2.set_ylabel("probability (−)")
+        ax2.set_title("perforation, ricochet, final axis beyond")
         ax2.legend(fontsize=8)
     else:
         for name, d in depths.items():
@@ -270,6 +306,7 @@ def uncertainty(fig, res: dict, depths: dict) -> None:
         ax2.set_title("depth's distribution")
         ax2.grid(alpha=0.3)
         ax2.legend(fontsize=8)
+    _fans_panel(ax3, res, fans or {}, colours, names)
     sc = res["scene"]
     fig.suptitle(f"Uncertainty: {sc['label']}, {sc['fidelity']} fidelity, {res['scatter']['samples']} samples")
     fig.tight_layout()

@@ -1,5 +1,6 @@
 """Statistics of a sample of shots (fepen study uncertainty, docs/uncertainty.md): the Wilson (1927) score
-interval of a proportion, fepen's own error drawn from the random-effects model of fepen.stats.interval, the
+interval of a proportion, the flags a designer asks the probability of (perforation, ricochet, a final axis beyond
+an angle), fepen's own error drawn from the random-effects model of fepen.stats.interval, the
 probability of perforation conditioned on a systematic error by self-normalised importance weights, and the
 depth's quantiles with shots through the target among them."""
 
@@ -9,7 +10,12 @@ import math
 
 import numpy as np
 
-__all__ = ["Z95", "MODEL_STREAM", "wilson", "draw_model_errors", "conditional_probability", "depth_quantiles"]
+__all__ = ["Z95", "MODEL_STREAM", "AXIS_BEYOND_DEG", "wilson", "draw_model_errors", "conditional_probability",
+           "depth_quantiles", "designer_flags", "proportion"]
+
+#: the final axis angle (deg) beyond which a shot counts in P(|final axis| > angle), unless a study is told
+#: otherwise: a body turned by 10° no longer strikes a layer behind the first as it was aimed
+AXIS_BEYOND_DEG = 10.0
 
 #: the standard normal's 97.5 % quantile (the 95 % interval)
 Z95 = 1.959963984540054
@@ -107,3 +113,34 @@ def depth_quantiles(depth_mm) -> dict:
     out["mean_mm"] = float(stopped.mean()) if len(stopped) else None
     out["shots"], out["stopped"] = int(len(d)), int(len(stopped))
     return out
+
+
+def designer_flags(summaries, beyond_deg: float = AXIS_BEYOND_DEG) -> dict:
+    """The 0/1 flags of the probabilities a designer asks, per shot: perforated, ricochet, |final axis| beyond
+    ``beyond_deg``; NaN for a shot without a result (None).
+
+    Args:
+        summaries: the shots' summaries (dicts with "outcome" and "final_axis_angle_deg") or None.
+        beyond_deg: the final axis's angle (deg).
+
+    Returns:
+        {"perforation", "ricochet", "axis_beyond"}: arrays of 0, 1 or NaN.
+    """
+    out = {k: [] for k in ("perforation", "ricochet", "axis_beyond")}
+    for s in summaries:
+        ok = s is not None
+        out["perforation"].append(float(s["outcome"] == "perforated") if ok else np.nan)
+        out["ricochet"].append(float(s["outcome"] == "ricochet") if ok else np.nan)
+        out["axis_beyond"].append(float(abs(s["final_axis_angle_deg"]) > beyond_deg) if ok else np.nan)
+    return {k: np.asarray(v, float) for k, v in out.items()}
+
+
+def proportion(flags) -> dict:
+    """The proportion of the finite 0/1 flags with its Wilson 95 % interval: {"count", "shots", "probability",
+    "wilson95"} ({"shots": 0} without one)."""
+    f = np.asarray(flags, float)
+    f = f[np.isfinite(f)]
+    if not len(f):
+        return {"shots": 0}
+    x, n = int(f.sum()), len(f)
+    return {"count": x, "shots": n, "probability": x / n, "wilson95": list(wilson(x, n))}

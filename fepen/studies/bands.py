@@ -24,7 +24,7 @@ from fepen.errors import InputError
 from fepen.stats import striking
 from fepen.studies.study import Round, Study, register
 
-__all__ = ["Bands", "QUANTITIES", "FIELDS", "band_rows", "test_values"]
+__all__ = ["Bands", "QUANTITIES", "FIELDS", "STRIKING_KEYS", "band_rows", "test_values", "striking_inputs"]
 
 #: the quantities banded, each with the test's value (test_values)
 QUANTITIES = ("Hx_mm", "Hy_mm", "Tx_mm", "Ty_mm", "final_axis_angle_deg", "nose_offset_mm", "depth_mm")
@@ -42,6 +42,38 @@ class BandsPlan:
     members: dict
     prior: striking.StrikingPrior
     seed: int
+
+
+#: the keys the striking draw sets besides the speed and the angles a scatter file may vary
+STRIKING_KEYS = ("impact.attack_plane_deg", "impact.pitch_rate_rad_s", "impact.yaw_rate_rad_s",
+                 "target.heterogeneity_cv", "target.heterogeneity_length", "target.heterogeneity_seed")
+
+
+def striking_inputs(resolved: fscene.Scene, keys: list, inputs: list, seed: int) -> tuple[list, list]:
+    """Each sample's inputs with the unmeasured striking state and the concrete's field drawn on top
+    (fepen.stats.striking: the sample's speed, obliquity and attack are its recorded values; generator
+    member_rng(seed, "striking", i), apart from the scatter's).
+
+    Returns:
+        (keys, inputs) with the drawn keys.
+    """
+    import dataclasses
+
+    from fepen.stats import striking as fstriking
+
+    clash = [k for k in keys if k in STRIKING_KEYS]
+    if clash:
+        raise InputError("--striking", f"draws {clash[0]} itself; leave it out of the --scatter file's vary")
+    prior = fstriking.PRIOR
+    if resolved.target.kind != "concrete" or resolved.get("target.layers"):
+        prior = dataclasses.replace(prior, concrete_cv=0.0)  # the field lives in one concrete
+    out = []
+    for i, s in enumerate(inputs):
+        v, ob, at = (s[k] if k in s else resolved.get(k) for k in ("impact.velocity", "impact.obliquity_deg",
+                                                                     "impact.attack_deg"))
+        d = fstriking.draw(prior, v, ob, at, fstriking.member_rng(seed, "striking", i))
+        out.append({**s, **d})
+    return list(dict.fromkeys([*keys, *out[0]])) if out else keys, out
 
 
 def test_values(name: str) -> dict:

@@ -346,6 +346,19 @@ def report(sweep, rows, wall_s: float, ran: int, ranks: int, ranks_per_shot: int
                 label = f"`{name}`" + (" (perforated)" if name == "residual_speed_m_s" else "")
                 lines.append(f"| {label} | {q['count']} | " + " | ".join(
                     f"{q[p]:.5g}" for p in ("mean", "std", "min", "P5", "P50", "P95", "max")) + " |")
+    if sweep.kind == "monte-carlo" and outcomes:
+        from fepen.stats.sampling import AXIS_BEYOND_DEG, designer_flags, proportion
+
+        ok = [r for r in rows if r["status"] == "ok"]
+        flags = designer_flags([{"outcome": r.get("outcome"), "final_axis_angle_deg": r.get("final_axis_angle_deg")}
+                                for r in ok if r.get("final_axis_angle_deg") is not None])
+        lines += ["", "| probability | shots | P | Wilson 95 % |", "|---|---|---|---|"]
+        for key, what in (("perforation", "perforation"), ("ricochet", "ricochet"),
+                          ("axis_beyond", f"final axis beyond {AXIS_BEYOND_DEG:g}°")):
+            e = proportion(flags[key])
+            if e["shots"]:
+                lines.append(f"| {what} | {e['count']}/{e['shots']} | {e['probability']:.3f} | "
+                             f"{e['wilson95'][0]:.3f}-{e['wilson95'][1]:.3f} |")
     lines += ["", "Files: sweep.csv (one row per shot), costs.csv (wall time per shot), shots.jsonl (the records, "
               "full precision), sweep.json, sweep.png" + (", histograms.png" if sweep.kind == "monte-carlo" else "")
               + ".", ""]

@@ -58,7 +58,9 @@ class Plan:
         base: the base scene's keys (flat). label: the shot's name in titles. shot: the Table 1 shot the base
             scene is (fepen.data.Shot) or None. keys: the varied input keys. inputs: one {key: value} per
             sample. samples, seed, latin_hypercube: the sample's. distributions: {key: (kind, parameters)}.
-            model_scatter: whether fepen's own error is drawn. scatter: the --scatter file or None.
+            model_scatter: whether fepen's own error is drawn. scatter: the --scatter file or None. striking:
+            whether each sample also draws the striking state and the concrete's field nobody measured
+            (fepen.stats.striking.PRIOR). axis_beyond_deg: the angle of P(|final axis| > angle).
     """
 
     base: dict
@@ -72,6 +74,8 @@ class Plan:
     distributions: dict
     model_scatter: bool
     scatter: str | None
+    striking: bool = False
+    axis_beyond_deg: float = 10.0
 
     @property
     def scene(self) -> fscene.Scene:
@@ -84,14 +88,16 @@ class Plan:
 
 
 def plan(scene_path=None, scatter=None, sets=(), samples: int | None = None, seed: int | None = None,
-         model_scatter: bool = True) -> Plan:
+         model_scatter: bool = True, striking: bool = False, axis_beyond: float | None = None) -> Plan:
     """Read and check the study's input: every error here, in one line, before anything runs.
 
     Args:
         scene_path: the base scene file, or None (the scatter file's scene and [base], else the default scene).
         scatter: a sweep file with a [monte_carlo] section (its distributions, samples, seed), or None (no
             input scatter). sets: --set KEY=VALUE over the base. samples, seed: override the file's (None: the
-            file's; without a file, 1000 and 0). model_scatter: draw fepen's own error.
+            file's; without a file, 1000 and 0). model_scatter: draw fepen's own error. striking: each sample
+            also draws the unmeasured striking state and the concrete's field (docs/uncertainty.md). axis_beyond:
+            the angle (deg) of P(|final axis| > angle) (None: fepen.stats.sampling.AXIS_BEYOND_DEG).
 
     Returns:
         The Plan.
@@ -104,11 +110,7 @@ def plan(scene_path=None, scatter=None, sets=(), samples: int | None = None, see
     from fepen.studies import spec as fspec
     from fepen.studies.sweep import measured_shot
 
-    if samples is not None and (isinstance(samples, bool) or not isinstance(samples, int) or not 2 <= samples
-                                <= fspec.MAX_SHOTS):
-        raise InputError("--samples", f"an integer in [2, {fspec.MAX_SHOTS}], got {samples!r}")
-    if seed is not None and (isinstance(seed, bool) or not isinstance(seed, int) or seed < 0):
-        raise InputError("--seed", f"a non-negative integer, got {seed!r}")
+    beyond = _check_options(samples, seed, axis_beyond)
     spec, path = {}, None
     if scatter is not None:
         path = Path(scatter)
@@ -154,11 +156,32 @@ def plan(scene_path=None, scatter=None, sets=(), samples: int | None = None, see
     shot = measured_shot(SimpleNamespace(base=base, keys=[]))
     fspec.keep_basis(base, keys, resolved)  # the drawn strengths keep the base scene's basis
     label = _label(resolved, scene_path, path, spec)
+    if striking:
+        base = fspec.expand_shot(base)
+        from fepen.studies.bands import striking_inputs
+
+        keys, inputs = striking_inputs(resolved, keys, inputs, sd)
     p = Plan(base, label, shot, keys, inputs, n, sd, lhs, dists, model_scatter,
-             str(path.resolve()) if path is not None else None)
+             str(path.resolve()) if path is not None else None, bool(striking), float(beyond))
     if not p.rigid and not model_scatter and not keys:
         raise InputError("--no-model-scatter", "with no --scatter nothing would vary")
     return p
+
+
+def _check_options(samples, seed, axis_beyond) -> float:
+    """--samples, --seed and --axis-beyond checked (InputError); the angle of P(|final axis| > angle)."""
+    from fepen.stats.sampling import AXIS_BEYOND_DEG
+    from fepen.studies import spec as fspec
+
+    if samples is not None and (isinstance(samples, bool) or not isinstance(samples, int) or not 2 <= samples
+                                <= fspec.MAX_SHOTS):
+        raise InputError("--samples", f"an integer in [2, {fspec.MAX_SHOTS}], got {samples!r}")
+    if seed is not None and (isinstance(seed, bool) or not isinstance(seed, int) or seed < 0):
+        raise InputError("--seed", f"a non-negative integer, got {seed!r}")
+    beyond = AXIS_BEYOND_DEG if axis_beyond is None else axis_beyond
+    if isinstance(beyond, bool) or not isinstance(beyond, (int, float)) or not 0.0 < beyond < 90.0:
+        raise InputError("--axis-beyond", f"an angle in (0, 90) degrees, got {axis_beyond!r}")
+    return float(beyond)
 
 
 def _label(sc: fscene.Scene, scene_path, scatter_path, spec) -> str:
@@ -227,11 +250,18 @@ class Uncertainty(Study):
                                                                                 "file's; without it 0)")
         parser.add_argument("--no-model-scatter", dest="model_scatter", action="store_false",
                             help="the input scatter alone (fepen's own error not drawn)")
+        parser.add_argument("--striking", action="store_true",
+                            help="each sample also draws what a test does not record: the yaw out of the plane of "
+                                 "fire, the angles' reading errors, the rates, the concrete's field "
+                                 "(docs/uncertainty.md)")
+        parser.add_argument("--axis-beyond", type=float, default=None, metavar="DEG",
+                            help="the angle of P(|final axis| > DEG) (default 10)")
 
     @classmethod
     def options(cls, args) -> dict:
         return {"scene_path": args.scene, "scatter": args.scatter, "sets": args.sets, "samples": args.samples,
-                "seed": args.seed, "model_scatter": args.model_scatter}
+                "seed": args.seed, "model_scatter": args.model_scatter, "striking": args.striking,
+                "axis_beyond": args.axis_beyond}
 
     def plan(self, **options) -> Plan:
         return plan(**options)
@@ -290,14 +320,15 @@ class Uncertainty(Study):
         return ur.report(result)
 
     def figure_size(self, result: dict) -> tuple[float, float]:
-        return (12, 4.8)
+        return (17, 4.8)
 
     def figure(self, result: dict, fig) -> bool:
         from fepen.post import study_figures
         from fepen.studies import uncertainty_report as ur
 
         m, why, response, draws, combined, inputs, verdict = self.drawn
-        study_figures.uncertainty(fig, result, ur.depths(self.out, combined, inputs))
+        study_figures.uncertainty(fig, result, ur.depths(self.out, combined, inputs),
+                                  ur.fans(self.out, combined, inputs))
         return True
 
     def lines(self, result: dict) -> list[str]:

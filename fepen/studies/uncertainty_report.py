@@ -8,13 +8,16 @@ from pathlib import Path
 
 import numpy as np
 
-from fepen.stats.sampling import conditional_probability, depth_quantiles, wilson
+from fepen.stats.sampling import conditional_probability, depth_quantiles, designer_flags, wilson
 from fepen.studies.resistance import LAMBDA_BOUNDS
 
-__all__ = ["results", "depths", "lines", "report", "B_LEVELS"]
+__all__ = ["results", "depths", "fans", "lines", "report", "B_LEVELS", "PATHS"]
 
 #: the points of b's distribution of the systematic band
 B_LEVELS = (0.1, 0.9)
+#: the path and attitude figures whose 10, 50 and 90 % points the study reports (Hz_mm, Tz_mm: across the plane
+#: of fire)
+PATHS = ("final_axis_angle_deg", "nose_offset_mm", "Hx_mm", "Hy_mm", "Tx_mm", "Ty_mm", "Hz_mm", "Tz_mm")
 
 
 def _records(out: Path, n: int) -> list:
@@ -24,30 +27,36 @@ def _records(out: Path, n: int) -> list:
     return [recs.get(i) for i in range(n)]
 
 
-def _sample_result(records: list, thickness: float | None, layers: list | None) -> dict:
-    """Depths (mm), perforation flags (slab and per layer) and statuses of a sample's records."""
-    statuses, depth, perf, per_layer = {}, [], [], []
+def _sample_result(records: list, thickness: float | None, layers: list | None,
+                   beyond_deg: float = 10.0) -> dict:
+    """Depths (mm), perforation flags (slab and per layer), the designer's flags (designer_flags), the path
+    figures (PATHS) and statuses of a sample's records."""
+    statuses, depth, perf, per_layer, summaries = {}, [], [], [], []
     for r in records:
         statuses[r["status"]] = statuses.get(r["status"], 0) + 1
         s = r.get("summary") if r["status"] == "ok" else None
+        summaries.append(s)
         depth.append((np.inf if s["outcome"] == "perforated" else s["depth_mm"]) if s else np.nan)
         perf.append(float(s["outcome"] == "perforated") if s else np.nan)
         if layers:
             ls = (s or {}).get("layers") or []
             per_layer.append([float(j < len(ls) and ls[j].get("exit_speed_m_s") is not None) if s else np.nan
                               for j in range(len(layers))])
+    paths = {q: np.array([(s.get(q, np.nan) if s else np.nan) for s in summaries], float) for q in PATHS}
     return {"statuses": statuses, "depth_mm": np.array(depth), "perforated": np.array(perf),
-            "layers": np.array(per_layer) if layers else None}
+            "layers": np.array(per_layer) if layers else None, "flags": designer_flags(summaries, beyond_deg),
+            "paths": paths}
 
 
-def _probability(flags, draws=None, model=None) -> dict:
-    """P, its Wilson interval and (with the draws) the systematic band, of the finite 0/1 flags."""
+def _probability(flags, draws=None, model=None, word: str = "perforated") -> dict:
+    """P, its Wilson interval and (with the draws) the systematic band, of the finite 0/1 flags (word: the key of
+    their count)."""
     ok = np.isfinite(flags)
     x, n = int(flags[ok].sum()), int(ok.sum())
     if n == 0:
         return {"shots": 0}
     lo, hi = wilson(x, n)
-    out = {"perforated": x, "shots": n, "probability": x / n, "wilson95": [lo, hi]}
+    out = {word: x, "shots": n, "probability": x / n, "wilson95": [lo, hi]}
     if draws is not None:
         from fepen.stats.interval import quantile_z
 
@@ -64,6 +73,17 @@ def _probability(flags, draws=None, model=None) -> dict:
     return out
 
 
+def fans(out: Path, combined, inputs) -> dict:
+    """{sample name: one (Hx, Hy, Tx, Ty, Hz, Tz) in mm per shot with a result}: the fan of final bodies."""
+    d = {}
+    for name, rows in (("combined", combined), ("inputs", inputs)):
+        if rows is not None:
+            p = _sample_result(_records(out / name, len(rows)), None, None)["paths"]
+            f = np.column_stack([p[q] for q in ("Hx_mm", "Hy_mm", "Tx_mm", "Ty_mm", "Hz_mm", "Tz_mm")])
+            d[name] = f[np.isfinite(f[:, :4]).all(axis=1)]
+    return d
+
+
 def depths(out: Path, combined, inputs) -> dict:
     """The depth (mm) arrays of the figure, by sample name."""
     d = {}
@@ -73,11 +93,21 @@ def depths(out: Path, combined, inputs) -> dict:
     return d
 
 
+def _test(shot) -> dict | None:
+    """The Table 1 test's depth and path figures (PATHS it measured), or None."""
+    if shot is None:
+        return None
+    from fepen.studies.bands import test_values
+
+    t = test_values(shot.name)
+    return {"shot": shot.name, "depth_mm": shot.Hy_mm, **{q: t[q] for q in PATHS if q in t}}
+
+
 def results(p, sc, out, m, why, response, draws, combined, inputs, verdict, wall, ranks, k) -> dict:
     """uncertainty.json's content."""
     thickness, layers = sc.get("target.thickness"), sc.get("target.layers")
     res = {"scene": {"label": p.label, "fidelity": sc.effects.fidelity, "base": p.base,
-                     "test": ({"shot": p.shot.name, "depth_mm": p.shot.Hy_mm} if p.shot else None)},
+                     "test": _test(p.shot)},
            "scatter": {"file": p.scatter, "samples": p.samples, "seed": p.seed, "latin_hypercube": p.latin_hypercube,
                        "vary": {k2: {"distribution": kind, **prm} for k2, (kind, prm) in p.distributions.items()}},
            "model_scatter": None, "envelope": verdict, "target": {"thickness_m": thickness,
@@ -98,9 +128,14 @@ def results(p, sc, out, m, why, response, draws, combined, inputs, verdict, wall
     for name, rows in (("combined", combined), ("inputs", inputs)):
         if rows is None:
             continue
-        s = _sample_result(_records(out / name, len(rows)), thickness, layers)
+        s = _sample_result(_records(out / name, len(rows)), thickness, layers, p.axis_beyond_deg)
         entry = {"shots": len(rows), "statuses": s["statuses"], "depth": depth_quantiles(s["depth_mm"])}
         model = (draws, m) if name == "combined" else (None, None)
+        entry["paths"] = {q: ({f"P{c}": float(np.percentile(v[np.isfinite(v)], c)) for c in (10, 50, 90)}
+                              if np.isfinite(v).any() else None) for q, v in s["paths"].items()}
+        entry["ricochet"] = _probability(s["flags"]["ricochet"], *model, word="ricochets")
+        entry["axis_beyond"] = {"angle_deg": p.axis_beyond_deg,
+                                **_probability(s["flags"]["axis_beyond"], *model, word="beyond")}
         if thickness is not None or layers:
             entry["perforation"] = _probability(s["perforated"], *model)
         if layers:
@@ -117,9 +152,14 @@ def results(p, sc, out, m, why, response, draws, combined, inputs, verdict, wall
 
 
 # ------------------------------------------------------------------------------------------------- outputs
+def _count(e: dict) -> int:
+    """The count of a probability's entry (perforated, ricochets or beyond)."""
+    return next(e[k] for k in ("perforated", "ricochets", "beyond") if k in e)
+
+
 def _fmt_p(e: dict) -> str:
     lo, hi = e["wilson95"]
-    text = f"{e['probability']:.3f} ({e['perforated']}/{e['shots']}; Wilson 95 % {lo:.3f}-{hi:.3f})"
+    text = f"{e['probability']:.3f} ({_count(e)}/{e['shots']}; Wilson 95 % {lo:.3f}-{hi:.3f})"
     if "systematic" in e:
         a, b = e["systematic"]["probability"]
         text += f"; systematic band {a:.3f}-{b:.3f} (b at its 10 % and 90 %)"
@@ -142,13 +182,27 @@ def lines(res: dict, out) -> list[str]:
         out_lines.append(f"depth ({what}, {q['shots']} shots): P10 {_mm(q['P10_mm'])}, P50 {_mm(q['P50_mm'])}, "
                          f"P90 {_mm(q['P90_mm'])}, mean {_mm(q['mean_mm'])}"
                          + (f" (of the {q['stopped']} that stopped)" if q["stopped"] < q["shots"] else ""))
+    for name, what in (("combined", "inputs and model"), ("inputs", "inputs alone")):
+        e = res["samples"].get(name)
+        if e is None or not e.get("paths") or not e["paths"].get("final_axis_angle_deg"):
+            continue
+        a, o = e["paths"]["final_axis_angle_deg"], e["paths"]["nose_offset_mm"]
+        out_lines.append(f"final axis ({what}): P10 {a['P10']:.1f}, P50 {a['P50']:.1f}, P90 {a['P90']:.1f} deg; "
+                         f"nose offset P10 {o['P10']:.0f}, P50 {o['P50']:.0f}, P90 {o['P90']:.0f} mm")
     if res["scene"]["test"]:
         t = res["scene"]["test"]
-        out_lines.append(f"the test {t['shot']}: {t['depth_mm']:.1f} mm")
+        out_lines.append(f"the test {t['shot']}: {t['depth_mm']:.1f} mm"
+                         + (f", final axis {t['final_axis_angle_deg']:.1f} deg, nose offset "
+                            f"{t['nose_offset_mm']:.0f} mm" if "final_axis_angle_deg" in t else ""))
     for name, what in (("combined", "inputs and model"), ("inputs", "inputs alone")):
         e = res["samples"].get(name)
         if e is None:
             continue
+        if e.get("ricochet", {}).get("shots"):
+            out_lines.append(f"P(ricochet, {what}) {_fmt_p(e['ricochet'])}")
+        if e.get("axis_beyond", {}).get("shots"):
+            out_lines.append(f"P(|final axis| > {e['axis_beyond']['angle_deg']:g} deg, {what}) "
+                             f"{_fmt_p(e['axis_beyond'])}")
         if "perforation" in e and e["perforation"].get("shots"):
             th = res["target"]["thickness_m"]
             target = f"the {1e3 * th:.4g} mm slab" if th is not None else "the target"
@@ -164,6 +218,22 @@ def lines(res: dict, out) -> list[str]:
     out_lines.append(res["envelope"]["line"])
     out_lines.append(f"wall {res['wall_s']:.1f} s ({res['ranks']} rank{'s' if res['ranks'] > 1 else ''})")
     return out_lines
+
+
+def _paths_table(res: dict) -> list[str]:
+    """uncertainty.md's table of the paths' and attitudes' 10, 50 and 90 % points."""
+    sc, L = res["scene"], []
+    paths = [(name, e) for name, e in res["samples"].items() if name != "note" and e.get("paths")]
+    if paths:
+        t = sc["test"] or {}
+        L += ["", "Paths and attitudes (10, 50 and 90 % of the shots; Hz, Tz: the nose and the tail across the "
+                  "plane of fire):", "", "| sample | figure | P10 | P50 | P90 | test |", "|---|---|---|---|---|---|"]
+        for name, e in paths:
+            for q, v in e["paths"].items():
+                if v is not None:
+                    L.append(f"| {name} | `{q}` | {v['P10']:.1f} | {v['P50']:.1f} | {v['P90']:.1f} | "
+                             + (f"{t[q]:.1f} |" if q in t else "– |"))
+    return L
 
 
 def report(res: dict) -> str:
@@ -209,21 +279,26 @@ def report(res: dict) -> str:
                   "shots that stopped."]
     if sc["test"]:
         L += ["", f"The test {sc['test']['shot']}: {sc['test']['depth_mm']:.1f} mm."]
-    probs = [(name, "target", e["perforation"]) for name, e in res["samples"].items()
+    L += _paths_table(res)
+    probs = [(name, "perforation of the target", e["perforation"]) for name, e in res["samples"].items()
              if name != "note" and "perforation" in e]
-    probs += [(name, f"layer {lay['layer']}", lay) for name, e in res["samples"].items() if name != "note"
-              for lay in e.get("layers", [])]
+    probs += [(name, f"perforation of layer {lay['layer']}", lay) for name, e in res["samples"].items()
+              if name != "note" for lay in e.get("layers", [])]
+    probs += [(name, "ricochet", e["ricochet"]) for name, e in res["samples"].items()
+              if name != "note" and "ricochet" in e]
+    probs += [(name, f"final axis beyond {e['axis_beyond']['angle_deg']:g}°", e["axis_beyond"])
+              for name, e in res["samples"].items() if name != "note" and "axis_beyond" in e]
     if probs:
-        L += ["", "| sample | what | P(perforation) | Wilson 95 % | P at b's 10 % | P at b's 90 % |",
+        L += ["", "| sample | what | P | Wilson 95 % | P at b's 10 % | P at b's 90 % |",
               "|---|---|---|---|---|---|"]
         for name, what, e in probs:
             if not e.get("shots"):
                 continue
             band = e.get("systematic", {}).get("probability")
-            L.append(f"| {name} | {what} | {e['probability']:.3f} ({e['perforated']}/{e['shots']}) | "
+            L.append(f"| {name} | {what} | {e['probability']:.3f} ({_count(e)}/{e['shots']}) | "
                      f"{e['wilson95'][0]:.3f}-{e['wilson95'][1]:.3f} | "
                      + (f"{band[0]:.3f} | {band[1]:.3f} |" if band else "– | – |"))
-        L += ["", "Wilson 95 %: the score interval of the sampling (Wilson 1927). The systematic band: P(perforation "
+        L += ["", "Wilson 95 %: the score interval of the sampling (Wilson 1927). The systematic band: P(event "
                   "| b) with b at the 10 % and 90 % points of its distribution, by self-normalised importance "
                   "reweighting of the drawn samples: how far the probability moves if fepen is systematically off "
                   "for this concrete as it is for the public sets."]

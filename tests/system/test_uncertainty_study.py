@@ -39,7 +39,15 @@ def test_c3_study_writes_its_files_and_the_model_widens_the_depth(c3):
     assert comb["shots"] == inp["shots"] == N
     assert comb["P90_mm"] - comb["P10_mm"] > 1.5 * (inp["P90_mm"] - inp["P10_mm"])
     assert 200 < inp["P50_mm"] < 400 and inp["P10_mm"] < comb["P50_mm"] < inp["P90_mm"] * 1.1
-    assert res["scene"]["test"] == {"shot": "C3", "depth_mm": 349.6}
+    t = res["scene"]["test"]
+    assert (t["shot"], t["depth_mm"], t["Hx_mm"], t["Ty_mm"]) == ("C3", 349.6, 81.4, 212.0)
+    # the paths' bands and the designer's probabilities: C3 neither ricochets nor perforates; its axis bands
+    # hold the deterministic 11 deg (the scatter's ±1° of obliquity and ±0.5° of yaw about C3's)
+    a = res["samples"]["inputs"]["paths"]["final_axis_angle_deg"]
+    assert a["P10"] < 11.0 < a["P90"] and a["P90"] - a["P10"] < 10.0
+    assert res["samples"]["inputs"]["ricochet"]["ricochets"] == 0 and res["samples"]["inputs"]["ricochet"]["shots"] == N
+    assert 0 <= res["samples"]["inputs"]["axis_beyond"]["beyond"] <= N
+    assert "final axis (inputs alone): P10" in stdout and "P(ricochet, inputs alone) 0.000" in stdout
     assert res["envelope"]["inside"]
     assert "depth (inputs and model, 80 shots): P10" in stdout and "written:" in stdout
     # the table holds the drawn factors, each the inverse of its eps through the response

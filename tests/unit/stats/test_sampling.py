@@ -73,3 +73,22 @@ def test_depth_quantiles_of_a_slab_say_through_beyond_the_stopped_shots():
     assert q["P10_mm"] == pytest.approx(np.percentile(d[:70], 10 * 99 / 69)) and q["P90_mm"] is None
     assert q["P50_mm"] == pytest.approx(50.5) and q["mean_mm"] == pytest.approx(35.5)
     assert (q["shots"], q["stopped"]) == (100, 70)
+
+
+def test_designer_flags_count_perforation_ricochet_and_a_turned_axis():
+    """The flags of the probabilities a designer asks, shot by shot (a shot without a result: NaN, left out of
+    its proportion), and their proportion with the Wilson interval of wilson()."""
+    from fepen.stats.sampling import designer_flags, proportion
+
+    shots = [{"outcome": "perforated", "final_axis_angle_deg": 3.0}, {"outcome": "ricochet",
+                                                                       "final_axis_angle_deg": -35.0},
+             {"outcome": "embedded", "final_axis_angle_deg": 10.5}, None,
+             {"outcome": "embedded", "final_axis_angle_deg": 9.9}]
+    f = designer_flags(shots, 10.0)
+    assert list(f["perforation"][[0, 1, 2, 4]]) == [1, 0, 0, 0] and np.isnan(f["perforation"][3])
+    assert list(f["ricochet"][[0, 1, 2, 4]]) == [0, 1, 0, 0]
+    assert list(f["axis_beyond"][[0, 1, 2, 4]]) == [0, 1, 1, 0]  # |−35| and 10.5 beyond 10
+    p = proportion(f["axis_beyond"])
+    assert (p["count"], p["shots"], p["probability"]) == (2, 4, 0.5)
+    assert p["wilson95"] == list(sampling.wilson(2, 4))
+    assert proportion([np.nan]) == {"shots": 0}

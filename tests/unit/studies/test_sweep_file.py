@@ -130,3 +130,28 @@ def test_bad_sweep_files_name_the_key(tmp_path, text, key):
     with pytest.raises(InputError) as err:
         sweep.read(write(tmp_path, text))
     assert err.value.key == key, str(err.value)
+
+
+def test_a_monte_carlo_sweep_reports_the_designers_probabilities():
+    """sweep.md of a Monte Carlo sweep: P(perforation), P(ricochet) and P(|final axis| > 10°) with their Wilson
+    intervals, over the shots that finished; the final axis among the summarised figures."""
+    from types import SimpleNamespace
+
+    from fepen.stats.sampling import wilson
+    from fepen.studies.sweep import report
+
+    outcomes = ["perforated", "embedded", "ricochet", "embedded"]
+    axes = [2.0, 12.0, -40.0, 5.0]
+    rows = [{"shot": i, "impact.velocity": 500.0 + i, "status": "ok", "outcome": o, "depth_mm": 100.0 + i,
+             "final_axis_angle_deg": a} for i, (o, a) in enumerate(zip(outcomes, axes))]
+    rows.append({"shot": 4, "impact.velocity": 504.0, "status": "error", "outcome": None, "depth_mm": None,
+                 "final_axis_angle_deg": None})
+    sw = SimpleNamespace(kind="monte-carlo", keys=["impact.velocity"], shots=[{}] * 5)
+    text = report(sw, rows, 1.0, 5, 1, 1)
+    lo, hi = wilson(1, 4)
+    assert f"| perforation | 1/4 | 0.250 | {lo:.3f}-{hi:.3f} |" in text
+    assert "| ricochet | 1/4 | 0.250 |" in text
+    assert "| final axis beyond 10° | 2/4 | 0.500 |" in text
+    assert "| `final_axis_angle_deg` | 4 |" in text
+    grid = report(SimpleNamespace(kind="grid", keys=["impact.velocity"], shots=[{}] * 5), rows, 1.0, 5, 1, 1)
+    assert "| perforation |" not in grid  # a grid's proportions are not probabilities

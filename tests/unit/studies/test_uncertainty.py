@@ -65,6 +65,10 @@ UNC = ["study", "uncertainty", "--out", "out", "--set", "effects.fidelity=rigid"
     (UNC + ["--set", "impact.velocity=-5"], None, "impact.velocity", r"got -5"),
     (UNC + ["--ranks-per-shot", "2"], None, "--ranks-per-shot", r"must divide the number of ranks \(1\)"),
     (UNC + ["--speeds", "1,2"], None, "command line", r"unrecognized arguments: --speeds"),
+    (UNC + ["--axis-beyond", "95"], None, "--axis-beyond", r"an angle in \(0, 90\) degrees, got 95"),
+    (UNC + ["--striking", "--scatter", "SWEEP"], "[monte_carlo]\nsamples = 4\n[monte_carlo.vary]\n"
+     "'impact.attack_plane_deg' = { distribution = 'normal', std = 10.0 }\n", "--striking",
+     r"draws impact.attack_plane_deg itself"),
     (["study", "uncertainty", "--set", "effects.fidelity=plastic", "--no-model-scatter"], None,
      "--no-model-scatter", r"nothing would vary"),
 ])
@@ -104,3 +108,29 @@ def test_the_drawn_strengths_keep_the_base_scenes_basis():
     p = unc.plan(None, DEMO, samples=4, seed=1)
     assert p.base["target.strength_basis"] == "cube"
     assert p.shot is not None and p.shot.name == "C3"  # still the test
+
+
+def test_striking_draws_the_unrecorded_state_on_top_of_each_sample():
+    """--striking: each sample of the C3 scatter also draws the yaw out of the plane of fire, the reading errors
+    and the concrete's field (fepen.stats.striking.PRIOR), about the sample's own speed, obliquity and attack; the
+    out-of-plane yaw's spread is the prior's (within its sampling error), the field's seeds differ, and the same
+    seed draws the same samples."""
+    from fepen.stats import striking
+
+    n = 400
+    p = unc.plan(None, DEMO, samples=n, seed=11, striking=True)
+    again = unc.plan(None, DEMO, samples=n, seed=11, striking=True)
+    assert p.inputs == again.inputs and p.striking
+    for k in ("impact.attack_plane_deg", "target.heterogeneity_cv", "target.heterogeneity_seed"):
+        assert k in p.keys
+    assert "impact.shot" not in p.base and p.shot is not None and p.shot.name == "C3"
+    plain = unc.plan(None, DEMO, samples=n, seed=11)
+    out = np.array([s["impact.attack_deg"] * math.sin(math.radians(s["impact.attack_plane_deg"])) for s in p.inputs])
+    inp = np.array([s["impact.attack_deg"] * math.cos(math.radians(s["impact.attack_plane_deg"])) for s in p.inputs])
+    sd = math.sqrt(striking.PRIOR.yaw_deg**2)
+    assert abs(out.mean()) < 3 * sd / math.sqrt(n) and abs(out.std() / sd - 1) < 3 / math.sqrt(2 * n)
+    # the in-plane attack is the scatter's own draw plus its reading error
+    base = np.array([s["impact.attack_deg"] for s in plain.inputs])
+    err = inp - base
+    assert abs(err.std() / striking.PRIOR.attack_error_deg - 1) < 3 / math.sqrt(2 * n)
+    assert len({s["target.heterogeneity_seed"] for s in p.inputs}) == n
