@@ -367,7 +367,7 @@ def crater_gauss() -> np.ndarray:
 
 #: the modes of the concrete's random field (§8.8): its marginal is a sum of FIELD_MODES cosines, Gaussian to
 #: within a few per cent in its tails
-FIELD_MODES = 64
+FIELD_MODES = 32
 
 
 def random_field_modes(seed: int, correlation_length: float, modes: int = FIELD_MODES) -> tuple:

@@ -21,7 +21,7 @@ def with_field(cv, length=0.02, seed=0):
 @pytest.mark.parametrize("cv", [0.1, 0.3])
 def test_the_factor_has_mean_one_and_the_declared_coefficient_of_variation(cv):
     """Over a block of 100 correlation lengths, 20,000 points, 8 seeds: the mean 1 and the cv within 3 % of
-    the cv (the spatial statistics of a sum of 64 cosines are those of the ensemble; what is left is the
+    the cv (the spatial statistics of a sum of 32 cosines are those of the ensemble; what is left is the
     sampling of the points, about 1 %, and the sum's slightly short tails)."""
     rng = np.random.default_rng(7)
     means, cvs = [], []
@@ -36,7 +36,7 @@ def test_the_factor_has_mean_one_and_the_declared_coefficient_of_variation(cv):
 
 def test_the_correlation_is_gaussian_with_the_declared_length():
     """The correlation of ln(factor) between points r apart, over 8 seeds and random directions: exp(−1/2) =
-    0.61 at one correlation length (within 0.06: 64 modes per seed), exp(−2) = 0.14 at two, and nothing at
+    0.61 at one correlation length (within 0.06: 32 modes per seed; measured 0.63 and 0.16), exp(−2) = 0.14 at two, and nothing at
     four (exp(−8))."""
     ell = 0.02
     rng = np.random.default_rng(3)
