@@ -24,7 +24,8 @@ from fepen.errors import InputError
 from fepen.stats import striking
 from fepen.studies.study import Round, Study, register
 
-__all__ = ["Bands", "QUANTITIES", "FIELDS", "STRIKING_KEYS", "band_rows", "test_values", "striking_inputs"]
+__all__ = ["Bands", "QUANTITIES", "FIELDS", "STRIKING_KEYS", "band_rows", "test_values", "striking_inputs",
+           "median_errors"]
 
 #: the quantities banded, each with the test's value (test_values)
 QUANTITIES = ("Hx_mm", "Hy_mm", "Tx_mm", "Ty_mm", "final_axis_angle_deg", "nose_offset_mm", "depth_mm")
@@ -200,14 +201,32 @@ def coverage(rows: list[dict]) -> dict:
     return out
 
 
+def median_errors(rows: list[dict]) -> dict:
+    """{shot: (nose error, tail error)} of the members' medians (p50 of Hx, Hy, Tx, Ty) against the test, as
+    fepen.io.results.comparison measures a run's: |H − H_test| / |H_test|."""
+    out = {}
+    for name in dict.fromkeys(r["shot"] for r in rows):
+        v = {r["quantity"]: r for r in rows if r["shot"] == name}
+        e = []
+        for a, b in (("Hx_mm", "Hy_mm"), ("Tx_mm", "Ty_mm")):
+            got = np.array([v[a]["p50"], v[b]["p50"]])
+            want = np.array([v[a]["test"], v[b]["test"]])
+            e.append(float(np.linalg.norm(got - want) / np.linalg.norm(want)))
+        out[name] = tuple(e)
+    return out
+
+
 def summary_lines(result: dict) -> list[str]:
     rows = result["rows"]
     cov = coverage(rows)
     width = {r["shot"]: r["p90"] - r["p10"] for r in rows if r["quantity"] == "final_axis_angle_deg"}
+    med = np.array(list(median_errors(rows).values()))
     return [f"{result['samples']} members per shot (seed {result['seed']}): the test inside its 10-90 % band on "
             + ", ".join(f"{q} {a} of {b}" for q, (a, b) in cov.items()),
             "final axis band widths: " + ", ".join(f"{k} {v:.1f}" for k, v in width.items())
-            + f" deg (mean {np.mean(list(width.values())):.1f})"]
+            + f" deg (mean {np.mean(list(width.values())):.1f})",
+            f"the members' medians: mean nose error {100 * med[:, 0].mean():.1f} %, mean tail error "
+            f"{100 * med[:, 1].mean():.1f} %"]
 
 
 def report(result: dict) -> str:

@@ -27,6 +27,8 @@ def test_a_prior_of_no_width_closes_every_band_on_the_deterministic_shot(tmp_pat
         if r["quantity"] in names:
             want = det[r["shot"]][names[r["quantity"]]]
             assert r["p10"] == r["p50"] == r["p90"] == pytest.approx(want, rel=1e-12, abs=1e-12), r
+    for shot, (nose, tail) in bands.median_errors(res["rows"]).items():  # the medians' errors are the line's
+        assert (nose, tail) == pytest.approx((det[shot]["nose_error"], det[shot]["tail_error"]), rel=1e-9)
     with open(tmp_path / "b" / "bands.csv", newline="") as f:
         rows = list(csv.DictReader(f))
     assert tuple(rows[0]) == bands.FIELDS and len(rows) == 8 * len(bands.QUANTITIES)
