@@ -439,3 +439,4 @@ def fans(fig, fans: dict, tests: dict) -> None:
     for ax in axes[len(names):]:
         ax.set_visible(False)
     axes[0].legend(loc="lower left", fontsize=8)
+    fig.tight_layout()
