@@ -72,9 +72,9 @@ def line(summary: dict) -> str | None:
     if not s:
         return None
     if "none" in s:
-        return f"attitude_sensitivity: none ({s['none']})"
+        return f"attitude_sensitivity = none ({s['none']})"
     lo, hi = s["final_axis_angle_deg"]
-    return (f"attitude_sensitivity: final axis {lo:.1f} to {hi:.1f} deg for the in-plane attack -/+ {s['yaw_deg']:g} "
+    return (f"attitude_sensitivity = final axis {lo:.1f} to {hi:.1f} deg for the in-plane attack -/+ {s['yaw_deg']:g} "
             f"deg (gain {s['gain_deg_per_deg']:.2f} deg/deg; nose offset {s['nose_offset_mm'][0]:.0f} and "
             f"{s['nose_offset_mm'][1]:.0f} mm; rigid shots; the spread a test's unrecorded yaw gives, "
             f"docs/uncertainty.md)")

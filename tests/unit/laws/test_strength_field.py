@@ -36,8 +36,8 @@ def test_the_factor_has_mean_one_and_the_declared_coefficient_of_variation(cv):
 
 def test_the_correlation_is_gaussian_with_the_declared_length():
     """The correlation of ln(factor) between points r apart, over 8 seeds and random directions: exp(−1/2) =
-    0.61 at one correlation length (within 0.06: 32 modes per seed; measured 0.63 and 0.16), exp(−2) = 0.14 at two, and nothing at
-    four (exp(−8))."""
+    0.61 at one correlation length (within 0.06: 32 modes per seed; measured 0.63 and 0.16), exp(−2) = 0.14 at
+    two, and nothing at four (exp(−8))."""
     ell = 0.02
     rng = np.random.default_rng(3)
     for r, want, tol in ((ell, math.exp(-0.5), 0.06), (2 * ell, math.exp(-2.0), 0.06), (4 * ell, 0.0, 0.04)):

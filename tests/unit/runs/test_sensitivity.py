@@ -44,7 +44,7 @@ def test_a_run_keeps_and_prints_its_sensitivity(tmp_path):
         "final_axis_angle_deg"] < s["final_axis_angle_deg"][1]
     from fepen.cli.run import sensitivity_lines
 
-    assert sensitivity_lines(r.summary)[0].startswith("attitude_sensitivity: final axis")
+    assert sensitivity_lines(r.summary)[0].startswith("attitude_sensitivity = final axis")
     r2 = api.run(api.Scene(None, sets=["effects.fidelity=rigid", "impact.shot='C2'"]), out=tmp_path / "q",
                  sensitivity=False)
     assert "attitude_sensitivity" not in r2.summary
