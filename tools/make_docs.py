@@ -376,8 +376,16 @@ def charge_safety(tmp: Path) -> str:
             f"{version()}):\n\n" + text + "\n\n![the charge-safety map](img/charge-safety-map.png)")
 
 
+def history_columns(tmp: Path) -> str:
+    """history.csv's column tables, from their declarations (fepen.io.columns)."""
+    from fepen.io import columns
+
+    return columns.markdown()
+
+
 #: name -> (page, generator, rough cost on 2 cores)
 BLOCKS = {
+    "history-columns": ("docs/results.md", history_columns, "0 s"),
     "table1": ("docs/validation.md", table1, "5 min"),
     "ballistic-limit": ("docs/studies.md", ballistic_limit, "15 s"),
     "ricochet": ("docs/studies.md", ricochet, "20 s"),

@@ -13,67 +13,22 @@ from mpi4py import MPI
 from fepen.data import shot
 from fepen.errors import OUTCOMES, SimulationError
 from fepen.geometry.frames import unit_axis
-from fepen.io import files
+from fepen.io import columns, files
 from fepen.version import SUMMARY_FORMAT
 
 G0 = 9.80665  # m/s^2, for accelerations in g
 
-HISTORY_COLUMNS = ["t_s", "nose_x_mm", "nose_y_mm", "tail_x_mm", "tail_y_mm", "speed_m_s", "decel_g",
-                   "vx_m_s", "vy_m_s", "force_x_N", "force_y_N", "length_mm", "kinetic_J", "internal_work_J",
-                   "external_work_J", "elastic_J", "plastic_J", "heat_J", "energy_error", "contact_nodes",
-                   "dt_s", "max_peeq", "contact_area_m2", "total_energy_J", "energy_ratio"]
-# the last two, in every history (both fidelities; LS-DYNA's glstat): total_energy_J (J) = kinetic_J +
-# internal_work_J + friction_J − the shell–charge contact's normal work + removed_kinetic_J − external_work_J,
-# the target's (or rigid wall's) work counted as energy it took, as LS-DYNA counts a stonewall's or a contact's;
-# it stays at the striking kinetic energy KE_0 when the balance holds (the terms of energy_error, signed).
-# energy_ratio (-) = total_energy_J / KE_0: 1 for a perfect balance. Rigid fidelity: kinetic_J + the kinetic
-# energy the worn mass carried off − external_work_J (no internal energy, no interface).
+#: history.csv's column groups, declared once with their units and meanings in fepen.io.columns (the lists
+#: below are their names, for the code that reads a history by position)
+HISTORY_COLUMNS = columns.BASE.columns
 COL = {k: i for i, k in enumerate(HISTORY_COLUMNS)}
-#: appended to every history (both fidelities), last: the third dimension where x and y are written (z: the
-#: scene's, across the plane of fire; mm, m/s, N), and the attitude. axis_angle_deg: the axis (tail to nose)
-#: from the target's normal, in the plane of fire, positive toward +x (final_axis_deg of the row's nose and
-#: tail; summary.json's final_axis_angle_deg is its last value); yaw_deg: between the axis and the centre of
-#: mass's velocity (3-D, >= 0). The pseudo-vectors, about the centre of mass, in the scene's right-handed frame
-#: (x along the face, y out of the target toward the gun, z = x × y): the angular velocity (rad/s), the target's
-#: moment (N m) and the angular momentum (N m s), whose rate the moment is
-ATTITUDE_COLUMNS = ["nose_z_mm", "tail_z_mm", "vz_m_s", "force_z_N", "centre_x_mm", "centre_y_mm", "centre_z_mm",
-                    "axis_angle_deg", "yaw_deg",
-                    "angular_velocity_x_rad_s", "angular_velocity_y_rad_s", "angular_velocity_z_rad_s",
-                    "moment_x_N_m", "moment_y_N_m", "moment_z_N_m",
-                    "angular_momentum_x_N_m_s", "angular_momentum_y_N_m_s", "angular_momentum_z_N_m_s",
-                    "angular_impulse_x_N_m_s", "angular_impulse_y_N_m_s", "angular_impulse_z_N_m_s"]
-#: (centre_*: the centre of mass, in the history's frame, y depth; the last three: the target's angular impulse
-#: about O, the impact point, since the run began, integrated every step; the angular momentum about O,
-#: H + x_c × M v_c in the scene's frame, has grown by it)
-#: appended with a charge: mass-averaged acceleration of each body along the axis (tail to nose), in g
-#: (negative while the projectile decelerates)
-CHARGE_COLUMNS = ["shell_acc_g", "charge_acc_g"]
-#: appended with a charge, after CHARGE_COLUMNS (LS-DYNA's matsum, fepen.solver.diagnostics.bodies): each
-#: body's kinetic energy (J), internal energy, elastic + plastic work (J; the plastic work split between the
-#: bodies exactly when the shell alone heats, the default), and momentum (N s) in the reported frame (x along
-#: the face in the direction of travel, y depth: positive while moving into the target, as vx_m_s, vy_m_s). A
-#: node of the tied wall counts in each body with the mass it takes from that body's cells, so shell + charge
-#: = kinetic_J, elastic_J + plastic_J, and mass × (vx_m_s, vy_m_s).
-BODY_COLUMNS = ["shell_kinetic_J", "shell_internal_J", "shell_px_N_s", "shell_py_N_s",
-                "charge_kinetic_J", "charge_internal_J", "charge_px_N_s", "charge_py_N_s"]
-#: appended with a charge, after BODY_COLUMNS (LS-DYNA's rcforc): the resultant force the shell exerts on the
-#: charge across their interface (N), reported frame (x along the face, y depth: positive pushing the charge
-#: into the target; it is negative while the shell decelerates the charge), and its magnitude (N, with the
-#: out-of-plane part). Frictional contact: the sum of the contact forces on the charge's wall nodes
-#: (fepen.solver.shell_charge); tied: the rate of change of the charge's momentum minus the external load on
-#: it (fepen.solver.diagnostics.tied_interface_force). Over time its impulse is the change of charge_p*_N_s.
-RESULTANT_COLUMNS = ["contact_fx_N", "contact_fy_N", "contact_force_N"]
-#: appended with effects.wear or effects.erosion (either fidelity): the mass, the interface heat, the eroded
-#: cells and the kinetic energy the removed material carried away, so far
-REMOVAL_COLUMNS = ["mass_kg", "wear_heat_J", "eroded_cells", "removed_kinetic_J"]
-#: appended in a concrete target (both fidelities; fepen.laws.tunnel.zones): the size of the target's resultant
-#: force on the nose (ahead of the shoulder, the widest section), the shank and the tail (the last calibre) (N),
-#: and the points it loads in each
-LOAD_COLUMNS = ["nose_force_N", "shank_force_N", "tail_force_N", "nose_points", "shank_points", "tail_points"]
-#: appended with a charge in frictional contact (fepen.solver.shell_charge): friction dissipation, the largest gap,
-#: interpenetration and slip over the wall's node pairs, the fractions of pairs open and sliding
-INTERFACE_COLUMNS = ["friction_J", "interface_gap_max_mm", "interface_penetration_max_mm", "interface_slip_max_mm",
-                     "interface_free_fraction", "interface_sliding_fraction"]
+ATTITUDE_COLUMNS = columns.ATTITUDE.columns
+CHARGE_COLUMNS = columns.ACCELERATIONS.columns
+BODY_COLUMNS = columns.BODIES.columns
+RESULTANT_COLUMNS = columns.RESULTANT.columns
+REMOVAL_COLUMNS = columns.REMOVAL.columns
+LOAD_COLUMNS = columns.LOADS.columns
+INTERFACE_COLUMNS = columns.INTERFACE.columns
 
 
 def attitude_row(tip, tail, velocity, force, centre, omega, moment, momentum, impulse) -> list[float]:

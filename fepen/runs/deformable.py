@@ -76,12 +76,12 @@ class DeformableRun(Run):
         return self.solver.step_count
 
     @property
-    def columns(self) -> list[str]:
-        charge = results.CHARGE_COLUMNS + results.BODY_COLUMNS + results.RESULTANT_COLUMNS
-        return (results.HISTORY_COLUMNS + (charge if self.pm.charge else [])
-                + (results.INTERFACE_COLUMNS if self.contact is not None else [])
-                + (results.REMOVAL_COLUMNS if self.removing else [])
-                + (results.LOAD_COLUMNS if self.splitting else []) + results.ATTITUDE_COLUMNS)
+    def charged(self) -> bool:
+        return bool(self.pm.charge)
+
+    @property
+    def frictional(self) -> bool:
+        return self.contact is not None
 
     def load_split(self) -> list[float]:
         return self.load.split(self.comm)

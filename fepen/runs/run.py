@@ -21,7 +21,7 @@ import numpy as np
 from mpi4py import MPI
 
 from fepen.errors import stop_outcome
-from fepen.io import files, results, rundir
+from fepen.io import columns, files, results, rundir
 from fepen.laws import layers as fl
 from fepen.runs import events, interrupts, outputs
 from fepen.runs.shot import Shot
@@ -153,9 +153,13 @@ class Run:
 
     @property
     def columns(self) -> list[str]:
-        """history.csv's columns."""
-        return (results.HISTORY_COLUMNS + (results.REMOVAL_COLUMNS if self.removing else [])
-                + (results.LOAD_COLUMNS if self.splitting else []) + results.ATTITUDE_COLUMNS)
+        """history.csv's columns (declared in fepen.io.columns, the groups this run writes)."""
+        return columns.history(self)
+
+    #: a charge's groups (fepen.io.columns): deformable runs with a charge
+    charged: bool = False
+    #: the frictional shell-charge interface's group
+    frictional: bool = False
 
     @property
     def splitting(self) -> bool:
