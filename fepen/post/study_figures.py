@@ -12,8 +12,8 @@ from pathlib import Path
 import numpy as np
 
 __all__ = ["OUTCOME_COLOURS", "SHOWN_UNITS", "column", "quantiles", "summarised", "sweep_size", "sweep_figure",
-           "histogram_names", "histograms", "limit", "ricochet", "uncertainty", "depth", "pareto", "validation",
-           "hazard_maps"]
+           "histogram_names", "histograms", "charge_safety", "limit", "ricochet", "uncertainty", "depth", "pareto",
+           "validation", "hazard_maps"]
 
 OUTCOME_COLOURS = {"embedded": "tab:blue", "perforated": "tab:green", "ricochet": "tab:red", "ended": "tab:grey"}
 #: the figures summarised by quantiles and histograms when present
@@ -440,3 +440,42 @@ def fans(fig, fans: dict, tests: dict) -> None:
         ax.set_visible(False)
     axes[0].legend(loc="lower left", fontsize=8)
     fig.tight_layout()
+
+
+def charge_safety(fig, result: dict) -> None:
+    """charge_safety.png (fepen study charge-safety): the governing margin over speed and obliquity (first angle
+    of attack), its margin-1 line, each point's value; hollow markers outside the validated envelope."""
+    rows = [r for r in result["rows"] if r["attack_deg"] == min(x["attack_deg"] for x in result["rows"])]
+    speeds = sorted({r["velocity_m_s"] for r in rows})
+    obl = sorted({r["obliquity_deg"] for r in rows})
+    M = np.full((len(obl), len(speeds)), np.nan)
+    for r in rows:
+        if r["margin"] is not None:
+            M[obl.index(r["obliquity_deg"]), speeds.index(r["velocity_m_s"])] = r["margin"]
+    ax = fig.add_subplot(111)
+    if len(speeds) > 1 and len(obl) > 1 and np.isfinite(M).all():
+        from matplotlib.colors import TwoSlopeNorm
+
+        lo, hi = min(float(M.min()), 0.95), max(float(M.max()), 1.05)  # red below 1 (past the threshold), green above
+        levels = np.unique(np.concatenate([np.linspace(lo, 1.0, 7), np.linspace(1.0, hi, 7)]))
+        cs = ax.contourf(speeds, obl, M, levels=levels, cmap="RdYlGn", norm=TwoSlopeNorm(1.0, lo, hi))
+        fig.colorbar(cs, ax=ax, label="governing margin (below 1: past the threshold)")
+        if M.min() < 1.0 < M.max():
+            ax.contour(speeds, obl, M, levels=[1.0], colors="k", linewidths=2.0)
+    pad_v = 0.04 * (max(speeds) - min(speeds) or 100.0)
+    pad_o = 0.06 * (max(obl) - min(obl) or 10.0)
+    ax.set_xlim(min(speeds) - pad_v, max(speeds) + 2 * pad_v)
+    ax.set_ylim(min(obl) - pad_o, max(obl) + 2 * pad_o)
+    for r in rows:
+        inside = r["inside_envelope"]
+        ax.plot(r["velocity_m_s"], r["obliquity_deg"], "o", mfc="k" if inside else "none", mec="k")
+        if r["margin"] is not None:
+            ax.annotate(f"{r['margin']:.3g}", (r["velocity_m_s"], r["obliquity_deg"]), textcoords="offset points",
+                        xytext=(4, 4), fontsize=8)
+    for b in result["boundary"]:
+        if b["boundary_speed_m_s"] is not None and b["attack_deg"] == rows[0]["attack_deg"]:
+            ax.plot(b["boundary_speed_m_s"], b["obliquity_deg"], "kx", ms=9)
+    ax.set_xlabel("striking speed (m/s)")
+    ax.set_ylabel("obliquity (deg)")
+    ax.set_title(f"charge safety ({result['explosive']}): the governing margin\n(line and x: margin 1; hollow "
+                 "markers: outside the validated envelope)", fontsize=9)

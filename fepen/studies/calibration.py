@@ -43,7 +43,7 @@ from fepen.studies.study import Round, Study, register, set_option
 
 __all__ = ["CALIBRATION_SETS", "OPEN", "STEP", "LIMITS", "S_SPAN", "EXPONENT", "nodes", "jobs", "job_scene",
            "table_of", "curves", "predicted", "group_errors", "objective", "fit", "calibrate", "shipped_node",
-           "Calibration", "main"]
+           "Calibration", "main", "positions", "cylinder", "ok_summary"]
 
 #: the calibration groups (file stems of fepen/data/depth; "table1" is the paper's Table 1, by its positions)
 #: and what each informs
@@ -95,16 +95,16 @@ def job_scene(job):
     from fepen import scene
 
     name, row, S, node, extra = job
-    return scene.load(None, [*_scene_sets(name, row), scene.set_item("target.quasi_static_stress", S * _cylinder(row)),
+    return scene.load(None, [*_scene_sets(name, row), scene.set_item("target.quasi_static_stress", S * cylinder(row)),
                              *[scene.set_item(k, v) for k, v in node.items()], *extra])
 
 
-def _positions(summary: dict) -> tuple:
+def positions(summary: dict) -> tuple:
     """(Hx, Hy, Tx, Ty) (m) of one rigid run's summary."""
     return tuple(summary[k] / 1e3 for k in ("Hx_mm", "Hy_mm", "Tx_mm", "Ty_mm"))
 
 
-def _cylinder(row) -> float:
+def cylinder(row) -> float:
     """The shot's cylinder strength (Pa): the row's strength on its basis (the paper's Table 1: C40 cube)."""
     return row.fc_cylinder
 
@@ -134,14 +134,14 @@ def curves(sets: dict, node_list: list[dict], extra=(), comm=None) -> np.ndarray
     from fepen.studies import engine
 
     found = engine.summaries([job_scene(j) for j in jobs(sets, node_list, extra)], comm)
-    return table_of(sets, node_list, [_positions(s) for s in found])
+    return table_of(sets, node_list, [positions(s) for s in found])
 
 
 class _Row:
     """A row seen with its cylinder strength (Forrestal's S and the scaled-S law take the cylinder f_c)."""
 
     def __init__(self, row):
-        self.fc, self.D = _cylinder(row), row.D
+        self.fc, self.D = cylinder(row), row.D
 
 
 def strength_S(row, a: float, D0: float, b: float = EXPONENT) -> float:
@@ -327,7 +327,7 @@ class Calibration(Study):
                 recs = yield Round([job_scene(j) for j in js], folder=f"rounds/{r:03d}", label=f"round {r}",
                                    then=True)
                 r += 1
-                t = table_of(plan.sets, missing, [_positions(_ok(recs[i])) for i in range(len(js))])
+                t = table_of(plan.sets, missing, [positions(ok_summary(recs[i])) for i in range(len(js))])
                 for i, n in enumerate(missing):
                     tables[_key(n)] = list(t[i])
             for k in tables:
@@ -360,7 +360,7 @@ class Calibration(Study):
                 f"{c['size_m']:.4g} m (objective {c['objective']:.4f})"]
 
 
-def _ok(record: dict) -> dict:
+def ok_summary(record: dict) -> dict:
     """A run's summary (a calibration run that did not finish stops the calibration)."""
     if record["status"] != "ok":
         from fepen.errors import SimulationError

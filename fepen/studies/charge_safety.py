@@ -15,12 +15,10 @@ import math
 from dataclasses import dataclass
 from pathlib import Path
 
-import numpy as np
-
 from fepen import scene as fscene
 from fepen.errors import InputError
 from fepen.laws.explosive import CRITERIA
-from fepen.studies.limits import _base, envelope_of, scene_line
+from fepen.studies.limits import base_keys, envelope_of, scene_line
 from fepen.studies.study import Round, Study, numbers, register, set_option
 
 __all__ = ["ChargeSafetyStudy", "SafetyPlan", "boundary", "table"]
@@ -61,7 +59,7 @@ def _angles(option: str, text: str | None, default: list[float]) -> list[float]:
 
 def check(scene_path, sets, speeds, obliquities, attacks) -> SafetyPlan:
     """The study's inputs checked, every point's scene resolved (InputError before anything is written)."""
-    base = _base(scene_path, sets)
+    base = base_keys(scene_path, sets)
     if base.get("effects.charge") is False:
         raise InputError("effects.charge", "the charge-safety study needs the charge: drop effects.charge = false")
     base["effects.charge"] = True
@@ -177,6 +175,7 @@ class ChargeSafetyStudy(Study):
 
         from fepen.atomic import replacing
         from fepen.io import files
+        from fepen.post import study_figures
         from fepen.post.figures import new_figure, save_figure
 
         files.write_json(out / "charge_safety.json", result, MPI.COMM_SELF)
@@ -191,7 +190,7 @@ class ChargeSafetyStudy(Study):
             tmp.write_text(buf.getvalue())
         files.write_text(out / "charge_safety.md", self.report(result), MPI.COMM_SELF)
         fig = new_figure((6.4, 4.6))
-        draw(fig, result)
+        study_figures.charge_safety(fig, result)
         save_figure(fig, out / "charge_safety.png", dpi=120)
 
     def report(self, result: dict) -> str:
@@ -236,42 +235,3 @@ class ChargeSafetyStudy(Study):
         out.append(f"governing: {', '.join(result['governing']) or 'none'}; {len(outside)} of {result['points']} "
                    "points outside the validated envelope")
         return out
-
-
-def draw(fig, result: dict) -> None:
-    """The map: the governing margin over speed and obliquity (first angle of attack), its margin-1 line,
-    each point's value; hollow markers outside the validated envelope."""
-    rows = [r for r in result["rows"] if r["attack_deg"] == min(x["attack_deg"] for x in result["rows"])]
-    speeds = sorted({r["velocity_m_s"] for r in rows})
-    obl = sorted({r["obliquity_deg"] for r in rows})
-    M = np.full((len(obl), len(speeds)), np.nan)
-    for r in rows:
-        if r["margin"] is not None:
-            M[obl.index(r["obliquity_deg"]), speeds.index(r["velocity_m_s"])] = r["margin"]
-    ax = fig.add_subplot(111)
-    if len(speeds) > 1 and len(obl) > 1 and np.isfinite(M).all():
-        from matplotlib.colors import TwoSlopeNorm
-
-        lo, hi = min(float(M.min()), 0.95), max(float(M.max()), 1.05)  # red below 1 (past the threshold), green above
-        levels = np.unique(np.concatenate([np.linspace(lo, 1.0, 7), np.linspace(1.0, hi, 7)]))
-        cs = ax.contourf(speeds, obl, M, levels=levels, cmap="RdYlGn", norm=TwoSlopeNorm(1.0, lo, hi))
-        fig.colorbar(cs, ax=ax, label="governing margin (below 1: past the threshold)")
-        if M.min() < 1.0 < M.max():
-            ax.contour(speeds, obl, M, levels=[1.0], colors="k", linewidths=2.0)
-    pad_v = 0.04 * (max(speeds) - min(speeds) or 100.0)
-    pad_o = 0.06 * (max(obl) - min(obl) or 10.0)
-    ax.set_xlim(min(speeds) - pad_v, max(speeds) + 2 * pad_v)
-    ax.set_ylim(min(obl) - pad_o, max(obl) + 2 * pad_o)
-    for r in rows:
-        inside = r["inside_envelope"]
-        ax.plot(r["velocity_m_s"], r["obliquity_deg"], "o", mfc="k" if inside else "none", mec="k")
-        if r["margin"] is not None:
-            ax.annotate(f"{r['margin']:.3g}", (r["velocity_m_s"], r["obliquity_deg"]), textcoords="offset points",
-                        xytext=(4, 4), fontsize=8)
-    for b in result["boundary"]:
-        if b["boundary_speed_m_s"] is not None and b["attack_deg"] == rows[0]["attack_deg"]:
-            ax.plot(b["boundary_speed_m_s"], b["obliquity_deg"], "kx", ms=9)
-    ax.set_xlabel("striking speed (m/s)")
-    ax.set_ylabel("obliquity (deg)")
-    ax.set_title(f"charge safety ({result['explosive']}): the governing margin\n(line and x: margin 1; hollow "
-                 "markers: outside the validated envelope)", fontsize=9)

@@ -24,7 +24,7 @@ from fepen.errors import InputError
 from fepen.studies.study import Round, Study, numbers, register, set_option
 
 __all__ = ["BallisticLimit", "Ricochet", "ballistic_limit", "ricochet", "recht_ipson", "fit_recht_ipson",
-           "check_ballistic_limit", "check_ricochet", "scene_line"]
+           "check_ballistic_limit", "check_ricochet", "scene_line", "envelope_of", "base_keys"]
 
 
 def recht_ipson(v, v_bl: float, a: float, p: float):
@@ -43,7 +43,9 @@ def fit_recht_ipson(v, vr, v_bl: float) -> tuple[float, float, float]:
     return float(a), float(p), float(np.sqrt(np.mean((recht_ipson(v, v_bl, a, p) - vr) ** 2)))
 
 
-def _base(scene_path, sets) -> dict:
+def base_keys(scene_path, sets) -> dict:
+    """A study's base scene as given keys: the file's, then the --set items, without impact.shot (the study
+    sets the speed and the angles itself)."""
     given = fscene.read_toml(scene_path) if scene_path else {}
     for item in sets:
         k, v = fscene.parse_set(item)
@@ -54,7 +56,7 @@ def _base(scene_path, sets) -> dict:
 
 def check_ballistic_limit(scene_path, sets, v_low: float, v_high: float, tol: float) -> tuple[dict, fscene.Scene]:
     """The ballistic-limit study's inputs checked (InputError before anything is written): (base keys, scene)."""
-    base = _base(scene_path, sets)
+    base = base_keys(scene_path, sets)
     probe = fscene.Scene(base)
     if probe.get("target.thickness") is None and not probe.get("target.layers"):
         raise InputError("target.thickness", "the ballistic limit needs a finite target: give target.thickness "
@@ -67,7 +69,7 @@ def check_ballistic_limit(scene_path, sets, v_low: float, v_high: float, tol: fl
 
 def check_ricochet(scene_path, sets, speeds, obliquity_max: float, tol: float) -> tuple[dict, fscene.Scene, list]:
     """The ricochet study's inputs checked (InputError before anything is written): (base keys, scene, speeds)."""
-    base = _base(scene_path, sets)
+    base = base_keys(scene_path, sets)
     probe = fscene.Scene(base)
     speeds = [float(v) for v in speeds]
     if not speeds or not all(0 < v <= 3000 for v in speeds) or not 0 < obliquity_max < 90 or not tol > 0:

@@ -169,14 +169,14 @@ class PredictionErrors(Study):
         yield Round([*self.scenes, *lateral], keep=lambda sc: False, label="shots")
 
     def result(self, plan: ErrorsPlan, records: list, info) -> dict:
-        from fepen.studies.calibration import _ok
+        from fepen.studies.calibration import ok_summary
         from fepen.version import __version__
 
         recs = records[0]
         n = len(self.scenes)
         summaries = [recs[i]["summary"] if recs[i]["status"] == "ok" else None for i in range(n)]
         rows = depth_rows(plan.sets, depth.predictions(plan.sets, self.where, summaries))
-        rows += lateral_rows([_ok(recs[n + j]) for j in range(len(_lateral_shots()))])
+        rows += lateral_rows([ok_summary(recs[n + j]) for j in range(len(_lateral_shots()))])
         if plan.plastic:
             rows += plastic_lateral_rows(plan.plastic)
             plastic = (f"the plastic rows from {Path(plan.plastic).name}/validation.csv (fepen validate, "

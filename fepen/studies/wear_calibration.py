@@ -52,7 +52,7 @@ def _scene(name: str, sigma: float, extra):
 
 def table1_scenes(eta: float, a: float, D0: float) -> list:
     """Table 1's shots with the rigid fidelity, wear on at η and the scaled-S law at (a, D0)."""
-    return [_scene(r.name, calibration.strength_S(r, a, D0) * calibration._cylinder(r), wear_sets(eta))
+    return [_scene(r.name, calibration.strength_S(r, a, D0) * calibration.cylinder(r), wear_sets(eta))
             for r in depth.table1_set()]
 
 
@@ -65,9 +65,9 @@ def table1_losses(eta: float, a: float, D0: float, comm=None) -> list[dict]:
 
 
 def _summaries(recs: dict, n: int) -> list[dict]:
-    from fepen.studies.calibration import _ok
+    from fepen.studies.calibration import ok_summary
 
-    return [_ok(recs[i]) for i in range(n)]
+    return [ok_summary(recs[i]) for i in range(n)]
 
 
 @dataclass
@@ -114,7 +114,7 @@ class WearCalibration(Study):
             recs = yield Round([calibration.job_scene(j) for j in js], folder=f"rounds/{r:03d}", label="", then=True)
             r += 1
             table = calibration.table_of(sets, [calibration.shipped_node()],
-                                         [calibration._positions(s) for s in _summaries(recs, len(js))])
+                                         [calibration.positions(s) for s in _summaries(recs, len(js))])
             a, D0, obj = calibration.fit(sets, list(table[0]))
             self.log.append(f"  eta {e:.5f} -> refit: a {a:.4g}, D0 {D0 * 1e3:.4g} mm, objective {obj:.4f}")
             done = abs(e / eta - 1.0) < 0.01 and it > 0

@@ -139,3 +139,24 @@ def test_every_module_is_in_the_readme_layout():
         if p.name not in parts.get(section, ""):
             missing.append(str(rel))
     assert not missing, f"README's Layout does not name {missing}"
+
+
+def test_no_study_module_draws_or_reaches_into_another_s_private_names():
+    """Studies draw through fepen.post.study_figures and share through public names (issue 60): no study module
+    imports matplotlib, and none imports or calls another study module's _private name."""
+    import re
+
+    studies = Path(__file__).resolve().parents[2] / "fepen" / "studies"
+    mods = {p.stem for p in studies.glob("*.py")}
+    bad = []
+    for p in sorted(studies.glob("*.py")):
+        text = p.read_text()
+        if re.search(r"^\s*(import matplotlib|from matplotlib)", text, re.M):
+            bad.append(f"{p.name}: imports matplotlib")
+        for m in re.finditer(r"from fepen\.studies\.(\w+) import ([^\n]+)", text):
+            if m.group(1) != p.stem and any(n.strip().startswith("_") for n in m.group(2).split(",")):
+                bad.append(f"{p.name}: {m.group(0)}")
+        for m in re.finditer(r"\b(\w+)\._[a-z]\w*\(", text):
+            if m.group(1) in mods and m.group(1) != p.stem:
+                bad.append(f"{p.name}: {m.group(0)}")
+    assert not bad, bad
