@@ -174,7 +174,8 @@ def run(scene, out=None, comm=None, progress: bool = False, force: bool = False,
     if sensitivity:
         from fepen.runs import sensitivity as fsens
 
-        blocks["attitude_sensitivity"] = comm.bcast(fsens.attitude(sc) if comm.rank == 0 else None, root=0)
+        blocks["attitude_sensitivity"] = comm.bcast(fsens.attitude(sc, built=sh.built) if comm.rank == 0 else None,
+                                                    root=0)
     if out is None:
         out = comm.bcast(tempfile.mkdtemp(prefix="fepen-") if comm.rank == 0 else None, root=0)
     out = Path(out)

@@ -34,18 +34,19 @@ def perturbed(attack_deg: float, plane_deg: float, delta_deg: float) -> dict:
             "impact.attack_plane_deg": math.degrees(math.atan2(out, inplane)) if attack > 0.0 else 0.0}
 
 
-def attitude(scene, delta_deg: float = YAW_DEG) -> dict:
+def attitude(scene, delta_deg: float = YAW_DEG, built=None) -> dict:
     """The final axis, the nose offset and Hx of the scene's shot, rigid, at the in-plane attack ± delta_deg, and
     the final axis's gain (one process, no MPI: a caller on many ranks runs it on one and shares the result).
 
     Args:
         scene: a resolved Scene (any fidelity: the two shots are rigid, the rest of the scene the same).
         delta_deg: the half-step (deg, > 0).
+        built: the scene's projectile when already built (fepen.api.run's: a CAD body is not read again).
 
     Returns:
         The summary's ``attitude_sensitivity`` (module docstring).
     """
-    from fepen.runs import batch
+    from fepen.runs import batch, shot
 
     a, p = float(scene.impact.attack_deg), float(scene.get("impact.attack_plane_deg") or 0.0)
     from fepen.scene import Scene
@@ -53,7 +54,8 @@ def attitude(scene, delta_deg: float = YAW_DEG) -> dict:
     given = {k: scene.get(k) for k in scene.explicit if k != "impact.shot"}  # a Table 1 shot's speed and angles,
     given.update({k: scene.get(k) for k in ("impact.velocity", "impact.obliquity_deg")})  # the attack moved below
     try:
-        shots = [Scene(given, {"effects.fidelity": "rigid", **perturbed(a, p, s * delta_deg)}) for s in (-1, 1)]
+        scenes = [Scene(given, {"effects.fidelity": "rigid", **perturbed(a, p, s * delta_deg)}) for s in (-1, 1)]
+        shots = [shot.resolve(sc, toml=False, built=built) for sc in scenes]
     except InputError as err:
         return {"none": f"the rigid shots refuse the scene: {err}"}
     got = batch.summaries(shots, history=False)

@@ -235,18 +235,20 @@ def _outputs(scene) -> OutputSettings:
                           r.checkpoint_interval, r.acceleration_filter_hz, bool(r.figures))
 
 
-def resolve(scene, toml: bool = True) -> Shot:
+def resolve(scene, toml: bool = True, built: Built | None = None) -> Shot:
     """The Shot of a resolved Scene (InputError on what this version cannot simulate, before any mesh).
 
     Args:
         scene: a resolved fepen.Scene.
         toml: False leaves scene_toml empty, for a shot that writes no results directory (fepen.runs.batch:
             the text costs a rigid shot's set-up a third).
+        built: the scene's projectile when already built (another shot of the same projectile: a CAD body is
+            read once).
 
     Returns:
         The frozen Shot.
     """
-    built = setup.check_supported(scene)
+    built = setup.check_supported(scene, built)
     rigid = scene.effects.fidelity == "rigid"
     law = setup.target_law(scene) if scene.target.kind == "concrete" else None
     R, v, w = setup.placement(scene)
