@@ -40,7 +40,7 @@ from fepen.atomic import replacing
 from fepen.errors import MachineFault, OutOfMemory, describe_os_error, out_of_memory
 
 __all__ = ["FLAGS", "KERNELS", "Kernel", "cache_dir", "compiler", "kernel", "library_path", "why_not", "python_only",
-           "load"]
+           "load", "c_enums"]
 
 #: no fast-math (NaN and inf must propagate); -fno-math-errno only lets sqrt be one instruction (errno is never
 #: read), without which GCC keeps a loop that takes a square root scalar
@@ -94,6 +94,37 @@ KERNELS = {
 PACKAGE = Path(__file__).resolve().parent
 _LOADED: dict[str, ctypes.CDLL | None] = {}
 _WHY_NOT: dict[str, str] = {}
+
+
+def c_enums(source) -> dict[str, int]:
+    """The values of every ``enum { ... };`` member in a C source file, read from the text (as ffcx reads its
+    declarations from its header): the layouts the Python side shares with a kernel are declared once, in C.
+    Comments are dropped; a member is its predecessor + 1 or its ``= expression`` of integers and earlier
+    members (+, -, *).
+
+    Args:
+        source: the .c file (a path).
+
+    Returns:
+        {member: value}.
+    """
+    text = re.sub(r"/\*.*?\*/", " ", Path(source).read_text(), flags=re.S)
+    text = re.sub(r"//[^\n]*", " ", text)
+    out: dict[str, int] = {}
+    for body in re.findall(r"\benum\s*(?:\w+\s*)?\{([^}]*)\}", text):
+        value = -1
+        for item in (x.strip() for x in body.split(",")):
+            if not item:
+                continue
+            name, _, expr = (t.strip() for t in item.partition("="))
+            if expr:
+                if not re.fullmatch(r"[\w\s+*-]+", expr):
+                    raise ValueError(f"{source}: enum member {name} = {expr}: not an integer expression")
+                value = int(eval(expr, {"__builtins__": {}}, dict(out)))  # noqa: S307 - integers and names only
+            else:
+                value += 1
+            out[name] = value
+    return out
 
 
 def python_only() -> bool:

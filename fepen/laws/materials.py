@@ -8,17 +8,24 @@ tension positive.
 from __future__ import annotations
 
 from dataclasses import dataclass
+from pathlib import Path
 
 import numba
 import numpy as np
 
+from fepen import native
+
 #: fast-math flags that keep IEEE NaN/inf semantics (inverted or NaN elements must still be detected)
 _FAST = {"nsz", "arcp", "contract", "afn", "reassoc"}
 
-# Layout of the parameter vector handed to compiled code
-KIND, E_, NU, RHO, A_, B_, N_, C_, M_, TMELT, TROOM, EPS0, CP, BETA, RATE_ON, THERMAL_ON, H_ = range(17)
-N_PARAMS = 17
-ELASTIC, JOHNSON_COOK, BILINEAR = 0, 1, 2
+# Layout of the parameter vector handed to compiled code, and the kinds: read from materials_kernel.c's enums
+# (declared once, in C)
+_C = native.c_enums(Path(__file__).with_name("materials_kernel.c"))
+KIND, E_, NU, RHO, A_, B_, N_, C_, M_, TMELT, TROOM, EPS0, CP, BETA, RATE_ON, THERMAL_ON, H_ = (_C[k] for k in (
+    "KIND", "E_", "NU", "RHO", "A_", "B_", "N_", "C_", "M_", "TMELT", "TROOM", "EPS0", "CP", "BETA", "RATE_ON",
+    "THERMAL_ON", "H_"))
+N_PARAMS = _C["N_PARAMS"]
+ELASTIC, JOHNSON_COOK, BILINEAR = _C["ELASTIC"], _C["JOHNSON_COOK"], _C["BILINEAR"]
 
 
 @dataclass(frozen=True)

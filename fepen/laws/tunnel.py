@@ -17,8 +17,11 @@ angle. The nose, ahead of the shoulder, opens the tunnel under the law of the op
 from __future__ import annotations
 
 from dataclasses import dataclass
+from pathlib import Path
 
 import numpy as np
+
+from fepen import native
 
 __all__ = ["Tunnel", "SECTORS", "CAPACITY", "HEADER", "STATION", "shoulder_of", "zones", "ZONES", "split"]
 
@@ -26,9 +29,12 @@ __all__ = ["Tunnel", "SECTORS", "CAPACITY", "HEADER", "STATION", "shoulder_of", 
 SECTORS = 16
 #: stations a tunnel has room for (then it ends where it is: 2048 calibres at the default spacing)
 CAPACITY = 4096
-#: tunnel_kernel.c's layout: the header's length, its fields, a station's fixed part
-HEADER, STATION = 16, 8
-T_M, T_CAP, T_S, T_SPACING, T_XI_SH, T_A0, T_COMMIT, T_CS, T_TS, T_FACE = 0, 1, 2, 3, 4, 5, 7, 8, 11, 14
+#: tunnel_kernel.c's layout, read from its enums (declared once, in C): the header's length, its fields, a
+#: station's fixed part
+_C = native.c_enums(Path(__file__).with_name("tunnel_kernel.c"))
+HEADER, STATION = _C["T_HEADER"], _C["T_STATION"]
+T_M, T_CAP, T_S, T_SPACING, T_XI_SH, T_A0, T_COMMIT, T_CS, T_TS, T_FACE = (_C[k] for k in (
+    "T_M", "T_CAP", "T_S", "T_SPACING", "T_XI_SH", "T_A0", "T_COMMIT", "T_CS", "T_TS", "T_FACE"))
 
 
 def shoulder_of(X: np.ndarray, radius: np.ndarray) -> tuple[float, float]:
