@@ -1,6 +1,6 @@
 """fepen's errors on the public data (prediction_errors.csv): one row per shot, law, fidelity and quantity,
-with the shot's features, fepen's prediction and the measurement. Written by
-``python -m fepen.studies.prediction_errors``; read by the validated envelope (fepen.stats.envelope) and the
+with the shot's features, fepen's prediction and the measurement. Written by ``fepen study prediction-errors
+--table fepen/data/prediction_errors.csv``; read by the validated envelope (fepen.stats.envelope) and the
 prediction intervals (fepen.stats.interval)."""
 
 from __future__ import annotations

@@ -30,7 +30,6 @@ from __future__ import annotations
 
 import itertools
 import math
-import sys
 from dataclasses import dataclass
 from pathlib import Path
 
@@ -43,7 +42,7 @@ from fepen.studies.study import Round, Study, register, set_option
 
 __all__ = ["CALIBRATION_SETS", "OPEN", "STEP", "LIMITS", "S_SPAN", "EXPONENT", "nodes", "jobs", "job_scene",
            "table_of", "curves", "predicted", "group_errors", "objective", "fit", "calibrate", "shipped_node",
-           "Calibration", "main", "positions", "cylinder", "ok_summary"]
+           "Calibration", "positions", "cylinder", "ok_summary"]
 
 #: the calibration groups (file stems of fepen/data/depth; "table1" is the paper's Table 1, by its positions)
 #: and what each informs
@@ -367,25 +366,3 @@ def ok_summary(record: dict) -> dict:
 
         raise SimulationError(f"a calibration run did not finish ({record['status']}: {record['message']})")
     return record["summary"]
-
-
-def main(argv=None) -> int:
-    """``python -m fepen.studies.calibration [--data DIR] [--out DIR] [--set KEY=VALUE]``: the Calibration study
-    (``fepen study calibration`` runs the same)."""
-    import argparse
-
-    from fepen.studies import study
-
-    ap = argparse.ArgumentParser(prog="python -m fepen.studies.calibration")
-    ap.add_argument("--data", default=None, help="folder of the depth sets (default: fepen/data/depth)")
-    ap.add_argument("--out", default=Calibration.out, help="results directory (its rounds are reused)")
-    ap.add_argument("--set", dest="sets", action="append", default=[], metavar="KEY=VALUE")
-    args = ap.parse_args(sys.argv[1:] if argv is None else argv)
-    st = Calibration()
-    study.run(st, st.plan(args.data, args.sets), args.out, say=print)
-    print("\n".join(report_lines(st.plan_sets, st.tables, st.ranked)))
-    return 0
-
-
-if __name__ == "__main__":
-    raise SystemExit(main())

@@ -12,7 +12,6 @@ Each row keeps the shot's features (what the validated envelope is made of, fepe
 measurement. The table is an output of fepen, not an input: ``tests/system/test_prediction_errors.py`` runs a
 subset again and checks it is what this version predicts.
 
-    .venv/bin/python -m fepen.studies.prediction_errors [--plastic DIR] [--out FILE]
     .venv/bin/fepen study prediction-errors [--plastic DIR] [--table FILE] [--out DIR]
 
 ``--plastic DIR``: the directory of ``fepen validate --set run.fields=false --out DIR`` (the plastic fidelity
@@ -24,17 +23,15 @@ from __future__ import annotations
 import csv
 import io
 import math
-import sys
 from dataclasses import dataclass
 from pathlib import Path
 
 from fepen.data.prediction_errors import COLUMNS, read
-from fepen.data.prediction_errors import path as shipped_path
 from fepen.studies import depth
 from fepen.studies.study import Round, Study, register
 
 __all__ = ["LAWS", "LATERAL_MIN_OBLIQUITY_DEG", "depth_rows", "lateral_scenes", "lateral_rows",
-           "plastic_lateral_rows", "write", "PredictionErrors", "main"]
+           "plastic_lateral_rows", "write", "PredictionErrors"]
 
 #: the concrete strength laws with prediction errors: target.strength_model -> fepen.studies.depth.METHODS name
 LAWS = {"scaled-S": "default", "forrestal-S": "forrestal-S"}
@@ -195,26 +192,3 @@ class PredictionErrors(Study):
 
     def lines(self, result: dict) -> list[str]:
         return [f"{result['rows']} rows"]
-
-
-def main(argv=None) -> int:
-    """``python -m fepen.studies.prediction_errors [--plastic DIR] [--out FILE]``: the PredictionErrors study,
-    its table written to FILE (default: the shipped one)."""
-    import argparse
-    import tempfile
-
-    from fepen.studies import study
-
-    p = argparse.ArgumentParser(prog="python -m fepen.studies.prediction_errors", description=__doc__.split("\n\n")[0])
-    p.add_argument("--plastic", metavar="DIR", help="a `fepen validate --set run.fields=false` results directory")
-    p.add_argument("--out", default=str(shipped_path()))
-    args = p.parse_args(argv)
-    st = PredictionErrors()
-    with tempfile.TemporaryDirectory(prefix="fepen-errors-") as tmp:
-        res = study.run(st, st.plan(args.plastic, args.out), tmp, say=lambda *ls: None)
-    print(f"written: {args.out} ({res['rows']} rows)")
-    return 0
-
-
-if __name__ == "__main__":
-    sys.exit(main())

@@ -21,7 +21,6 @@ are predictions (docs/wear.md shows them against the paper's statements).
 
 from __future__ import annotations
 
-import sys
 from dataclasses import dataclass
 
 import numpy as np
@@ -30,7 +29,7 @@ from fepen.laws import target as tg
 from fepen.studies import calibration, depth
 from fepen.studies.study import Round, Study, register
 
-__all__ = ["TARGET_MASS_LOSS", "wear_sets", "table1_scenes", "table1_losses", "WearCalibration", "main"]
+__all__ = ["TARGET_MASS_LOSS", "wear_sets", "table1_scenes", "table1_losses", "WearCalibration"]
 
 #: the paper's largest mass loss of its recovered projectiles (its Fig. 13: "below 4.5 %", at the fastest)
 TARGET_MASS_LOSS = 0.045
@@ -138,22 +137,3 @@ class WearCalibration(Study):
         return [f"== chosen: efficiency {result['efficiency']:.4g}, coefficient {result['coefficient']:.4g}, size "
                 f"{result['size_m']:.4g} m"] + [f"  {s['shot']:3s} mass loss {s['mass_loss_percent']:5.2f} %  length "
                                                f"change {s['length_change_mm']:6.2f} mm" for s in result["shots"]]
-
-
-def main(argv=None) -> int:
-    """``python -m fepen.studies.wear_calibration [--out DIR]``: the WearCalibration study (``fepen study
-    wear-calibration`` runs the same)."""
-    import argparse
-
-    from fepen.studies import study
-
-    ap = argparse.ArgumentParser(prog="python -m fepen.studies.wear_calibration")
-    ap.add_argument("--out", default=WearCalibration.out, help="results directory (its rounds are reused)")
-    args = ap.parse_args(sys.argv[1:] if argv is None else argv)
-    st = WearCalibration()
-    study.run(st, st.plan(), args.out, say=print)
-    return 0
-
-
-if __name__ == "__main__":
-    raise SystemExit(main())
