@@ -50,7 +50,8 @@ def numbers(d, prefix: str = "") -> dict[str, float]:
 #: striking speed's size
 SCALE = {"nose_profile.tip_recession_mm": 100.0, "length_change_mm": 100.0, "residual_speed_m_s": 100.0,
          "energy_error": 1.0,  # and the energy balance's error, a fraction of the striking energy (1e-5 of it)
-         "yaw_deg": 1.0, "axis_angle_deg": 1.0}  # and angles of a nearly normal shot, hundredths of a degree
+         "yaw_deg": 1.0, "axis_angle_deg": 1.0,  # and angles of a nearly normal shot, hundredths of a degree
+         "Hz_mm": 100.0, "Tz_mm": 100.0}  # and the body across the plane of an in-plane shot: round-off of 100 mm
 
 
 def rel(a: float, b: float, scale: float = 0.0) -> float:
