@@ -234,6 +234,21 @@ def _verdict_line(err: BaseException) -> tuple[int, str]:
                   f"it): {type(err).__name__}: {text}")
 
 
+class _Console(logging.StreamHandler):
+    """fepen's console: the process's stderr as it is at each record (an in-process caller, a notebook or a test,
+    may have swapped it since the first command: a handler that kept the first one would write to a closed file)."""
+
+    fepen_console = True
+
+    @property
+    def stream(self):
+        return sys.stderr
+
+    @stream.setter
+    def stream(self, value) -> None:
+        pass
+
+
 def _quiet() -> None:
     """The console speaks only for fepen: the "fepen" logger's records as ``fepen: ...`` lines on stderr; every
     other package's records (ffcx's compiler lines, matplotlib's font cache and warnings, Python's warnings) go
@@ -247,9 +262,8 @@ def _quiet() -> None:
     own.setLevel(logging.INFO)
     own.propagate = False  # not through the root logger's handlers
     if not any(getattr(h, "fepen_console", False) for h in own.handlers):
-        console = logging.StreamHandler(sys.stderr)
+        console = _Console()
         console.setFormatter(logging.Formatter("fepen: %(message)s"))
-        console.fepen_console = True
         own.addHandler(console)
     rundir.chatter_to_log()
 

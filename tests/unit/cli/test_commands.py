@@ -31,3 +31,22 @@ def test_a_missing_command_is_one_line_exit_2(capsys):
     assert cli.main([]) == 2
     err = capsys.readouterr().err.strip().splitlines()
     assert len(err) == 1 and err[0].startswith("fepen: bad input: command line:")
+
+
+def test_the_console_writes_to_the_stderr_of_the_moment(monkeypatch):
+    """fepen's console handler follows sys.stderr (a notebook or a test swaps it between commands): a record
+    after the first stream was closed goes to the new one, with no logging error."""
+    import io
+    import logging
+
+    from fepen import cli as fcli
+
+    first, second = io.StringIO(), io.StringIO()
+    monkeypatch.setattr("sys.stderr", first)
+    fcli._quiet()
+    logging.getLogger("fepen").warning("one")
+    first.close()
+    monkeypatch.setattr("sys.stderr", second)
+    fcli._quiet()
+    logging.getLogger("fepen").warning("two")
+    assert second.getvalue() == "fepen: two\n"
