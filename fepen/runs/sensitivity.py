@@ -28,10 +28,8 @@ def perturbed(attack_deg: float, plane_deg: float, delta_deg: float) -> dict:
         {"impact.attack_deg": ..., "impact.attack_plane_deg": ...}.
     """
     p = math.radians(plane_deg)
-    inplane, out = attack_deg * math.cos(p) + delta_deg, attack_deg * math.sin(p)
-    attack = math.hypot(inplane, out)
-    return {"impact.attack_deg": attack,
-            "impact.attack_plane_deg": math.degrees(math.atan2(out, inplane)) if attack > 0.0 else 0.0}
+    attack, plane = striking.attack_in_plane(attack_deg * math.cos(p) + delta_deg, attack_deg * math.sin(p))
+    return {"impact.attack_deg": attack, "impact.attack_plane_deg": plane}
 
 
 def attitude(scene, delta_deg: float = YAW_DEG, built=None) -> dict:

@@ -14,7 +14,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
-__all__ = ["StrikingPrior", "PRIOR", "draw", "member_rng"]
+__all__ = ["StrikingPrior", "PRIOR", "draw", "member_rng", "attack_in_plane"]
 
 
 @dataclass(frozen=True)
@@ -52,6 +52,13 @@ PRIOR = StrikingPrior(yaw_deg=0.49, attack_error_deg=0.05, rate_rad_s=0.0, speed
                       obliquity_error_deg=0.05, concrete_cv=0.15, concrete_length_m=0.02)
 
 
+def attack_in_plane(inplane_deg: float, out_deg: float) -> tuple[float, float]:
+    """The attack and its plane (impact.attack_deg, impact.attack_plane_deg) of an attack whose components are
+    inplane_deg in the plane of fire and out_deg across it (the plane 0 without attack)."""
+    attack = math.hypot(inplane_deg, out_deg)
+    return attack, math.degrees(math.atan2(out_deg, inplane_deg)) if attack > 0.0 else 0.0
+
+
 def member_rng(seed: int, shot: str, member: int) -> np.random.Generator:
     """The generator of one member of one shot's ensemble: numpy's PCG64 from (seed, the shot's name, the member),
     so that a member's draw depends on nothing else (not the other shots, not the order, not the ranks)."""
@@ -71,12 +78,10 @@ def draw(prior: StrikingPrior, velocity: float, obliquity_deg: float, attack_deg
         {scene key: value}.
     """
     z = rng.standard_normal(6)
-    inplane = attack_deg + prior.attack_error_deg * z[0]
-    out = prior.yaw_deg * z[1]
-    attack, plane = math.hypot(inplane, out), math.degrees(math.atan2(out, inplane))
+    attack, plane = attack_in_plane(attack_deg + prior.attack_error_deg * z[0], prior.yaw_deg * z[1])
     values = {"impact.velocity": velocity * (1.0 + prior.speed_fraction * z[2]),
               "impact.obliquity_deg": min(max(obliquity_deg + prior.obliquity_error_deg * z[3], 0.0), 89.0),
-              "impact.attack_deg": attack, "impact.attack_plane_deg": plane if attack > 0.0 else 0.0,
+              "impact.attack_deg": attack, "impact.attack_plane_deg": plane,
               "impact.pitch_rate_rad_s": prior.rate_rad_s * z[4], "impact.yaw_rate_rad_s": prior.rate_rad_s * z[5]}
     values = {k: float(v) for k, v in values.items()}  # plain numbers (numpy 2's repr is np.float64(...))
     seed = int(rng.integers(0, 2**32 - 1))
