@@ -12,11 +12,10 @@ from mpi4py import MPI
 
 from fepen.data import shot
 from fepen.errors import OUTCOMES, SimulationError
-from fepen.geometry.frames import unit_axis
 from fepen.io import columns, files
 from fepen.version import SUMMARY_FORMAT
 
-G0 = 9.80665  # m/s^2, for accelerations in g
+G0 = columns.G0  # m/s^2, for accelerations in g
 
 #: history.csv's column groups, declared once with their units and meanings in fepen.io.columns (the lists
 #: below are their names, for the code that reads a history by position)
@@ -29,38 +28,6 @@ RESULTANT_COLUMNS = columns.RESULTANT.columns
 REMOVAL_COLUMNS = columns.REMOVAL.columns
 LOAD_COLUMNS = columns.LOADS.columns
 INTERFACE_COLUMNS = columns.INTERFACE.columns
-
-
-def attitude_row(tip, tail, velocity, force, centre, omega, moment, momentum, impulse) -> list[float]:
-    """ATTITUDE_COLUMNS of one row (world-frame arguments, SI; see ATTITUDE_COLUMNS for the frames)."""
-    axis = unit_axis(tip, tail)
-    # atan2(|a × v|, a · v): a small yaw to full precision (acos of a cosine near 1 keeps only its square root)
-    yaw = math.degrees(math.atan2(float(np.linalg.norm(np.cross(axis, velocity))), float(axis @ velocity)))
-    angle = float(final_axis_deg(tip[0], -tip[1], tail[0], -tail[1]))
-    return [tip[2] * 1e3, tail[2] * 1e3, float(velocity[2]), float(force[2]), centre[0] * 1e3, -centre[1] * 1e3,
-            centre[2] * 1e3, angle, yaw,
-            *map(float, omega), *map(float, moment), *map(float, momentum), *map(float, impulse)]
-
-
-def history_row(t, tip, tail, velocity, force, mass, energies: dict, contact: int, dt: float, peeq: float,
-                contact_area: float = 0.0):
-    """One history row in the reported frame: x along the face, y depth into the target (mm from O).
-
-    Args:
-        tip, tail: world positions (m) of the nose tip and tail centre. velocity: centre-of-mass velocity.
-        force: target force on the projectile (N, world). mass: projectile mass (kg).
-        contact: number of loaded points (nodes on a rigid wall); contact_area: loaded area (m^2).
-        energies: kinetic, internal_work, external_work, elastic, plastic, heat, energy_error, total_energy,
-            energy_ratio (J, -).
-    """
-    axis = unit_axis(tip, tail)
-    decel = -float(np.dot(force, axis)) / mass / G0
-    row = [t, tip[0] * 1e3, -tip[1] * 1e3, tail[0] * 1e3, -tail[1] * 1e3, float(np.linalg.norm(velocity)), decel,
-           velocity[0], -velocity[1], force[0], -force[1], float(np.linalg.norm(tip - tail)) * 1e3,
-           energies["kinetic"], energies["internal_work"], energies["external_work"], energies["elastic"],
-           energies["plastic"], energies["heat"], energies["energy_error"], contact, dt, peeq, contact_area,
-           energies["total_energy"], energies["energy_ratio"]]
-    return row
 
 
 class HistoryText:
@@ -161,10 +128,8 @@ def comparison(name: str | None, summary: dict) -> dict | None:
             "Hy_error": float(summary["Hy_mm"] / s.Hy_mm - 1), "Ty_error": float(summary["Ty_mm"] / s.Ty_mm - 1)}
 
 
-def final_axis_deg(Hx_mm, Hy_mm, Tx_mm, Ty_mm):
-    """The projectile's axis at the end (deg from the face's normal, toward +x): atan2(Hx − Tx, Hy − Ty) of the
-    nose and tail positions in the reported frame (x along the face, y depth); numbers or arrays."""
-    return np.degrees(np.arctan2(np.subtract(Hx_mm, Tx_mm), np.subtract(Hy_mm, Ty_mm)))
+#: the axis at the end from the nose and tail positions (declared with the history columns)
+final_axis_deg = columns.final_axis_deg
 
 
 def nose_offset_mm(Hx_mm: float, Hy_mm: float, obliquity_deg: float) -> float:

@@ -182,21 +182,23 @@ class DeformableRun(Run):
                 f"internal work {e.internal_work:.4g} J): the explicit step is unstable in distorted or eroding "
                 "cells; the rows written so far are kept")
         tip, tail = probes.node_value(s, m.tip, x), probes.node_value(s, m.tail, x)
-        extra = []
+        extra = {}  # the body's own history columns, by their declared names (fepen.io.columns)
         if self.pm.charge:
-            extra += list(diagnostics.body_accelerations(s, unit_axis(tip, tail)) / results.G0)
+            extra.update(zip(("shell_acc_g", "charge_acc_g"),
+                             diagnostics.body_accelerations(s, unit_axis(tip, tail)) / results.G0))
             b = diagnostics.bodies(s, e)
-            for k in range(2):  # reported frame: y is depth
-                extra += [b.kinetic[k], b.internal[k], b.momentum[k, 0], -b.momentum[k, 1]]
+            for k, body in enumerate(("shell", "charge")):  # reported frame: y is depth
+                extra.update({f"{body}_kinetic_J": b.kinetic[k], f"{body}_internal_J": b.internal[k],
+                              f"{body}_px_N_s": b.momentum[k, 0], f"{body}_py_N_s": -b.momentum[k, 1]})
             f = self.contact.resultant() if self.contact is not None else diagnostics.tied_interface_force(s)
-            extra += [f[0], -f[1], float(np.linalg.norm(f))]
+            extra.update(contact_fx_N=f[0], contact_fy_N=-f[1], contact_force_N=float(np.linalg.norm(f)))
             self.sections.record(tip, tail)
             if self.safety is not None:
                 self.safety.record(s.t)
         if self.contact is not None:
             i = self.contact.summary()
-            extra += [e.friction, i["gap_max_mm"], i["penetration_max_mm"], i["slip_max_mm"], i["free_fraction"],
-                      i["sliding_fraction"]]
+            extra.update(friction_J=e.friction, **{f"interface_{k}": i[k] for k in (
+                "gap_max_mm", "penetration_max_mm", "slip_max_mm", "free_fraction", "sliding_fraction")})
         self.gauges.record()
         rear = -self._y_extent(x)[1] if self.crossings is not None else np.nan
         xc, w, M, H, vc = diagnostics.rotation(s, x, getattr(self.load, "nodal_force", None))  # a rigid wall: none

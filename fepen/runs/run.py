@@ -49,10 +49,11 @@ class Snapshot:
 
     Attributes:
         tip, tail: positions of the nose tip and the tail centre (m). velocity: centre-of-mass velocity (m/s).
-        force: the target's force (N). mass: the projectile's mass now (kg). energies: fepen.io.results.
-        history_row's energies. contact: loaded points. dt: the step (s). peeq: the largest plastic strain.
+        force: the target's force (N). mass: the projectile's mass now (kg). energies: kinetic, internal_work,
+        external_work, elastic, plastic, heat, energy_error, total_energy, energy_ratio (J, -). contact: loaded
+        points. dt: the step (s). peeq: the largest plastic strain.
         area: the loaded area (m^2). rear_depth: the shallowest load point's depth (m; the crossings).
-        extra: the body's own columns (charge, interface), in Run.columns' order.
+        extra: the body's own history columns (charge, interface) by their names in fepen.io.columns.
         removal: what wear and erosion took off, when the body has it at hand (else Run.record asks removal()).
     """
 
@@ -67,7 +68,7 @@ class Snapshot:
     peeq: float
     area: float
     rear_depth: float
-    extra: list = field(default_factory=list)
+    extra: dict = field(default_factory=dict)
     removal: Removal | None = None
     #: about the centre of mass, world frame: angular velocity (rad/s), the target's moment (N m), angular
     #: momentum (N m s)
@@ -237,15 +238,7 @@ class Run:
     def record(self) -> list[float]:
         """Append one history row from the body's snapshot (and sample the layer crossings there)."""
         s = self.snapshot()
-        row = results.history_row(self.t, s.tip, s.tail, s.velocity, s.force, s.mass, s.energies, s.contact,
-                                  s.dt, s.peeq, s.area) + list(s.extra)
-        if self.removing:
-            r = s.removal or self.removal()
-            row += [s.mass, r.heat_J, r.eroded_cells, r.kinetic_J]
-        if self.splitting:
-            row += self.load_split()
-        row += results.attitude_row(s.tip, s.tail, s.velocity, s.force, s.centre, s.omega, s.moment, s.momentum,
-                                    s.impulse)
+        row = columns.values(self, self.t, s)
         results.finite_row(row, self.step_count, self.t)
         self.rows.append(row)
         if self.probes is not None:

@@ -50,3 +50,53 @@ def test_a_run_writes_the_declared_groups_it_has(tmp_path, sets, groups):
     want = [c for name in groups for g in columns.HISTORY if g.name == name for c in g.columns]
     assert header == want == run.columns
     assert results.HISTORY_COLUMNS == columns.BASE.columns
+
+
+def test_every_row_value_is_declared_and_every_declaration_written(tmp_path):
+    """A rigid run's rows are as long as its declared header, and every declared group of a rigid run computes
+    its values from the declaration itself (only the deformable body's own columns come by name)."""
+    out = tmp_path / "r"
+    run = RigidRun(scene.load(None, ["effects.fidelity=rigid", "run.end_time=2e-5", "effects.wear=true"]), out,
+                   MPI.COMM_SELF)
+    run.run()
+    lines = (out / "history.csv").read_text().splitlines()
+    assert all(len(line.split(",")) == len(run.columns) for line in lines)
+    for g in columns.HISTORY:
+        if g.on(run):
+            assert all(q.value is not None for q in g.quantities), g.name
+
+
+class _Snap:
+    extra = {"shell_acc_g": 1.0, "new_column_g": 2.0}
+
+
+class _Charged:
+    charged, frictional, removing, splitting = True, False, False, False
+
+
+def test_a_body_column_written_but_not_declared_fails():
+    with pytest.raises(ValueError, match="new_column_g"):
+        columns.values(_Charged(), 0.0, _Snap())
+
+
+def test_a_value_of_the_wrong_length_fails():
+    q = columns.Quantity(("a_mm", "b_mm"), "mm", "two", lambda r: (1.0,))
+    with pytest.raises(ValueError, match="a_mm"):
+        q.values(columns.Row(0.0, _Snap(), None))
+
+
+def test_a_new_declaration_is_a_new_column_in_both_fidelities(tmp_path, monkeypatch):
+    """Adding a column is one declaration: a Quantity appended to a group writes its name in the header and its
+    value in every row (here the nose's depth in cm, from the snapshot), with nothing else changed."""
+    q = columns.Quantity(("nose_depth_cm",), "cm", "the nose's depth", lambda r: (-r.s.tip[1] * 1e2,))
+    base = columns.Group(columns.BASE.name, "", columns.BASE.intro, columns.BASE.quantities + (q,))
+    monkeypatch.setattr(columns, "HISTORY", (base, *columns.HISTORY[1:]))
+    out = tmp_path / "r"
+    RigidRun(scene.load(None, ["effects.fidelity=rigid", "run.end_time=2e-5"]), out, MPI.COMM_SELF).run()
+    lines = (out / "history.csv").read_text().splitlines()
+    header = lines[0].split(",")
+    i, y = header.index("nose_depth_cm"), header.index("nose_y_mm")
+    assert i == len(columns.BASE.columns)
+    for line in lines[1:]:
+        v = [float(x) for x in line.split(",")]
+        assert v[i] == pytest.approx(v[y] / 10, rel=1e-8, abs=1e-12)
