@@ -18,12 +18,11 @@ itself).
 
 from __future__ import annotations
 
-import io
 from pathlib import Path
 
 from mpi4py import MPI
 
-from fepen.io import files
+from fepen.io import files, table
 from fepen.io.results import G0
 
 __all__ = ["NODE_COLUMNS", "CELL_COLUMNS", "ACCELEROMETER_COLUMNS", "ACCELEROMETER_FILTERED", "quantities", "columns",
@@ -93,10 +92,6 @@ def write(rows, out: Path, header: list[str], comm=MPI.COMM_WORLD) -> None:
     """
 
     def write_file():
-        buf = io.StringIO()
-        buf.write(",".join(header) + "\n")
-        for r in rows:
-            buf.write(",".join(repr(float(v)) for v in r) + "\n")
-        files.write_text(Path(out) / "probes.csv", buf.getvalue(), comm)
+        files.write_text(Path(out) / "probes.csv", table.text(header, rows, digits=None), comm)
 
     files.agree(comm, f"{Path(out) / 'probes.csv'}", write_file)

@@ -3,7 +3,6 @@
 from __future__ import annotations
 
 import csv
-import io
 import math
 from pathlib import Path
 
@@ -12,7 +11,7 @@ from mpi4py import MPI
 
 from fepen.data import shot
 from fepen.errors import OUTCOMES, SimulationError
-from fepen.io import columns, files
+from fepen.io import columns, files, table
 from fepen.version import SUMMARY_FORMAT
 
 G0 = columns.G0  # m/s^2, for accelerations in g
@@ -30,43 +29,30 @@ LOAD_COLUMNS = columns.LOADS.columns
 INTERFACE_COLUMNS = columns.INTERFACE.columns
 
 
-class HistoryText:
-    """The CSV text of a run's history rows, each row formatted once. history.csv is replaced whole at every
-    output (atomically: the file keeps its last complete version), and formatting every row again each time
-    made a long run's outputs grow as the square of its rows (a 33 ms layered shot: 333 writes of up to 33,000
-    rows, 94 s of its 236). The text is kept while the rows before the new ones are the same row objects; any
-    other change of the list (a row replaced or inserted) formats them all again."""
-
-    def __init__(self):
-        self.rows: list = []  #: the row objects formatted so far, in order
-        self.chunks: list[str] = []  #: their CSV text, a chunk per write
-
-    def of(self, rows) -> str:
-        """The CSV text (no header) of ``rows``, as csv.writer writes them with 9 significant digits."""
-        n = len(self.rows)
-        if n > len(rows) or any(a is not b for a, b in zip(self.rows, rows)):
-            self.rows, self.chunks, n = [], [], 0
-        if len(rows) > n:
-            buf = io.StringIO()
-            w = csv.writer(buf)
-            for r in rows[n:]:
-                w.writerow([f"{v:.9g}" for v in r])
-            self.chunks.append(buf.getvalue())
-            self.rows.extend(rows[n:])
-        return "".join(self.chunks)
+#: history.csv's line end: the csv module's own (RFC 4180's CRLF), as history.csv has been written since 0.1
+HISTORY_NEWLINE = "\r\n"
 
 
-def write_history(rows, out: Path, comm=MPI.COMM_WORLD, columns=None, text: HistoryText | None = None) -> None:
-    """history.csv (rank 0, atomically; collective: a failed write raises MachineFault on every rank, and
-    the file keeps its last complete version); columns: HISTORY_COLUMNS (default), + CHARGE_COLUMNS, BODY_COLUMNS
-    and RESULTANT_COLUMNS with a charge, ...; text: the run's HistoryText (its rows formatted once), or None."""
+def history_rows() -> table.Rows:
+    """A run's history rows, each formatted once (fepen.io.table.Rows: history.csv is replaced whole at every
+    output, and formatting every row again each time made a long run's outputs grow as the square of its rows)."""
+    return table.Rows(digits=table.DIGITS, newline=HISTORY_NEWLINE)
+
+
+def write_history(rows, out: Path, comm=MPI.COMM_WORLD, columns=None, text: table.Rows | None = None) -> None:
+    """history.csv (rank 0, atomically, through fepen.io.table; collective: a failed write raises MachineFault on
+    every rank, and the file keeps its last complete version).
+
+    Args:
+        rows: the history rows. out: the results directory. comm: the run's communicator. columns: the header
+            (the run's declared groups, fepen.io.columns; default HISTORY_COLUMNS). text: the run's
+            ``history_rows()`` (its rows formatted once), or None.
+    """
 
     def write():
         files.inject("history")
-        buf = io.StringIO()
-        csv.writer(buf).writerow(columns or HISTORY_COLUMNS)
-        body = (text or HistoryText()).of(rows)
-        files.write_text(Path(out) / "history.csv", buf.getvalue() + body, comm)
+        files.write_text(Path(out) / "history.csv", table.text(columns or HISTORY_COLUMNS, rows, table.DIGITS,
+                                                               HISTORY_NEWLINE, text), comm)
 
     files.agree(comm, f"{Path(out) / 'history.csv'}", write)
 

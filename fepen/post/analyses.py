@@ -23,8 +23,12 @@ from mpi4py import MPI
 
 from fepen.geometry import tags
 from fepen.geometry.frames import unit_axis
+from fepen.io import table
 from fepen.solver import diagnostics, probes
 
+#: hazard.csv's columns: per bin of the axis, the surface's and the whole section's peaks
+HAZARD_COLUMNS = [
+    "axial_from_nose_mm", "max_surface_peeq", "peak_surface_von_mises_Pa", "max_peeq", "peak_von_mises_Pa"]
 GAUGE_NAMES = ["top", "bottom", "side+", "side-"]
 GAUGE_DIRECTIONS = np.array([[1.0, 0.0, 0.0], [-1.0, 0.0, 0.0], [0.0, 0.0, 1.0], [0.0, 0.0, -1.0]])
 
@@ -168,27 +172,13 @@ class Gauges:
         haz = self.hazard()
         out = Path(out)
         if self.comm.rank == 0:
-            save_table(out / "strains.csv", np.array(self.rows), ",".join(self.columns), "%.9g")
-            save_table(out / "hazard.csv", np.column_stack(haz),
-                       "axial_from_nose_mm,max_surface_peeq,peak_surface_von_mises_Pa,max_peeq,peak_von_mises_Pa",
-                       "%.6g")
+            table.write(out / "strains.csv", self.columns, self.rows)
+            table.write(out / "hazard.csv", HAZARD_COLUMNS, np.column_stack(haz).tolist(), digits=6)
         if not figures:
             return None
         haz = self.comm.bcast(haz[:3] if self.comm.rank == 0 else None, root=0)
         rows, columns = np.array(self.rows), list(self.columns)  # the same rows on every rank
         return lambda: hazard_figure(out, haz, rows, columns)
-
-
-def save_table(path: Path, rows: np.ndarray, header: str, fmt: str) -> None:
-    """A CSV table (one header line), replaced whole (fepen.atomic)."""
-    import io
-
-    from fepen.atomic import replacing
-
-    buf = io.StringIO()
-    np.savetxt(buf, rows, delimiter=",", header=header, comments="", fmt=fmt)
-    with replacing(path) as tmp:
-        tmp.write_text(buf.getvalue())
 
 
 def hazard_figure(out: Path, haz, rows: np.ndarray, columns: list[str]) -> Path:
@@ -342,7 +332,6 @@ def nose_profile(solver, shape, tip_node, tail_node, tri: np.ndarray, out: Path,
     Returns:
         {"tip_recession_mm", "max_radius_mm"} on every rank.
     """
-    from fepen.io import files
 
     comm = solver.comm
     x = solver.positions()
@@ -368,10 +357,9 @@ def nose_profile(solver, shape, tip_node, tail_node, tri: np.ndarray, out: Path,
         np.maximum.at(r_after, k, radius[sel])
         z_after = (np.arange(len(r_after)) + 0.5) * PROFILE_BIN
         z_after, r_after = z_after[r_after > 0.0], r_after[r_after > 0.0]
-        lines = ["state,behind_tip_mm,radius_mm"]
-        lines += [f"before,{a * 1e3:.4f},{b * 1e3:.4f}" for a, b in zip(z0, r0)]
-        lines += [f"after,{a * 1e3:.4f},{b * 1e3:.4f}" for a, b in zip(z_after, r_after)]
-        files.write_text(Path(out) / "nose_profile.csv", "\n".join(lines) + "\n", MPI.COMM_SELF)
+        rows = [["before", a * 1e3, b * 1e3] for a, b in zip(z0, r0)]
+        rows += [["after", a * 1e3, b * 1e3] for a, b in zip(z_after, r_after)]
+        table.write(Path(out) / "nose_profile.csv", ["state", "behind_tip_mm", "radius_mm"], rows)
         result = {"tip_recession_mm": float(behind.min() * 1e3) if len(behind) else 0.0,
                   "max_radius_mm": float(radius[sel].max() * 1e3) if sel.any() else 0.0}
         if figures:
@@ -480,7 +468,7 @@ class ChargeSections:
     def write(self, out: Path) -> None:
         """charge_sections.csv (rank 0)."""
         if self.comm.rank == 0:
-            save_table(Path(out) / "charge_sections.csv", np.array(self.rows), ",".join(self.columns), "%.9g")
+            table.write(Path(out) / "charge_sections.csv", self.columns, self.rows)
 
 
 @numba.njit(cache=True)

@@ -131,12 +131,31 @@ def paths_figure(runs: Mapping[str, Path], out: Path, shots: Sequence[str] | Non
     """
     from fepen.post.figures import new_figure, save_figure
 
-    names = [n for n in (oblique_shots() if shots is None else shots) if n in SHOTS]
+    fig = new_figure(size(shots))
+    draw(fig, runs, shots)
+    out = Path(out)
+    out.parent.mkdir(parents=True, exist_ok=True)
+    return save_figure(fig, out)
+
+
+def _names(shots: Sequence[str] | None) -> list[str]:
+    return [n for n in (oblique_shots() if shots is None else shots) if n in SHOTS]
+
+
+def size(shots: Sequence[str] | None = None) -> tuple[float, float]:
+    """The path figure's size (inches) for the shots (as paths_figure's)."""
+    n = len(_names(shots))
+    ncols = min(3, max(n, 1))
+    return (4.4 * ncols, 6.0 * max(math.ceil(n / ncols), 1) + 0.8)
+
+
+def draw(fig, runs: Mapping[str, Path], shots: Sequence[str] | None = None) -> None:
+    """Draw the path figure (as paths_figure's) on ``fig``, a Figure of ``size(shots)``."""
+    names = _names(shots)
     colours = {label: f"C{i}" for i, label in enumerate(runs)}
     ncols = min(3, max(len(names), 1))
     nrows = max(math.ceil(len(names) / ncols), 1)
     height = 6.0 * nrows + 0.8
-    fig = new_figure((4.4 * ncols, height))
     axes = np.atleast_1d(fig.subplots(nrows, ncols, squeeze=False).ravel())
     for ax, name in zip(axes, names):
         paths = {label: p for label, d in runs.items() if (p := read_path(Path(d) / name)) is not None}
@@ -155,9 +174,6 @@ def paths_figure(runs: Mapping[str, Path], out: Path, shots: Sequence[str] | Non
     fig.suptitle(f"Nose and tail paths of the oblique shots ({which}) against Table 1's final positions",
                  fontsize=12)
     fig.tight_layout(rect=(0, 0.55 / height, 1, 1 - 0.45 / height))
-    out = Path(out)
-    out.parent.mkdir(parents=True, exist_ok=True)
-    return save_figure(fig, out)
 
 
 def _labelled(text: str) -> tuple[str, Path]:

@@ -10,7 +10,7 @@ import numpy as np
 from mpi4py import MPI
 
 from fepen.data.experiments import shot as table1_shot
-from fepen.io import files, results
+from fepen.io import results, table
 from fepen.post import analyses, signals, slices
 from fepen.solver import diagnostics
 
@@ -134,6 +134,5 @@ def accelerations(run) -> dict:
         peaks[name.replace("_g", "")] = {"filtered_g": float(filt[k]), "t_s": float(t[k]),
                                          "nose_depth_mm": float(depth),
                                          "raw_peak_g": float(raw[np.argmax(np.abs(raw))])}
-    body = "\n".join(",".join(f"{v:.9g}" for v in r) for r in np.column_stack(cols))
-    files.write_text(run.out / "accelerations.csv", ",".join(header) + "\n" + body + "\n", run.comm)
+    table.write(run.out / "accelerations.csv", header, np.column_stack(cols).tolist(), table.DIGITS, run.comm)
     return peaks

@@ -103,7 +103,7 @@ class Run:
         self.output_s = 0.0
         self.out = files.prepare(out, comm) if out is not None else None
         self.rows: list[list[float]] = []
-        self.history_text = results.HistoryText()  # history.csv's rows, each formatted once
+        self.history_text = results.history_rows()  # history.csv's rows, each formatted once
         law = shot.law
         self.rules = events.StopRules(law.thickness if law is not None else None, shot.end_time is None)
         self.crossings = fl.Crossings(law.faces()) if shot.layered else None

@@ -4,8 +4,6 @@ and C7, each run a whole ``fepen run`` process on the one executor; restartable 
 
 from __future__ import annotations
 
-import csv
-import io
 import json
 from dataclasses import dataclass
 from pathlib import Path
@@ -13,7 +11,7 @@ from pathlib import Path
 import numpy as np
 
 from fepen import scene as fscene
-from fepen.io import files
+from fepen.studies.products import Picture, Table
 from fepen.studies.study import Round, Study, register
 
 SHOTS = ("C3", "C7")
@@ -151,14 +149,24 @@ class AccuracyCost(Study):
         _against_finest(rows, plan.quick)
         return {"exponents": cost_exponents(rows), "speedups": rank_speedups(rows), "_rows": rows}
 
-    def write(self, plan: CostPlan, result: dict, out: Path, info) -> None:
-        from fepen.post import study_figures
-        from fepen.post.figures import new_figure, save_figure
+    @property
+    def json_name(self) -> str:
+        """Its files' stem: study.json, study.csv, study.md."""
+        return "study"
 
-        _write(result["_rows"], result["exponents"], result["speedups"], out)
-        fig = new_figure((12, 5))
-        study_figures.pareto(fig, result["_rows"])
-        save_figure(fig, out / "pareto.png", dpi=120)
+    def document(self, plan: CostPlan, result: dict, info) -> dict:
+        return {"exponents": result["exponents"], "speedups": result["speedups"]}
+
+    def tables(self, plan: CostPlan, result: dict, info) -> list:
+        return [Table("study.csv", COLUMNS, result["_rows"])]
+
+    def texts(self, plan: CostPlan, result: dict, info) -> dict:
+        return {"study.md": _report(result["_rows"], result["exponents"], result["speedups"])}
+
+    def pictures(self, plan: CostPlan, result: dict, info) -> list:
+        from fepen.post import study_figures
+
+        return [Picture("pareto.png", (12, 5), lambda fig: study_figures.pareto(fig, result["_rows"]), 120)]
 
 
 def study(out: str | Path = "results/study", ranks: int = 2, quick: bool = False, fresh: bool = False,
@@ -237,15 +245,8 @@ COLUMNS = ["shot", "group", "name", "h_mm", "ranks", "cells", "process_s", "wall
            "nose_error", "tail_error", "Hy_vs_finest", "H_vs_finest", "peeq_vs_finest", "failed"]
 
 
-def _write(rows, exponents, speedups, out: Path) -> None:
-    from mpi4py import MPI
-
-    buf = io.StringIO()
-    w = csv.DictWriter(buf, COLUMNS)
-    w.writeheader()
-    for r in rows:
-        w.writerow({k: (f"{v:.6g}" if isinstance(v, float) else v) for k, v in r.items() if k in COLUMNS})
-    files.write_text(out / "study.csv", buf.getvalue(), MPI.COMM_SELF)
+def _report(rows, exponents, speedups) -> str:
+    """study.md: the runs' table, then the cost exponents and the speed-ups."""
     lines = ["| shot | run | h (mm) | ranks | cells | wall (s) | time loop (s) | steps | smallest step (ns) | "
              "peak memory (MiB) | Hy (mm) | nose error vs Table 1 | tail error vs Table 1 | "
              "H vs finest | max PEEQ | PEEQ vs finest |", "|" + "---|" * 16]
@@ -268,5 +269,4 @@ def _write(rows, exponents, speedups, out: Path) -> None:
     for shot, s in speedups.items():
         lines.append(f"- {shot}: 1 -> {s['ranks']} ranks at 2.5 mm: process {s['process']:.2f} x, time loop "
                      f"{s['loop']:.2f} x")
-    files.write_text(out / "study.md", "\n".join(lines) + "\n", MPI.COMM_SELF)
-    files.write_json(out / "study.json", {"exponents": exponents, "speedups": speedups}, MPI.COMM_SELF)
+    return "\n".join(lines) + "\n"

@@ -11,10 +11,7 @@ bands' widths) and bands.png (each shot's fan of final nose and tail positions w
 
 from __future__ import annotations
 
-import csv
-import io
 from dataclasses import dataclass
-from pathlib import Path
 
 import numpy as np
 
@@ -22,6 +19,7 @@ from fepen import scene as fscene
 from fepen.data import SHOTS
 from fepen.errors import InputError
 from fepen.stats import striking
+from fepen.studies.products import Picture, Table
 from fepen.studies.study import Round, Study, register
 
 __all__ = ["Bands", "QUANTITIES", "FIELDS", "STRIKING_KEYS", "band_rows", "test_values", "striking_inputs",
@@ -170,23 +168,21 @@ class Bands(Study):
         return {"rows": rows, "samples": len(next(iter(plan.members.values()))), "seed": plan.seed,
                 "prior": plan.prior.__dict__, "fidelity": self.fidelity(plan), "_fans": fans}
 
-    def write(self, plan: BandsPlan, result: dict, out: Path, info) -> None:
-        from mpi4py import MPI
+    def document(self, plan: BandsPlan, result: dict, info) -> None:
+        return None
 
-        from fepen.io import files
+    def tables(self, plan: BandsPlan, result: dict, info) -> list:
+        return [Table("bands.csv", FIELDS, result["rows"])]
+
+    def texts(self, plan: BandsPlan, result: dict, info) -> dict:
+        return {"bands.md": report(result)}
+
+    def pictures(self, plan: BandsPlan, result: dict, info) -> list:
         from fepen.post import study_figures
-        from fepen.post.figures import new_figure, save_figure
 
-        buf = io.StringIO()
-        w = csv.DictWriter(buf, FIELDS, extrasaction="ignore")
-        w.writeheader()
-        for r in result["rows"]:
-            w.writerow({k: (f"{v:.6g}" if isinstance(v, float) else v) for k, v in r.items()})
-        files.write_text(out / "bands.csv", buf.getvalue(), MPI.COMM_SELF)
-        files.write_text(out / "bands.md", report(result), MPI.COMM_SELF)
-        fig = new_figure((15, 6.5))
-        study_figures.fans(fig, result["_fans"], {n: test_values(n) for n in result["_fans"]})
-        save_figure(fig, out / "bands.png", dpi=110)
+        fans = result["_fans"]
+        return [Picture("bands.png", (15, 6.5),
+                        lambda fig: study_figures.fans(fig, fans, {n: test_values(n) for n in fans}), 110)]
 
     def lines(self, result: dict) -> list[str]:
         return summary_lines(result)

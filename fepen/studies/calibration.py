@@ -336,22 +336,18 @@ class Calibration(Study):
             ranked = sorted(fits.values(), key=lambda x: x[0])
             todo = [n for n in _beyond(ranked[0][1], [x[1] for x in ranked]) if _key(n) not in tables]
             if not todo:
-                self.ranked, self.tables = ranked, tables
-                return
+                return ranked, tables
 
     def result(self, plan: CalibrationPlan, records: list, info) -> dict:
-        obj, node, a, D0 = self.ranked[0]
+        ranked, tables = info.found
+        obj, node, a, D0 = ranked[0]
         return {"chosen": {"node": node, "coefficient": a, "exponent": EXPONENT, "size_m": D0, "objective": obj},
-                "nodes": [{"node": n, "coefficient": aa, "size_m": dd, "objective": oo}
-                          for oo, n, aa, dd in self.ranked]}
+                "nodes": [{"node": n, "coefficient": aa, "size_m": dd, "objective": oo} for oo, n, aa, dd in ranked],
+                "_report": "\n".join(["# The calibration of the concrete law", "", "```",
+                                      *report_lines(plan.sets, tables, ranked), "```", ""])}
 
     def report(self, result: dict) -> str:
-        return "\n".join(["# The calibration of the concrete law", "", "```",
-                          *report_lines(self.plan_sets, self.tables, self.ranked), "```", ""])
-
-    def write(self, plan: CalibrationPlan, result: dict, out: Path, info) -> None:
-        self.plan_sets = plan.sets
-        super().write(plan, result, out, info)
+        return result["_report"]
 
     def lines(self, result: dict) -> list[str]:
         c = result["chosen"]

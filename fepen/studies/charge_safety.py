@@ -7,18 +7,16 @@ a table (charge_safety.csv, .md) and a map (charge_safety.png).
 
 from __future__ import annotations
 
-import csv
 import hashlib
-import io
 import json
 import math
 from dataclasses import dataclass
-from pathlib import Path
 
 from fepen import scene as fscene
 from fepen.errors import InputError
 from fepen.laws.explosive import CRITERIA
 from fepen.studies.limits import base_keys, envelope_of, scene_line
+from fepen.studies.products import Picture, Table
 from fepen.studies.study import Round, Study, numbers, register, set_option
 
 __all__ = ["ChargeSafetyStudy", "SafetyPlan", "boundary", "table"]
@@ -170,28 +168,14 @@ class ChargeSafetyStudy(Study):
                 "mesh_size_m": plan.probe.mesh.size,
                 "statuses": {s: sum(r["status"] == s for r in rows) for s in sorted({r["status"] for r in rows})}}
 
-    def write(self, plan: SafetyPlan, result: dict, out: Path, info) -> None:
-        from mpi4py import MPI
-
-        from fepen.atomic import replacing
-        from fepen.io import files
-        from fepen.post import study_figures
-        from fepen.post.figures import new_figure, save_figure
-
-        files.write_json(out / "charge_safety.json", result, MPI.COMM_SELF)
+    def tables(self, plan: SafetyPlan, result: dict, info) -> list:
         rows = result["rows"]
-        buf = io.StringIO()
-        w = csv.writer(buf, lineterminator="\n")
-        cols = list(rows[0]) if rows else []
-        w.writerow(cols)
-        for r in rows:
-            w.writerow(["" if r[c] is None else f"{r[c]:.6g}" if isinstance(r[c], float) else r[c] for c in cols])
-        with replacing(out / "charge_safety.csv", ".csv") as tmp:
-            tmp.write_text(buf.getvalue())
-        files.write_text(out / "charge_safety.md", self.report(result), MPI.COMM_SELF)
-        fig = new_figure((6.4, 4.6))
-        study_figures.charge_safety(fig, result)
-        save_figure(fig, out / "charge_safety.png", dpi=120)
+        return [Table("charge_safety.csv", list(rows[0]) if rows else [], rows)]
+
+    def pictures(self, plan: SafetyPlan, result: dict, info) -> list:
+        from fepen.post import study_figures
+
+        return [Picture("charge_safety.png", (6.4, 4.6), lambda fig: study_figures.charge_safety(fig, result), 120)]
 
     def report(self, result: dict) -> str:
         lines = [f"# Charge safety: {result['explosive']}", "",

@@ -17,7 +17,6 @@ from __future__ import annotations
 
 import csv
 import functools
-import io
 import math
 from dataclasses import dataclass
 from importlib import resources
@@ -27,6 +26,7 @@ import numpy as np
 
 from fepen.data import SHOTS
 from fepen.laws import target as tg
+from fepen.studies.products import Picture, Table
 from fepen.studies.study import Round, Study, register
 
 __all__ = ["Row", "read_set", "table1_set", "shipped_sets", "scene_sets", "rigid_depth", "closed_form_depth",
@@ -345,45 +345,43 @@ class ValidateDepth(Study):
         return hashlib.sha256(blob.encode()).hexdigest()[:16]
 
     def rounds(self, plan: DepthPlan):
-        self.scenes, self.where = shot_scenes(plan.sets, plan.extra)
-        yield Round(self.scenes, keep=lambda sc: False, label="shots")
+        scenes, where = shot_scenes(plan.sets, plan.extra)
+        yield Round(scenes, keep=lambda sc: False, label="shots")
+        return where
 
     def result(self, plan: DepthPlan, records: list, info) -> dict:
         from fepen.errors import SimulationError
 
         summaries = []
-        for i in range(len(self.scenes)):
+        for i in range(len(records[0])):
             r = records[0][i]
             if r["status"] == "stopped":
                 raise SimulationError(r["message"])
             summaries.append(r["summary"] if r["status"] == "ok" else None)
-        results = predictions(plan.sets, self.where, summaries)
+        results = predictions(plan.sets, info.found, summaries)
         return {"table": summary_table(results, plan.law), "_results": results}
 
-    def write(self, plan: DepthPlan, result: dict, out: Path, info) -> None:
-        from mpi4py import MPI
+    @property
+    def json_name(self) -> str:
+        """Its files' stem: depth.csv, depth.md, depth.png."""
+        return "depth"
 
-        from fepen.atomic import replacing
-        from fepen.io import files
-        from fepen.post import study_figures
-        from fepen.post.figures import new_figure, save_figure
+    def document(self, plan: DepthPlan, result: dict, info) -> None:
+        return None
 
-        results = result["_results"]
-        fields = ["set", *Row.__dataclass_fields__, *METHODS]
-        buf = io.StringIO()
-        w = csv.DictWriter(buf, fieldnames=fields, lineterminator="\r\n")
-        w.writeheader()
-        for name, shots in results.items():
-            for s in shots:
-                w.writerow({"set": name, **s})
-        with replacing(out / "depth.csv") as tmp:
-            tmp.write_text(buf.getvalue(), newline="")
+    def tables(self, plan: DepthPlan, result: dict, info) -> list:
+        rows = [{"set": name, **s} for name, shots in result["_results"].items() for s in shots]
+        return [Table("depth.csv", ["set", *Row.__dataclass_fields__, *METHODS], rows, digits=None)]
+
+    def texts(self, plan: DepthPlan, result: dict, info) -> dict:
         note = (f"Rigid fidelity, default scene but for each shot's projectile, target strength and density"
                 f"{' and ' + ', '.join(plan.extra) if plan.extra else ''}; errors P_pred/P_meas - 1.")
-        files.write_text(out / "depth.md", markdown(result["table"], note), MPI.COMM_SELF)
-        fig = new_figure((6.6, 6.4))
-        study_figures.depth(fig, results)
-        save_figure(fig, out / "depth.png", dpi=130)
+        return {"depth.md": markdown(result["table"], note)}
+
+    def pictures(self, plan: DepthPlan, result: dict, info) -> list:
+        from fepen.post import study_figures
+
+        return [Picture("depth.png", (6.6, 6.4), lambda fig: study_figures.depth(fig, result["_results"]), 130)]
 
 
 def validate_depth(paths=(), sets=(), out="results/validate-depth", shipped: bool = True, comm=None) -> list[dict]:

@@ -32,7 +32,7 @@ from fepen.io import rundir
 from fepen.studies import queue
 
 __all__ = ["execute", "summaries", "run_shot", "run_shots", "process_shot", "How", "read_records",
-           "check_ranks_per_shot", "RECORDS", "BATCH", "chunks"]
+           "check_ranks_per_shot", "RECORDS", "BATCH", "chunks", "own_folders"]
 
 RECORDS = "shots.jsonl"
 #: the records are synced to the disk at most this often (s)
@@ -358,3 +358,28 @@ def summaries(scenes, comm=None) -> list:
         out.append(r["summary"] if r["status"] == "ok" else InputError(*r["message"].split(": ", 1))
                    if ": " in r["message"] else InputError("", r["message"]))
     return out
+
+
+def own_folders(out: Path, folder: Path, scenes, shot_folder=None, process: int = 0) -> None:
+    """Rank 0, before a study's round (its scenes, shot_folder and process as Round's): the top-level folders its
+    kept shots will be in (OUT/shots, OUT/runs, OUT/C1, ...) in the study's manifest before any group makes them
+    (the other ranks' writes, and a shot run as a process of its own, are not recorded where they happen:
+    fepen.atomic.Claim's strict owner is rank 0). A name already there stays what it is (a user's was refused
+    when the folder was claimed)."""
+    import os
+
+    from fepen import atomic
+
+    claim = atomic.claim_of(out)
+    if claim is None:
+        return
+    how = How(lambda sc: True, shot_folder, process)
+    tops = set()
+    for i in range(len(scenes)):
+        try:
+            tops.add(Path(os.path.abspath(how.where(folder, i))).relative_to(claim.dir).parts[0])
+        except (ValueError, IndexError):
+            continue
+    for top in sorted(tops):  # a study that declares no folder of its shots keeps none
+        if not os.path.lexists(claim.dir / top) and claim.declared is not None and claim.declared(top):
+            claim.own(top)

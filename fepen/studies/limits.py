@@ -151,16 +151,11 @@ class _Limit(Study):
     def scene(self, plan: LimitPlan, **keys) -> fscene.Scene:
         return fscene.Scene({**plan.base, **{k: float(v) for k, v in keys.items()}})
 
-    def write(self, plan: LimitPlan, result: dict, out, info) -> None:
-        from mpi4py import MPI
+    def pictures(self, plan: LimitPlan, result: dict, info) -> list:
+        from fepen.studies.products import Picture
 
-        from fepen.io import files
-        from fepen.post.figures import new_figure, save_figure
-
-        files.write_json(out / f"{self.json_name}.json", result, MPI.COMM_SELF)
-        fig = new_figure(self.figure_size(result))
-        self.draw(fig, result, plan)
-        save_figure(fig, out / f"{self.json_name}.png", dpi=120)
+        return [Picture(f"{self.json_name}.png", self.figure_size(result), lambda fig: self.draw(fig, result, plan),
+                        120)]
 
 
 @register
@@ -195,35 +190,38 @@ class BallisticLimit(_Limit):
     def rounds(self, plan: LimitPlan):
         lo, hi = plan.speeds
         tol = plan.tol
-        self.bisection, r = [], 0
+        r = 0
         ends = _summaries(r, (yield _round(r, [self.scene(plan, **{"impact.velocity": v}) for v in (lo, hi)])), 2)
         if _perforates(ends[0]) or not _perforates(ends[1]):
             raise InputError("--speeds", f"{lo:g} m/s must not perforate and {hi:g} m/s must "
                                          f"({ends[0]['outcome']}, {ends[1]['outcome']})")
-        self.bisection = [(lo, ends[0]["outcome"], ends[0]["residual_speed_m_s"]),
-                          (hi, ends[1]["outcome"], ends[1]["residual_speed_m_s"])]
+        bisection = [(lo, ends[0]["outcome"], ends[0]["residual_speed_m_s"]),
+                     (hi, ends[1]["outcome"], ends[1]["residual_speed_m_s"])]
         while hi - lo > tol:
             r += 1
             mid = 0.5 * (lo + hi)
             s = _summaries(r, (yield _round(r, [self.scene(plan, **{"impact.velocity": mid})])), 1)[0]
-            self.bisection.append((mid, s["outcome"], s["residual_speed_m_s"]))
+            bisection.append((mid, s["outcome"], s["residual_speed_m_s"]))
             lo, hi = (lo, mid) if _perforates(s) else (mid, hi)
-        self.bracket = (lo, hi)
+        bracket = (lo, hi)
         v_bl = 0.5 * (lo + hi)
-        self.speeds = [v_bl * (1.0 + 0.04 * (j + 1)) for j in range(plan.curve)] if plan.curve else []
-        vs = [v_bl - tol, v_bl + tol, *self.speeds]
-        self.last = _summaries(r + 1, (yield _round(r + 1, [self.scene(plan, **{"impact.velocity": v})
-                                                            for v in vs])), len(vs))
+        speeds = [v_bl * (1.0 + 0.04 * (j + 1)) for j in range(plan.curve)] if plan.curve else []
+        vs = [v_bl - tol, v_bl + tol, *speeds]
+        last = _summaries(r + 1, (yield _round(r + 1, [self.scene(plan, **{"impact.velocity": v}) for v in vs])),
+                          len(vs))
+        return {"bisection": bisection, "bracket": bracket, "speeds": speeds, "last": last}
 
     def result(self, plan: LimitPlan, records: list[dict], info) -> dict:
-        lo, hi = self.bracket
-        v_bl, tol, shots = 0.5 * (lo + hi), plan.tol, self.last
+        found = info.found
+        lo, hi = found["bracket"]
+        v_bl, tol, shots = 0.5 * (lo + hi), plan.tol, found["last"]
         check = {"below": {"v_m_s": v_bl - tol, "outcome": shots[0]["outcome"]},
                  "above": {"v_m_s": v_bl + tol, "outcome": shots[1]["outcome"],
                            "residual_speed_m_s": shots[1]["residual_speed_m_s"]}}
-        pts = [(v, s["residual_speed_m_s"]) for v, s in zip(self.speeds, shots[2:]) if _perforates(s)]
+        pts = [(v, s["residual_speed_m_s"]) for v, s in zip(found["speeds"], shots[2:]) if _perforates(s)]
         result = {"v_bl_m_s": v_bl, "bracket_m_s": [lo, hi], "tol_m_s": tol, "check": check,
-                  "bisection": [{"v_m_s": v, "outcome": o, "residual_speed_m_s": vr} for v, o, vr in self.bisection],
+                  "bisection": [{"v_m_s": v, "outcome": o, "residual_speed_m_s": vr}
+                                for v, o, vr in found["bisection"]],
                   "curve": [{"v_m_s": v, "residual_speed_m_s": vr} for v, vr in pts]}
         if len(pts) >= 3:
             a, p, rms = fit_recht_ipson([v for v, _ in pts], [vr for _, vr in pts], v_bl)
@@ -293,37 +291,39 @@ class Ricochet(_Limit):
             grid.append(top)
         pairs = [(v, ob) for v in speeds for ob in grid]
         shots = _summaries(0, (yield _round(0, [self._at(plan, v, ob) for v, ob in pairs])), len(pairs))
-        self.cells = [{"v_m_s": v, "obliquity_deg": ob, "outcome": s["outcome"]} for (v, ob), s in zip(pairs, shots)]
-        self.brackets = []
+        cells = [{"v_m_s": v, "obliquity_deg": ob, "outcome": s["outcome"]} for (v, ob), s in zip(pairs, shots)]
+        brackets = []
         for v in speeds:  # the bracket: the last grid obliquity that does not ricochet, the next that does
-            row = [c for c in self.cells if c["v_m_s"] == v]
+            row = [c for c in cells if c["v_m_s"] == v]
             rico = [c["obliquity_deg"] for c in row if c["outcome"] == "ricochet"]
             if not rico:
                 raise InputError("--obliquity-max", f"no ricochet at {v:g} m/s up to {top:g} deg")
             hi = min(rico)
             lower = [c["obliquity_deg"] for c in row if c["obliquity_deg"] < hi]
-            self.brackets.append([max(lower) if lower else 0.0, hi])
+            brackets.append([max(lower) if lower else 0.0, hi])
         r = 0
-        while any(hi - lo > tol for lo, hi in self.brackets):
+        while any(hi - lo > tol for lo, hi in brackets):
             r += 1
-            open_ = [j for j, (lo, hi) in enumerate(self.brackets) if hi - lo > tol]
-            mids = [0.5 * sum(self.brackets[j]) for j in open_]
+            open_ = [j for j, (lo, hi) in enumerate(brackets) if hi - lo > tol]
+            mids = [0.5 * sum(brackets[j]) for j in open_]
             res = _summaries(r, (yield _round(r, [self._at(plan, speeds[j], m) for j, m in zip(open_, mids)])),
                              len(open_))
             for j, m, s in zip(open_, mids, res):
-                self.cells.append({"v_m_s": speeds[j], "obliquity_deg": m, "outcome": s["outcome"]})
-                self.brackets[j][1 if s["outcome"] == "ricochet" else 0] = m
+                cells.append({"v_m_s": speeds[j], "obliquity_deg": m, "outcome": s["outcome"]})
+                brackets[j][1 if s["outcome"] == "ricochet" else 0] = m
+        return {"cells": cells, "brackets": brackets}
 
     def _at(self, plan: LimitPlan, v: float, ob: float) -> fscene.Scene:
         return fscene.Scene({**plan.base, "impact.velocity": v, "impact.obliquity_deg": float(ob)})
 
     def result(self, plan: LimitPlan, records: list[dict], info) -> dict:
-        critical = [0.5 * (lo + hi) for lo, hi in self.brackets]
+        cells, brackets = info.found["cells"], info.found["brackets"]
+        critical = [0.5 * (lo + hi) for lo, hi in brackets]
         # the envelope at the boundary's ends: the slowest and the fastest speed at its critical obliquity
         ends = {f"{v:g}": envelope_of(self._at(plan, v, c))
                 for v, c in ((plan.speeds[0], critical[0]), (plan.speeds[-1], critical[-1]))}
-        return {"speeds_m_s": plan.speeds, "critical_obliquity_deg": critical, "brackets": self.brackets,
-                "tol_deg": plan.tol, "map": self.cells, "envelope": ends}
+        return {"speeds_m_s": plan.speeds, "critical_obliquity_deg": critical, "brackets": brackets,
+                "tol_deg": plan.tol, "map": cells, "envelope": ends}
 
     def draw(self, fig, res: dict, plan: LimitPlan) -> None:
         from fepen.post import study_figures

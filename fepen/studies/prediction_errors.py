@@ -21,17 +21,17 @@ at the default mesh); without it the plastic rows of the existing table are kept
 from __future__ import annotations
 
 import csv
-import io
 import math
 from dataclasses import dataclass
 from pathlib import Path
 
 from fepen.data.prediction_errors import COLUMNS, read
 from fepen.studies import depth
+from fepen.studies.products import Table
 from fepen.studies.study import Round, Study, register
 
 __all__ = ["LAWS", "LATERAL_MIN_OBLIQUITY_DEG", "depth_rows", "lateral_scenes", "lateral_rows",
-           "plastic_lateral_rows", "write", "PredictionErrors"]
+           "plastic_lateral_rows", "PredictionErrors"]
 
 #: the concrete strength laws with prediction errors: target.strength_model -> fepen.studies.depth.METHODS name
 LAWS = {"scaled-S": "default", "forrestal-S": "forrestal-S"}
@@ -113,19 +113,8 @@ def plastic_lateral_rows(validate_dir) -> list[dict]:
     return out
 
 
-def write(rows: list[dict], path, header: str) -> None:
-    """The table, after ``# `` lines of its provenance; every number with the digits of its double."""
-    buf = io.StringIO()
-    for line in header.splitlines():
-        buf.write(f"# {line}\n")
-    w = csv.writer(buf, lineterminator="\n")
-    w.writerow(COLUMNS)
-    for r in rows:
-        w.writerow([repr(r[c]) if isinstance(r[c], float) else r[c] for c in COLUMNS])
-    from fepen.atomic import replacing
-
-    with replacing(path) as tmp:
-        tmp.write_text(buf.getvalue())
+def _table(rows: list[dict], header: str, file: str = "prediction_errors.csv", copies=()) -> Table:
+    return Table(file, COLUMNS, rows, digits=None, comments=header, copies=copies)
 
 
 @dataclass
@@ -161,18 +150,19 @@ class PredictionErrors(Study):
         return ErrorsPlan(depth.gather_sets(), plastic, table)
 
     def rounds(self, plan: ErrorsPlan):
-        self.scenes, self.where = depth.shot_scenes(plan.sets)
+        scenes, where = depth.shot_scenes(plan.sets)
         lateral = lateral_scenes()
-        yield Round([*self.scenes, *lateral], keep=lambda sc: False, label="shots")
+        yield Round([*scenes, *lateral], keep=lambda sc: False, label="shots")
+        return where
 
     def result(self, plan: ErrorsPlan, records: list, info) -> dict:
         from fepen.studies.calibration import ok_summary
         from fepen.version import __version__
 
         recs = records[0]
-        n = len(self.scenes)
+        n = len(recs) - len(_lateral_shots())
         summaries = [recs[i]["summary"] if recs[i]["status"] == "ok" else None for i in range(n)]
-        rows = depth_rows(plan.sets, depth.predictions(plan.sets, self.where, summaries))
+        rows = depth_rows(plan.sets, depth.predictions(plan.sets, info.found, summaries))
         rows += lateral_rows([ok_summary(recs[n + j]) for j in range(len(_lateral_shots()))])
         if plan.plastic:
             rows += plastic_lateral_rows(plan.plastic)
@@ -185,10 +175,14 @@ class PredictionErrors(Study):
                   "Predictions of fepen's defaults on the shipped public data (docs/uncertainty.md); lengths in m.")
         return {"rows": len(rows), "_rows": rows, "_header": header}
 
-    def write(self, plan: ErrorsPlan, result: dict, out: Path, info) -> None:
-        write(result["_rows"], out / "prediction_errors.csv", result["_header"])
-        if plan.table:
-            write(result["_rows"], plan.table, result["_header"])
+    def document(self, plan: ErrorsPlan, result: dict, info) -> None:
+        return None
+
+    def tables(self, plan: ErrorsPlan, result: dict, info) -> list:
+        return [_table(result["_rows"], result["_header"], copies=(plan.table,) if plan.table else ())]
+
+    def pictures(self, plan: ErrorsPlan, result: dict, info) -> list:
+        return []
 
     def lines(self, result: dict) -> list[str]:
         return [f"{result['rows']} rows"]

@@ -13,7 +13,8 @@ import numpy as np
 from fepen import scene as fscene
 from fepen.errors import SimulationError
 
-__all__ = ["Response", "calibrate", "calibration_scene_keys", "LAMBDA_GRID", "LAMBDA_BOUNDS", "RESISTANCE"]
+__all__ = ["Response", "calibrate", "response_scenes", "response_of", "calibration_scene_keys", "LAMBDA_GRID",
+           "LAMBDA_BOUNDS", "RESISTANCE"]
 
 #: the resistance factors of the response g: 13 log-spaced from 0.2 to 5, the middle one exactly 1
 LAMBDA_GRID = tuple(1.0 if j == 6 else float(math.exp(math.log(0.2) + j * math.log(25.0) / 12)) for j in range(13))
@@ -93,11 +94,25 @@ def calibrate(base: dict, comm=None, lambdas=LAMBDA_GRID) -> Response:
     from fepen.studies import engine
 
     comm = MPI.COMM_SELF if comm is None else comm
+    scenes = response_scenes(base, lambdas)
+    done, _, _ = engine.execute(len(scenes), lambda i: scenes[i], None, comm, keep=lambda sc: False,
+                                batch=engine.BATCH, progress=False)  # the records in memory: a second to run again
+    return response_of(done, lambdas)
+
+
+def response_scenes(base: dict, lambdas=LAMBDA_GRID) -> list:
+    """The calibration shots of the Response: the base scene's (calibration_scene_keys) at each factor."""
     keys = calibration_scene_keys(base)
-    scenes = [fscene.Scene({**keys, RESISTANCE: float(lam)}) for lam in lambdas]
-    done, _, _ = engine.execute(len(scenes), lambda i: scenes[i], None, comm, keep=lambda sc: False, batch=engine.BATCH,
-                             progress=False)  # the records in memory: a second to run again
-    records = [done[i] for i in range(len(scenes))]
+    return [fscene.Scene({**keys, RESISTANCE: float(lam)}) for lam in lambdas]
+
+
+def response_of(done: dict, lambdas=LAMBDA_GRID) -> Response:
+    """The Response from the records of the response_scenes' shots ({index: record}; as ``calibrate``).
+
+    Raises:
+        SimulationError: as ``calibrate``.
+    """
+    records = [done[i] for i in range(len(lambdas))]
     one = list(lambdas).index(1.0)
     ok = [r["status"] == "ok" and r["summary"]["outcome"] == "embedded" for r in records]
     if not ok[one]:

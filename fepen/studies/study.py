@@ -8,10 +8,13 @@ A study is four separable things (ASE's eos: produce, analyse, draw, command):
     plan(**options) -> plan          read and check everything: InputError before anything is written
     digest(plan) -> str | None       what makes its folder resumable (None: it runs again each time)
     rounds(plan)                     a generator of Rounds of shots (each ``yield`` receives the round's records),
-                                     or of Subs: whole studies run in a folder of its own
-    result(plan, records) -> dict    pure: the records in, the study's result out (rank 0)
-    write(plan, result, out)         its files (rank 0): by default NAME.json, NAME.md (report) and NAME.png
-                                     (figure, drawn on a Figure fepen.post gives it)
+                                     or of Subs: whole studies run in a folder of its own; what it returns
+                                     (what its rounds found) reaches result as info.found
+    result(plan, records, info)      pure: the records (and info.found) in, the study's result out (rank 0)
+    document, tables, texts, pictures  what it writes (rank 0): by default NAME.json, NAME.md (report) and
+                                     NAME.png (figure, drawn on a Figure fepen.post gives it); the skeleton's
+                                     write() writes them (fepen.studies.products: every table through
+                                     fepen.io.table)
     lines(result) -> list[str]       what the console says
 
 A new study is one file: a subclass with a name, its options and these methods, and ``@register``.
@@ -25,6 +28,7 @@ from dataclasses import dataclass, field
 from pathlib import Path
 
 from fepen.io import layout
+from fepen.studies.products import Inputs
 
 __all__ = ["Round", "Sub", "Study", "RunInfo", "run", "register", "get", "public", "set_option", "numbers",
            "STUDIES", "REGISTRY", "study_names"]
@@ -199,20 +203,33 @@ class Study:
     def figure_size(self, result: dict) -> tuple[float, float]:
         return (8.0, 5.0)
 
-    def write(self, plan, result: dict, out: Path, info) -> None:
-        """Its files (rank 0): NAME.json, and NAME.md and NAME.png when it has them (info: RunInfo)."""
-        from mpi4py import MPI
+    # ---- what it writes: declared here, written by the skeleton (fepen.studies.products) --------------------
+    def document(self, plan, result: dict, info) -> dict | None:
+        """NAME.json's content (default: the public result), or None: no NAME.json."""
+        return public(result)
 
-        from fepen.io import files
-        from fepen.post.figures import new_figure, save_figure
+    def tables(self, plan, result: dict, info) -> list:
+        """Its CSV tables (fepen.studies.products.Table), written by fepen.io.table."""
+        return []
 
-        files.write_json(out / f"{self.json_name}.json", public(result), MPI.COMM_SELF)
+    def texts(self, plan, result: dict, info) -> dict:
+        """Its texts, {file: text} (default NAME.md: ``report``)."""
         text = self.report(result)
-        if text is not None:
-            files.write_text(out / f"{self.json_name}.md", text, MPI.COMM_SELF)
-        fig = new_figure(self.figure_size(result))
-        if self.figure(result, fig):
-            save_figure(fig, out / f"{self.json_name}.png")
+        return {} if text is None else {f"{self.json_name}.md": text}
+
+    def pictures(self, plan, result: dict, info) -> list:
+        """Its figures (fepen.studies.products.Picture; default NAME.png: ``figure``)."""
+        from fepen.studies.products import Picture
+
+        return [Picture(f"{self.json_name}.png", self.figure_size(result), lambda fig: self.figure(result, fig))]
+
+    def write(self, plan, result: dict, out: Path, info) -> None:
+        """Its files (rank 0; info: RunInfo): what ``document``, ``tables``, ``texts`` and ``pictures`` declare,
+        written by the skeleton alone (a study never overrides this)."""
+        from fepen.studies import products
+
+        products.write(out, self.document(plan, result, info), self.json_name, self.tables(plan, result, info),
+                       self.texts(plan, result, info), self.pictures(plan, result, info), info.say)
 
     @property
     def json_name(self) -> str:
@@ -252,6 +269,8 @@ class RunInfo:
     ran: int = 0
     records: list = field(default_factory=list)
     stop: object = None  #: the study's fepen.runs.interrupts.Interrupts while its rounds run
+    out: Path | None = None  #: the study's folder (made)
+    found: object = None  #: what the rounds returned (their generator's return value: e.g. a bisection's steps)
 
     @property
     def wall_s(self) -> float:
@@ -284,7 +303,7 @@ def run(study: Study, plan, out, comm=None, ranks_per_shot: int = 1, fresh: bool
     info = RunInfo(time.perf_counter(), comm.size, ranks_per_shot, say)
     inputs = record.inputs_of(study, plan)
     with rundir.study_directory(out, comm, fresh, study.name, study.names, digest=inputs["sha256"], inputs=inputs):
-        out = files.prepare(Path(out), comm)
+        out = info.out = files.prepare(Path(out), comm)
         study.prepare(plan, out, comm)
         from fepen.runs.interrupts import Interrupts
 
@@ -336,8 +355,18 @@ def _rounds(study: Study, plan, out: Path, comm, info: RunInfo, progress: bool) 
     while True:
         try:
             rnd = gen.send(records) if records is not None else next(gen)
-        except StopIteration:
+        except StopIteration as end:
+            info.found = end.value
             return
+        if isinstance(rnd, Inputs):  # files the next rounds read, written by rank 0; every rank gets the folder
+            from fepen.io import files
+            from fepen.studies import products
+
+            files.agree(comm, str(out), lambda r=rnd: [products.write(out, None, "", r.tables, say=info.say),
+                                                       *(files.write_json(out / f, d, MPI.COMM_SELF)
+                                                         for f, d in (r.documents or {}).items())])
+            records = out
+            continue
         if isinstance(rnd, Sub):
             say = info.say if not rnd.label else (lambda *ls, n=rnd.label: info.say(*(f"{n}: {x}" for x in ls)))
             records = run(rnd.study, rnd.plan, out / rnd.folder, comm, info.ranks_per_shot, False, say, progress)
@@ -350,7 +379,7 @@ def _rounds(study: Study, plan, out: Path, comm, info: RunInfo, progress: bool) 
 
             files.agree(comm, str(folder), lambda f=folder: make_dir(f))
         if comm.rank == 0:
-            _own_folders(out, folder, rnd)
+            engine.own_folders(out, folder, rnd.scenes, rnd.shot_folder, rnd.process)
         recs, ran, halted = engine.execute(len(rnd.scenes), lambda i, s=rnd.scenes: s[i], folder, comm,
                                            info.ranks_per_shot, keep=rnd.keep, say=info.say if rnd.label else None,
                                            desc=rnd.label or "shots", batch=engine.BATCH if rnd.batch else 1,
@@ -366,28 +395,3 @@ def _rounds(study: Study, plan, out: Path, comm, info: RunInfo, progress: bool) 
         records = comm.bcast(recs if comm.rank == 0 else None, root=0) if rnd.then and comm.size > 1 else recs
         info.records.append(records)
         info.ran += ran
-
-
-def _own_folders(out: Path, folder: Path, rnd: Round) -> None:
-    """Rank 0, before the round: the top-level folders its kept shots will be in (OUT/shots, OUT/runs, OUT/C1, ...)
-    in the study's manifest before any group makes them (the other ranks' writes, and a shot run as a process of
-    its own, are not recorded where they happen: fepen.atomic.Claim's strict owner is rank 0). A name already
-    there stays what it is (a user's was refused when the folder was claimed)."""
-    import os
-
-    from fepen import atomic
-    from fepen.studies import engine
-
-    claim = atomic.claim_of(out)
-    if claim is None:
-        return
-    how = engine.How(lambda sc: True, rnd.shot_folder, rnd.process)
-    tops = set()
-    for i in range(len(rnd.scenes)):
-        try:
-            tops.add(Path(os.path.abspath(how.where(folder, i))).relative_to(claim.dir).parts[0])
-        except (ValueError, IndexError):
-            continue
-    for top in sorted(tops):  # a study that declares no folder of its shots keeps none
-        if not os.path.lexists(claim.dir / top) and claim.declared is not None and claim.declared(top):
-            claim.own(top)

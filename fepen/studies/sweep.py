@@ -9,14 +9,14 @@ figures (fepen.post.study_figures). A Study (fepen.studies.study) of one round, 
 
 from __future__ import annotations
 
-import csv
-import io
 from dataclasses import dataclass
 from pathlib import Path
 
 import numpy as np
 
 from fepen.errors import InputError
+from fepen.studies import products
+from fepen.studies.products import Picture, Table
 from fepen.studies.spec import DISTRIBUTIONS, IMPACT, MAX_SHOTS, monte_carlo, read, resized
 from fepen.studies.spec import Spec as Sweep
 from fepen.studies.study import Round, Study, register
@@ -73,62 +73,30 @@ def table_rows(sweep: Sweep, records: dict) -> tuple[list, list]:
     return cols, rows
 
 
-def _fmt(v, digits: int) -> str:
-    if isinstance(v, bool):
-        return str(v).lower()
-    if isinstance(v, float):
-        return f"{v:.{digits}g}"
-    return "" if v is None else str(v)
+def tables(sweep: Sweep, records: dict) -> tuple[list, list, list]:
+    """sweep.csv (and sweep.parquet with pyarrow: the extra ``parquet``) and costs.csv, declared for the skeleton's
+    writer (fepen.studies.products); (the tables, sweep.csv's columns, its rows).
+
+    Args:
+        sweep: the sweep. records: {shot: record}.
+    """
+    cols, rows = table_rows(sweep, records)
+    costs = [[i, records[i].get("wall_s", float("nan")), records[i].get("ranks", "")] for i in sorted(records)]
+    return ([Table("sweep.csv", cols, rows, sweep.digits, parquet=True),
+             Table("costs.csv", ["shot", "wall_s", "ranks"], costs, sweep.digits)], cols, rows)
 
 
 def write_table(sweep: Sweep, records: dict, out: Path, say=None) -> tuple[list, list]:
-    """sweep.csv (and sweep.parquet with pyarrow: the extra ``parquet``) and costs.csv; (columns, rows).
+    """sweep.csv, sweep.parquet and costs.csv alone (the skeleton writes them with the rest); (columns, rows).
 
     Args:
         sweep: the sweep. records: {shot: record}. out: the results directory.
         say: prints the one line saying why sweep.parquet was not written (pyarrow absent, or failing to import,
             as a release built for numpy 2 does beside numpy 1.24), or None.
     """
-    from fepen.atomic import replacing
-
-    cols, rows = table_rows(sweep, records)
-    buf = io.StringIO()
-    w = csv.writer(buf, lineterminator="\n")
-    w.writerow(cols)
-    for r in rows:
-        w.writerow([_fmt(r.get(c), sweep.digits) for c in cols])
-    with replacing(out / "sweep.csv", ".csv") as tmp:
-        tmp.write_text(buf.getvalue())
-    buf = io.StringIO()
-    w = csv.writer(buf, lineterminator="\n")
-    w.writerow(["shot", "wall_s", "ranks"])
-    for i in sorted(records):
-        w.writerow([i, f"{records[i].get('wall_s', float('nan')):.4g}", records[i].get("ranks", "")])
-    with replacing(out / "costs.csv", ".csv") as tmp:
-        tmp.write_text(buf.getvalue())
-    why = parquet_unavailable()
-    if why is None:
-        import pyarrow as pa
-        import pyarrow.parquet as pq
-
-        with replacing(out / "sweep.parquet", ".parquet") as tmp:
-            pq.write_table(pa.table({c: [r.get(c) for r in rows] for c in cols}), str(tmp))
-    elif say is not None:
-        say(f"sweep.parquet not written: {why}")
+    written, cols, rows = tables(sweep, records)
+    products.write(out, None, "sweep", written, say=say)
     return cols, rows
-
-
-def parquet_unavailable() -> str | None:
-    """Why sweep.parquet cannot be written here (one line), or None when pyarrow imports."""
-    try:
-        import pyarrow  # noqa: F401
-        import pyarrow.parquet  # noqa: F401
-    except ModuleNotFoundError:
-        return "pyarrow is not installed (pip install 'fepen[parquet]': a pyarrow that works with numpy 1.24)"
-    except Exception as err:  # noqa: BLE001 - an ImportError of a build for numpy 2, or anything it raises
-        text = " ".join(str(err).split()) or type(err).__name__
-        return f"pyarrow failed to import ({text}); pip install 'pyarrow>=14,<26' (the extra 'parquet')"
-    return None
 
 
 # -------------------------------------------------------------------------------------------------- the study
@@ -198,16 +166,18 @@ class SweepStudy(Study):
         cols, rows = table_rows(plan.spec, recs)
         return {"shots": len(plan.spec.shots), "statuses": statuses, "_records": recs, "_cols": cols, "_rows": rows}
 
-    def write(self, plan: SweepPlan, result: dict, out: Path, info) -> None:
-        from mpi4py import MPI
+    def document(self, plan: SweepPlan, result: dict, info) -> None:
+        return None
 
-        from fepen.io import files
+    def tables(self, plan: SweepPlan, result: dict, info) -> list:
+        return tables(plan.spec, result["_records"])[0]
 
-        sw = plan.spec
-        write_table(sw, result["_records"], out, info.say)
-        draw(sw, result["_cols"], result["_rows"], out)
-        files.write_text(out / "sweep.md", report(sw, result["_rows"], info.wall_s, info.ran, info.ranks,
-                                                  info.ranks_per_shot), MPI.COMM_SELF)
+    def texts(self, plan: SweepPlan, result: dict, info) -> dict:
+        return {"sweep.md": report(plan.spec, result["_rows"], info.wall_s, info.ran, info.ranks,
+                                   info.ranks_per_shot)}
+
+    def pictures(self, plan: SweepPlan, result: dict, info) -> list:
+        return pictures(plan.spec, result["_cols"], result["_rows"])
 
     def lines(self, result: dict) -> list[str]:
         return []
@@ -295,29 +265,31 @@ def _title(sweep, rows) -> str:
     return f"{sweep.kind} sweep, {len(rows)} shots" + (f", {', '.join(sorted(fid))} fidelity" if fid else "")
 
 
-def draw(sweep, cols, rows, out: Path) -> list[Path]:
+def pictures(sweep, cols, rows) -> list:
     """sweep.png and, for a Monte Carlo sample, histograms.png (fepen.post.study_figures), with what only the
     scene knows handed over: each varied key's axis label, unit factor and test value, the measured shot, the
-    title. Returns the files written."""
+    title (fepen.studies.products.Picture)."""
     from fepen.post import study_figures as sf
-    from fepen.post.figures import new_figure, save_figure
 
     shot = measured_shot(sweep)
     axes = [(k, *key_axis(k), _test_x(sweep, shot, k) if shot is not None else None) for k in sweep.keys]
     title = _title(sweep, rows)
-    written = []
+    out = []
     size = sf.sweep_size(axes, rows)
     if size is not None:
-        fig = new_figure(size)
-        sf.sweep_figure(fig, axes, rows, shot, title)
-        written.append(save_figure(fig, out / "sweep.png"))
-    if sweep.kind == "monte-carlo":
-        names = sf.histogram_names(cols, rows)
-        if names:
-            fig = new_figure((4.4 * len(names), 3.8))
-            sf.histograms(fig, names, rows, shot, title)
-            written.append(save_figure(fig, out / "histograms.png"))
-    return written
+        out.append(Picture("sweep.png", size, lambda fig: sf.sweep_figure(fig, axes, rows, shot, title)))
+    names = sf.histogram_names(cols, rows) if sweep.kind == "monte-carlo" else []
+    if names:
+        out.append(Picture("histograms.png", (4.4 * len(names), 3.8),
+                           lambda fig: sf.histograms(fig, names, rows, shot, title)))
+    return out
+
+
+def draw(sweep, cols, rows, out: Path) -> list[Path]:
+    """The pictures of a sweep's table, written into ``out`` alone; the files written."""
+    pics = pictures(sweep, cols, rows)
+    products.write(out, None, "sweep", pictures=pics)
+    return [Path(out) / p.file for p in pics]
 
 
 def report(sweep, rows, wall_s: float, ran: int, ranks: int, ranks_per_shot: int) -> str:

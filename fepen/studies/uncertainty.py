@@ -29,9 +29,7 @@ concrete as it is for the public sets. OUT/uncertainty.json, uncertainty.md and 
 
 from __future__ import annotations
 
-import csv
 import hashlib
-import io
 import json
 from dataclasses import dataclass
 from pathlib import Path
@@ -39,10 +37,11 @@ from pathlib import Path
 import numpy as np
 
 from fepen import scene as fscene
-from fepen.errors import InputError, SimulationError
+from fepen.errors import InputError
 from fepen.stats.sampling import draw_model_errors
+from fepen.studies.products import Inputs, Picture, Table
 from fepen.studies.resistance import LAMBDA_BOUNDS, LAMBDA_GRID, RESISTANCE, Response, calibrate
-from fepen.studies.study import Study, Sub, register, set_option
+from fepen.studies.study import Round, Study, Sub, register, set_option
 
 __all__ = ["Uncertainty", "Response", "Plan", "LAMBDA_GRID", "LAMBDA_BOUNDS", "calibrate", "plan", "study",
            "RESISTANCE"]
@@ -211,20 +210,10 @@ def model_of(sc: fscene.Scene):
     return m, None
 
 
-# ------------------------------------------------------------------------------------------------- tables
-def _csv(rows: list, cols: list) -> str:
-    buf = io.StringIO()
-    w = csv.writer(buf, lineterminator="\n")
-    w.writerow(cols)
-    for r in rows:
-        w.writerow([repr(float(r[c])) if isinstance(r[c], float) else r[c] for c in cols])
-    return buf.getvalue()
-
-
 # ------------------------------------------------------------------------------------------------- the study
 #: what the uncertainty study writes into its folder (fepen.io.rundir.study_directory)
-UNCERTAINTY_NAMES = ("uncertainty_input.json", "combined.csv", "model_draws.csv", "inputs.csv", "combined", "inputs",
-                     "uncertainty.json", "uncertainty.md", "uncertainty.png")
+UNCERTAINTY_NAMES = ("uncertainty_input.json", "response", "combined.csv", "model_draws.csv", "inputs.csv", "combined",
+                     "inputs", "uncertainty.json", "uncertainty.md", "uncertainty.png")
 
 
 @register
@@ -272,70 +261,52 @@ class Uncertainty(Study):
         return hashlib.sha256(json.dumps([p.base, p.inputs, p.seed, p.model_scatter], sort_keys=True,
                                          default=str).encode()).hexdigest()
 
-    def prepare(self, p: Plan, out: Path, comm) -> None:
-        """The response and the model's draws (rank 0, told to every rank), then the tables of what is drawn."""
-        from mpi4py import MPI
-
-        from fepen.io import files
-        from fepen.runs import setup
-        from fepen.stats import envelope
-
-        sc = p.scene
-        verdict = envelope.verdict(setup.envelope_facts(sc, setup.check_supported(sc)))
-        verdict["line"] = envelope.line(verdict)
-        m, why, response, draws = _model_draws(p, sc, comm)
-        combined = [{**s, RESISTANCE: float(draws["lambda"][i])} for i, s in enumerate(p.inputs)] \
-            if m is not None else None
-        inputs = (p.inputs if p.keys else [{}]) if (m is None or p.rigid) else None
-        self.drawn = (m, why, response, draws, combined, inputs, verdict)
-        if comm.rank == 0:
-            files.write_json(out / "uncertainty_input.json", {"digest": self.digest(p), "scatter": p.scatter,
-                                                              "samples": p.samples, "seed": p.seed}, MPI.COMM_SELF)
-            _write_tables(out, p, combined, inputs, draws)
-        comm.barrier()
-        self.out = out
-
     def rounds(self, p: Plan):
+        """The response's shots (a round of their own, resumable), the tables of what is drawn (written before the
+        samples' sweeps read them), then the sweeps; returns what was drawn (``_drawn``)."""
         from fepen.studies import sweep
+        from fepen.studies.resistance import response_scenes
 
-        m, why, response, draws, combined, inputs, verdict = self.drawn
+        m, why = model_of(p.scene) if p.model_scatter else (None, "--no-model-scatter")
+        records = (yield Round(response_scenes(p.base), folder="response", keep=lambda sc: False, label="",
+                               then=True)) if m is not None else None
+        drawn = _drawn(p, m, why, records)
+        m, why, response, draws, combined, inputs, verdict = drawn
+        out = yield Inputs(tuple(_tables(p, combined, inputs, draws)), {"uncertainty_input.json": {
+            "digest": self.digest(p), "scatter": p.scatter, "samples": p.samples, "seed": p.seed}})
         for name, rows, table in (("combined", combined, "combined.csv"), ("inputs", inputs, "inputs.csv")):
             if rows is None:
                 continue
-            spec = ({"base": dict(p.base), "table": {"file": str((self.out / table).resolve())}} if p.keys or name ==
+            spec = ({"base": dict(p.base), "table": {"file": str((out / table).resolve())}} if p.keys or name ==
                     "combined" else {"base": dict(p.base), "grid": {RESISTANCE: [1.0]}})
             st = sweep.SweepStudy()
             yield Sub(st, st.plan(spec), name, label=name)
+        return drawn
 
     def result(self, p: Plan, records: list, info) -> dict:
         from fepen.studies import uncertainty_report as ur
 
-        m, why, response, draws, combined, inputs, verdict = self.drawn
-        return ur.results(p, p.scene, self.out, m, why, response, draws, combined, inputs, verdict, info.wall_s,
-                          info.ranks, info.ranks_per_shot)
+        m, why, response, draws, combined, inputs, verdict = info.found
+        return {**ur.results(p, p.scene, info.out, m, why, response, draws, combined, inputs, verdict, info.wall_s,
+                             info.ranks, info.ranks_per_shot), "_out": info.out}
 
     def report(self, result: dict) -> str:
         from fepen.studies import uncertainty_report as ur
 
         return ur.report(result)
 
-    def figure_size(self, result: dict) -> tuple[float, float]:
-        return (17, 4.8)
-
-    def figure(self, result: dict, fig) -> bool:
+    def pictures(self, p: Plan, result: dict, info) -> list:
         from fepen.post import study_figures
         from fepen.studies import uncertainty_report as ur
 
-        m, why, response, draws, combined, inputs, verdict = self.drawn
-        study_figures.uncertainty(fig, result, ur.depths(self.out, combined, inputs),
-                                  ur.fans(self.out, combined, inputs))
-        return True
+        combined, inputs, out = info.found[4], info.found[5], info.out
+        return [Picture("uncertainty.png", (17, 4.8), lambda fig: study_figures.uncertainty(
+            fig, result, ur.depths(out, combined, inputs), ur.fans(out, combined, inputs)))]
 
     def lines(self, result: dict) -> list[str]:
         from fepen.studies import uncertainty_report as ur
 
-        return ur.lines(result, self.out)
-
+        return ur.lines(result, result["_out"])
 
 def study(p: Plan, out, comm=None, ranks_per_shot: int = 1, fresh: bool = False, say=print,
           progress: bool = True) -> dict:
@@ -350,39 +321,40 @@ def study(p: Plan, out, comm=None, ranks_per_shot: int = 1, fresh: bool = False,
     return {k: v for k, v in res.items() if k != "ran"}
 
 
-def _model_draws(p: Plan, sc, comm) -> tuple:
-    """(the ErrorModel or None, why none or None, the Response, the draws with their "lambda") of the study:
-    the response calibrated on rank 0 (its error raised on every rank), the draws the same on every rank."""
-    m, why = model_of(sc) if p.model_scatter else (None, "--no-model-scatter")
-    if m is None:
-        return None, why, None, None
-    res = None
-    if comm.rank == 0:
-        try:
-            res = calibrate(p.base)
-        except SimulationError as err:
-            res = err
-    res = comm.bcast(res, root=0)
-    if isinstance(res, SimulationError):
-        raise res
-    speeds = [s.get("impact.velocity", sc.impact.velocity) for s in p.inputs]
-    draws = draw_model_errors(m, speeds, p.seed)
-    draws["speed_m_s"] = np.array(speeds, float)
-    draws["lambda"] = np.clip(res.inverse(np.exp(draws["eps"])), *LAMBDA_BOUNDS)
-    return m, None, res, draws
+def _drawn(p: Plan, m, why, records) -> tuple:
+    """What the study draws, the same on every rank: (the ErrorModel or None, why none, the Response, the draws
+    with their "lambda", the combined sample's rows, the input scatter's rows, the envelope's verdict), from the
+    response shots' records (None without a model)."""
+    from fepen.runs import setup
+    from fepen.stats import envelope
+    from fepen.studies.resistance import response_of
+
+    sc = p.scene
+    verdict = envelope.verdict(setup.envelope_facts(sc, setup.check_supported(sc)))
+    verdict["line"] = envelope.line(verdict)
+    response = draws = None
+    if m is not None:
+        response = response_of(records)
+        speeds = [s.get("impact.velocity", sc.impact.velocity) for s in p.inputs]
+        draws = draw_model_errors(m, speeds, p.seed)
+        draws["speed_m_s"] = np.array(speeds, float)
+        draws["lambda"] = np.clip(response.inverse(np.exp(draws["eps"])), *LAMBDA_BOUNDS)
+    combined = [{**s, RESISTANCE: float(draws["lambda"][i])} for i, s in enumerate(p.inputs)] \
+        if m is not None else None
+    inputs = (p.inputs if p.keys else [{}]) if (m is None or p.rigid) else None
+    return m, why, response, draws, combined, inputs, verdict
 
 
-def _write_tables(out: Path, p: Plan, combined, inputs, draws) -> None:
-    """combined.csv, model_draws.csv, inputs.csv (rank 0): the record of what was drawn."""
-    from mpi4py import MPI
-
-    from fepen.io import files
-
+def _tables(p: Plan, combined, inputs, draws) -> list:
+    """combined.csv, model_draws.csv, inputs.csv: the record of what was drawn (each number the digits of its
+    double)."""
+    out = []
     if combined is not None:
-        files.write_text(out / "combined.csv", _csv(combined, [*p.keys, RESISTANCE]), MPI.COMM_SELF)
+        out.append(Table("combined.csv", [*p.keys, RESISTANCE], combined, digits=None))
         rows = [{"shot": i, "speed_m_s": float(draws["speed_m_s"][i]), "b": float(draws["b"][i]),
                  "e": float(draws["e"][i]), "eps": float(draws["eps"][i]), "sigma": float(draws["sigma"][i]),
                  RESISTANCE: float(draws["lambda"][i])} for i in range(len(combined))]
-        files.write_text(out / "model_draws.csv", _csv(rows, list(rows[0])), MPI.COMM_SELF)
+        out.append(Table("model_draws.csv", list(rows[0]), rows, digits=None))
     if inputs is not None and p.keys:
-        files.write_text(out / "inputs.csv", _csv(inputs, p.keys), MPI.COMM_SELF)
+        out.append(Table("inputs.csv", p.keys, inputs, digits=None))
+    return out

@@ -10,16 +10,14 @@ the test's final projectile, fepen.post.paths; ``python -m fepen.post.paths`` pu
 
 from __future__ import annotations
 
-import csv
-import io
 from dataclasses import dataclass
-from pathlib import Path
 
 import numpy as np
 
 from fepen import scene as fscene
 from fepen.data import SHOTS
 from fepen.errors import InputError
+from fepen.studies.products import Picture, Table
 from fepen.studies.study import Round, Study, register
 
 __all__ = ["Validate", "validate", "table", "FIELDS"]
@@ -82,29 +80,25 @@ class Validate(Study):
                          "outcome": s["outcome"], "wall_s": s["wall_s"]})
         return {"rows": rows}
 
-    def write(self, plan: ValidatePlan, result: dict, out: Path, info) -> None:
-        from mpi4py import MPI
+    def document(self, plan: ValidatePlan, result: dict, info) -> None:
+        return None
 
-        from fepen.io import files
+    def tables(self, plan: ValidatePlan, result: dict, info) -> list:
+        return [Table("validation.csv", FIELDS, result["rows"])]
+
+    def texts(self, plan: ValidatePlan, result: dict, info) -> dict:
+        return {"validation.md": table(result["rows"], plan.scenes["C1"])}
+
+    def pictures(self, plan: ValidatePlan, result: dict, info) -> list:
         from fepen.post import paths, study_figures
-        from fepen.post.figures import new_figure, save_figure
 
-        rows = result["rows"]
-        buf = io.StringIO()
-        w = csv.DictWriter(buf, FIELDS)
-        w.writeheader()
-        for r in rows:
-            w.writerow({k: (f"{v:.6g}" if isinstance(v, float) else v) for k, v in r.items()})
-        files.write_text(out / "validation.csv", buf.getvalue(), MPI.COMM_SELF)
-        files.write_text(out / "validation.md", table(rows, plan.scenes["C1"]), MPI.COMM_SELF)
-        fig = new_figure((15, 4.6))
-        study_figures.validation(fig, rows, out)
-        save_figure(fig, out / "validation.png", dpi=110)
-        paths.paths_figure({plan.scenes["C1"].effects.fidelity: out}, out / "paths.png")
-        if all((out / r["shot"] / "hazard.csv").is_file() for r in rows):
-            fig = new_figure((12, 3.8))
-            study_figures.hazard_maps(fig, out)
-            save_figure(fig, out / "hazard_maps.png", dpi=110)
+        rows, out = result["rows"], info.out
+        hazards = all((out / r["shot"] / "hazard.csv").is_file() for r in rows)
+        return [Picture("validation.png", (15, 4.6), lambda fig: study_figures.validation(fig, rows, out), 110),
+                Picture("paths.png", paths.size(),
+                        lambda fig: paths.draw(fig, {plan.scenes["C1"].effects.fidelity: out})),
+                Picture("hazard_maps.png", (12, 3.8),
+                        lambda fig: study_figures.hazard_maps(fig, out) if hazards else False, 110)]
 
     def lines(self, result: dict) -> list[str]:
         return [f"{r['shot']}: Hx {r['Hx_mm']:.1f}/{r['Hx_exp_mm']:g} Hy {r['Hy_mm']:.1f}/{r['Hy_exp_mm']:g} "

@@ -94,16 +94,16 @@ class WearCalibration(Study):
     def rounds(self, plan: WearPlan):
         a, D0, eta, r = plan.a, plan.D0, plan.eta, 0
         sets = calibration.load_sets()
-        self.log = []
+        log = []
         for it in range(6):
-            self.log.append(f"iteration {it + 1}: a {a:.4g}, D0 {D0 * 1e3:.4g} mm")
+            log.append(f"iteration {it + 1}: a {a:.4g}, D0 {D0 * 1e3:.4g} mm")
             e, prev = eta, None
             for _ in range(12):  # step 1: a secant iteration in eta
                 scenes = table1_scenes(e, a, D0)
                 recs = yield Round(scenes, folder=f"rounds/{r:03d}", label="", then=True)
                 r += 1
                 loss = max(s["mass_loss_percent"] for s in _summaries(recs, len(scenes))) / 100.0
-                self.log.append(f"  eta {e:.5f}: largest mass loss {loss:.3%}")
+                log.append(f"  eta {e:.5f}: largest mass loss {loss:.3%}")
                 if abs(loss / TARGET_MASS_LOSS - 1.0) < 1e-3:
                     break
                 new = e * TARGET_MASS_LOSS / loss if prev is None or prev[1] == loss else (
@@ -115,23 +115,24 @@ class WearCalibration(Study):
             table = calibration.table_of(sets, [calibration.shipped_node()],
                                          [calibration.positions(s) for s in _summaries(recs, len(js))])
             a, D0, obj = calibration.fit(sets, list(table[0]))
-            self.log.append(f"  eta {e:.5f} -> refit: a {a:.4g}, D0 {D0 * 1e3:.4g} mm, objective {obj:.4f}")
+            log.append(f"  eta {e:.5f} -> refit: a {a:.4g}, D0 {D0 * 1e3:.4g} mm, objective {obj:.4f}")
             done = abs(e / eta - 1.0) < 0.01 and it > 0
             eta = e
             if done:
                 break
         scenes = table1_scenes(eta, a, D0)
-        self.final = (eta, a, D0, _summaries((yield Round(scenes, folder=f"rounds/{r:03d}", label="", then=True)),
-                                             len(scenes)))
+        shots = _summaries((yield Round(scenes, folder=f"rounds/{r:03d}", label="", then=True)), len(scenes))
+        return eta, a, D0, shots, log
 
     def result(self, plan: WearPlan, records: list, info) -> dict:
-        eta, a, D0, shots = self.final
-        return {"efficiency": eta, "coefficient": a, "size_m": D0,
+        eta, a, D0, shots, log = info.found
+        return {"efficiency": eta, "coefficient": a, "size_m": D0, "_log": log,
                 "shots": [{"shot": s["experiment"]["shot"], "mass_loss_percent": s["mass_loss_percent"],
                            "length_change_mm": s["length_change_mm"]} for s in shots]}
 
     def report(self, result: dict) -> str:
-        return "\n".join(["# The calibration of the wear law", "", "```", *self.log, *self.lines(result), "```", ""])
+        return "\n".join(["# The calibration of the wear law", "", "```", *result["_log"], *self.lines(result), "```",
+                          ""])
 
     def lines(self, result: dict) -> list[str]:
         return [f"== chosen: efficiency {result['efficiency']:.4g}, coefficient {result['coefficient']:.4g}, size "

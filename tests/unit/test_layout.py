@@ -160,3 +160,36 @@ def test_no_study_module_draws_or_reaches_into_another_s_private_names():
             if m.group(1) in mods and m.group(1) != p.stem:
                 bad.append(f"{p.name}: {m.group(0)}")
     assert not bad, bad
+
+
+def test_one_csv_writer():
+    """Every CSV fepen writes goes through fepen.io.table (issue 60): no other module makes a csv writer, calls
+    numpy's savetxt, or joins a header line by hand for a .csv file."""
+    import re
+
+    package = Path(__file__).resolve().parents[2] / "fepen"
+    bad = []
+    for p in sorted(package.rglob("*.py")):
+        if p == package / "io" / "table.py":
+            continue
+        text = p.read_text()
+        for pattern in (r"csv\.writer\(", r"csv\.DictWriter\(", r"\.savetxt\(", r"lineterminator"):
+            if re.search(pattern, text):
+                bad.append(f"{p.relative_to(package)}: {pattern}")
+    assert not bad, bad
+
+
+def test_no_study_writes_its_own_files():
+    """A study declares what it writes (document, tables, texts, pictures) and the skeleton's write() writes it
+    (fepen.studies.products): no study class overrides write()."""
+    import importlib
+
+    from fepen.studies import study
+
+    for name in study.STUDIES:
+        cls = study.get(name)
+        assert cls.write is study.Study.write, f"{name} ({cls.__name__}) overrides write()"
+    for mod in {m for m, _ in study.STUDIES.values()}:
+        importlib.import_module(mod)
+    for cls in study.Study.__subclasses__():
+        assert "write" not in vars(cls), cls.__name__

@@ -55,9 +55,10 @@ def test_finished_runs_of_a_folder(tmp_path):
 
 
 def test_history_text_formats_each_row_once_and_gives_the_whole_text(tmp_path):
-    """history.csv is replaced whole at every output: a run's HistoryText formats only the rows added since
-    its last write, and its text is, to the character, that of every row formatted afresh; a list whose
-    earlier rows changed (a row inserted at its head, as the batched rigid path does) is formatted again."""
+    """history.csv is replaced whole at every output: a run's history_rows() formats only the rows added since
+    its last write (fepen.io.table.Rows), and its text is, to the character, that of every row formatted afresh;
+    a list whose earlier rows changed (a row inserted at its head, as the batched rigid path does) is formatted
+    again."""
     import csv
     import io
 
@@ -69,7 +70,7 @@ def test_history_text_formats_each_row_once_and_gives_the_whole_text(tmp_path):
         return buf.getvalue()
 
     rng = np.random.default_rng(3)
-    text, rows = results.HistoryText(), []
+    text, rows = results.history_rows(), []
     for n in (1, 5, 0, 40, 3):
         rows.extend(list(rng.normal(size=6) * 10.0 ** rng.integers(-9, 9)) for _ in range(n))
         assert text.of(rows) == afresh(rows)
