@@ -1,24 +1,29 @@
-"""The checks across scene keys and their list: every refusal in fepen.scene.resolve is a registered check with
-its one-line description, every registered check runs, and the list ``fepen keys`` prints is the one
-docs/scenes.md shows."""
+"""The checks across scene keys and their list: every refusal in fepen.scene (resolve, checks, reading) is a
+registered check with its one-line description, every registered check runs, and the list ``fepen keys`` prints
+is the one docs/scenes.md shows."""
 
 import ast
 import inspect
 from pathlib import Path
 
 from fepen import scene
-from fepen.scene import resolve
+from fepen.scene import checks, reading, resolve
+
+MODULES = (resolve, checks, reading)
 
 ROOT = Path(__file__).resolve().parents[3]
 HEADER = "Checks across keys, before anything is meshed (bad input, exit 2, naming the key):"
 
-#: the functions of resolve.py that refuse what the user gave before any key is known: not checks across keys
-PARSING = {"flatten", "unknown_key", "parse_set", "_check_sets", "read_toml", "read_capped", "_given", "resolve"}
+#: the functions that refuse what the user gave before any key is known: not checks across keys
+PARSING = {"flatten", "unknown_key", "parse_set", "check_sets", "read_toml", "read_capped", "given_from", "resolve"}
 
 
 def _functions() -> dict[str, ast.FunctionDef]:
-    tree = ast.parse(Path(inspect.getfile(resolve)).read_text())
-    return {n.name: n for n in ast.walk(tree) if isinstance(n, ast.FunctionDef)}
+    out = {}
+    for m in MODULES:
+        tree = ast.parse(Path(inspect.getfile(m)).read_text())
+        out.update({n.name: n for n in ast.walk(tree) if isinstance(n, ast.FunctionDef)})
+    return out
 
 
 def _raises_input_error(fn: ast.FunctionDef) -> bool:
@@ -44,9 +49,10 @@ def test_every_refusal_is_a_registered_check():
 
 def test_every_registered_check_runs():
     """Each registered function is called (or passed on to be called) somewhere besides its definition."""
-    source = Path(inspect.getfile(resolve)).read_text()
-    tree = ast.parse(source)
-    used = {n.id for n in ast.walk(tree) if isinstance(n, ast.Name) and isinstance(n.ctx, ast.Load)}
+    used = set()
+    for m in MODULES:
+        tree = ast.parse(Path(inspect.getfile(m)).read_text())
+        used |= {n.id for n in ast.walk(tree) if isinstance(n, ast.Name) and isinstance(n.ctx, ast.Load)}
     missing = [f.__name__ for _, f in scene.registered_checks() if f.__name__ not in used]
     assert not missing, f"registered but never run: {missing}"
 
