@@ -14,7 +14,7 @@ from mpi4py import MPI
 from fepen import dolfinx_api as dx
 from fepen.errors import SimulationError
 from fepen.laws import materials as M
-from fepen.solver import assembly, ckernel, failures, kernels, reference
+from fepen.solver import assembly, ckernel, failures, kernels, reference, time_step
 from fepen.solver import state as st
 
 dx.quiet()  # quiet dolfinx wherever the solver is used
@@ -41,11 +41,6 @@ class StepTimes:
 
 #: steps between two evaluations of the stable step
 STEP_EVERY = 4
-#: a landing time closer than this fraction of the stable step is not landed on (the output it is for is
-#: written at the step after, as without landing): no step that short
-LANDING_SLIVER = 1e-6
-#: the eigenvalue step's gain over the altitude estimate is rounded down to a multiple of this (calibrate_step)
-GAIN_QUANTUM = 0.005
 
 
 class Load(Protocol):
@@ -175,20 +170,18 @@ class ExplicitSolver:
         return self.X + self.U
 
     def stable_step(self) -> float:
-        """Safety x min over cells of (shortest altitude / dilatational speed), current mesh, all ranks."""
-        # a scratch array: nodal_vol must keep the ghost-summed volumes of the last step (energies use them)
-        _, _, h_c, _ = kernels.volumes_and_step(self.positions(), self.dofs, self.orient, self.vol0,
-                                                       self.mat, self.cell.speed, np.empty(self.n_cells))
-        return self.clock.safety * self.clock.step_gain * self.comm.allreduce(h_c, op=MPI.MIN)
+        """Safety x min over cells of (shortest altitude / dilatational speed), current mesh, all ranks
+        (fepen.solver.time_step.stable)."""
+        return time_step.stable(self)
 
     def calibrate_step(self, iterations: int = 400, rtol: float = 1e-5) -> tuple[float, float]:
-        """The critical step of the undeformed body by power iteration; sets ``step_gain`` (module function
-        calibrate_step: the method's documentation).
+        """The critical step of the undeformed body by power iteration; sets ``step_gain``
+        (fepen.solver.time_step.calibrate: the method's documentation).
 
         Returns:
             (critical step of the undeformed body (s), step_gain).
         """
-        return calibrate_step(self, iterations, rtol)
+        return time_step.calibrate(self, iterations, rtol)
 
     def set_initial(self, displacement=None, velocity=None) -> None:
         """Initial displacement (a rigid placement of the stress-free body) and velocity, as callables of
@@ -207,7 +200,7 @@ class ExplicitSolver:
         self.node.a_fn.x.scatter_forward()
         self.sums.ke0 = self.kinetic_energy(self.Vel)
         self.clock.dt_stable = self.clock.dt0 = self.clock.dt_min = self.stable_step()
-        _choose_step(self)
+        time_step.choose(self)
         if self.interface is not None:
             self.interface(self)
 
@@ -345,19 +338,15 @@ class ExplicitSolver:
         self.clock.times.update += perf_counter() - t0
         if self.step_count % STEP_EVERY == 1:
             self._new_step(h_c)
-        _choose_step(self)
+        time_step.choose(self)
         if self.interface is not None:
             t0 = perf_counter()
             self.interface(self)
             self.clock.times.boundary += perf_counter() - t0
 
     def _new_step(self, h_c: float) -> None:
-        """The next Δt from this rank's h/c (all ranks agree), or SimulationError if it collapsed."""
-        new = self.clock.safety * self.clock.step_gain * self.comm.allreduce(h_c, op=MPI.MIN)
-        if not (new > 1e-3 * self.clock.dt0):
-            failures.step_collapsed(self, h_c, new)
-        self.clock.dt_stable = new
-        self.clock.dt_min = min(self.clock.dt_min, new)
+        """The next stable Δt from this rank's h/c (fepen.solver.time_step.new_stable)."""
+        time_step.new_stable(self, h_c)
 
     def state(self) -> dict[str, np.ndarray]:
         """This rank's state between two steps: STATE_ARRAYS, the reference positions ``X`` and the
@@ -398,80 +387,6 @@ def _set(s: ExplicitSolver, where: str, value) -> None:
     """Set the solver's value at a dotted path."""
     *path, last = where.split(".")
     setattr(_get(s, ".".join(path)) if path else s, last, value)
-
-
-def _choose_step(s: ExplicitSolver) -> None:
-    """The coming step ``s.dt``: the stable step, or, with a landing time ahead (``s.landing``), the time to it
-    (of the outputs whose interval is at least the stable step) cut into the fewest equal steps no longer than
-    the stable step, the last of which ends on it (central
-    differences take any shorter step; the stable step bounds it from above). Equal steps, not one short one
-    before each landing: a step that changes every interval pumps energy into the highest modes (a C3 run at
-    300 m/s, elastic: an energy error of 2.6e-3 with one short step per microsecond, 1.2e-5 without landing)."""
-    dt, s.clock.land_at = s.clock.dt_stable, -1.0
-    if s.landing is not None:
-        target = s.landing(s.t, dt)
-        r = target - s.t
-        if LANDING_SLIVER * dt < r < math.inf:
-            n = max(1, math.ceil(r / dt * (1.0 - 1e-12)))
-            dt = r / n
-            if n == 1:
-                s.clock.land_at = target
-    s.dt = dt
-
-
-def calibrate_step(s: ExplicitSolver, iterations: int = 400, rtol: float = 1e-5) -> tuple[float, float]:
-    """The critical step 2/ω_max of the undeformed, unstressed body, by power iteration on M⁻¹K.
-
-    K d is the internal force of a tiny displacement ε d from the reference state (the solver's own
-    element, nodal pressure included), so ω_max is that of the discrete system actually integrated.
-    Sets ``step_gain`` = (2/ω_max) / min(h/c) (rounded down to a multiple of GAIN_QUANTUM), by which the
-    altitude estimate is multiplied from then
-    on (it keeps tracking the deformed mesh). Call before set_initial: the state is zeroed after.
-    The start vector is a smooth-free oscillating field of the reference positions, the same on any
-    partition. The Rayleigh quotient approaches ω_max² from below, so the safety factor keeps a margin.
-
-    Returns:
-        (critical step of the undeformed body (s), step_gain).
-    """
-    n = s.n_owned
-    X = s.X
-    L = float(np.ptp(X, axis=0).max())
-    d = np.stack([np.sin(X @ np.array(w) / L * 977.0 + k) for k, w in
-                  enumerate(([1.0, 0.31, 0.57], [0.23, 1.0, 0.71], [0.61, 0.43, 1.0]))], axis=1)
-    external, s.external = s.external, None
-    eps = 1e-9 * L
-    lam = lam_prev = 0.0
-    for it in range(iterations):
-        if s.node.fixed is not None:
-            d[s.node.fixed] = 0.0
-        norm = np.sqrt(s.comm.allreduce(float(np.sum(s.mass[:n, None] * d[:n] ** 2)), op=MPI.SUM))
-        d /= norm
-        s.U[:] = eps * d
-        s.Vel[:] = eps * d
-        s.s[:] = 0.0
-        s._forces(1.0)  # increment v dt = eps d from the reference: f_int = K eps d
-        Kd = s.node.fint[:n] / eps
-        lam = s.comm.allreduce(float(np.sum(d[:n] * Kd)), op=MPI.SUM)
-        s.Vel[:n] = Kd / s.mass[:n, None]
-        s.node.v.x.scatter_forward()
-        d = s.Vel.copy()
-        if it > 30 and abs(lam - lam_prev) < rtol * lam:
-            break
-        lam_prev = lam
-    s.external = external
-    for a in (s.U, s.Vel, s.s, s.node.fint, s.fext, s.acc):
-        a[:] = 0.0
-    s.eps_p[:] = 0.0
-    _, _, h_c, _ = kernels.volumes_and_step(s.positions(), s.dofs, s.orient, s.vol0, s.mat,
-                                               s.cell.speed, np.empty(s.n_cells))
-    h_c = s.comm.allreduce(h_c, op=MPI.MIN)
-    dt_crit = 2.0 / np.sqrt(lam)
-    # rounded down to a multiple of GAIN_QUANTUM: the Rayleigh quotient of a 1e-9 L displacement carries
-    # round-off of ~1e-6 that depends on the partition; rounded, the step is the same on any number of
-    # ranks (unless the gain falls within ~1e-6 of a multiple), and at most GAIN_QUANTUM / 2 smaller
-    s.clock.step_gain = max(math.floor(dt_crit / h_c / GAIN_QUANTUM) * GAIN_QUANTUM, GAIN_QUANTUM)
-    s.dt = s.clock.dt_stable = s.clock.dt0 = s.clock.dt_min = s.stable_step()
-    return dt_crit, s.clock.step_gain
 
 
 #: the grids' ranges: a nodal sum is exact while its partial sums stay below 2^53 quanta, here FORCE_RANGE x

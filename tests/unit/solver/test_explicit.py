@@ -10,7 +10,7 @@ from mpi4py import MPI
 from fepen import scene
 from fepen.laws import materials as M
 from fepen.runs import setup
-from fepen.solver import diagnostics, explicit, probes
+from fepen.solver import diagnostics, explicit, probes, time_step
 from fepen.solver import rigid_wall as rigidwall
 
 STEEL = dict(E=210e9, nu=0.3, density=7850.0)
@@ -243,7 +243,7 @@ def test_calibrated_critical_step_is_the_stability_limit():
     cells = np.zeros(pm.mesh.topology.index_map(3).size_local, dtype=np.int64)
     s = explicit.ExplicitSolver(pm.mesh, [M.elastic(210e9, 0.3, 7850.0)], cells, 0.8)
     dt, gain = s.calibrate_step()
-    q = explicit.GAIN_QUANTUM
+    q = time_step.GAIN_QUANTUM
     assert 1.5 < gain < 3.0 and round(gain / q) * q == pytest.approx(gain, rel=1e-12)  # rounded down to q
     assert 0.8 * dt * (1.0 - q / gain) < s.dt <= 0.8 * dt * (1.0 + 1e-12)
 
