@@ -18,9 +18,9 @@ from fepen import native
 #: fast-math flags that keep IEEE NaN/inf semantics (inverted or NaN elements must still be detected)
 _FAST = {"nsz", "arcp", "contract", "afn", "reassoc"}
 
-# Layout of the parameter vector handed to compiled code, and the kinds: read from materials_kernel.c's enums
+# Layout of the parameter vector handed to compiled code, and the kinds: read from materials_kernel.h's enums
 # (declared once, in C)
-_C = native.c_enums(Path(__file__).with_name("materials_kernel.c"))
+_C = native.c_enums(Path(__file__).with_name("materials_kernel.h"))
 KIND, E_, NU, RHO, A_, B_, N_, C_, M_, TMELT, TROOM, EPS0, CP, BETA, RATE_ON, THERMAL_ON, H_ = (_C[k] for k in (
     "KIND", "E_", "NU", "RHO", "A_", "B_", "N_", "C_", "M_", "TMELT", "TROOM", "EPS0", "CP", "BETA", "RATE_ON",
     "THERMAL_ON", "H_"))

@@ -8,17 +8,7 @@
 #include <math.h>
 #include <stdint.h>
 
-/* p[]: the TargetLaw as numbers, in this order */
-enum { P_DENSITY, P_Y, P_E, P_T, P_LAM, P_SIGMA_S, P_B, P_THICKNESS /* < 0: none */, P_CRATER /* 2: energy */,
-       P_K, P_D, P_SEPARATION, P_PHI_MIN, P_FREE_SURFACE, P_FRICTION, P_MU, P_MU_DYNAMIC, P_MU_DECAY,
-       P_LOCK_DENSITY, P_CRUSH_STRAIN, P_C_OVER_A, P_GIVEN_SIGMA_S,
-       P_WALL_SHEAR2 /* 2G of the tunnel's wall (Pa): its elastic stiffness 2G/a under a sideways push */,
-       P_TOP /* the material's own faces in a block of layers */, P_LOWER /* < 0: none */,
-       P_SURFACE_RANGE /* the free face's reach in plastic-zone widths */,
-       P_RELOAD /* the tunnel wall's reload strength: the fraction of sigma_s that re-expands its cracked wall */,
-       P_FIELD_SIGMA /* the concrete's random field on sigma_s (§8.8): the standard deviation of its logarithm */,
-       P_FIELD_MODES /* its number of modes N; 0: none. The modes follow P_COUNT: (kx, ky, kz, phase) each */,
-       P_COUNT };
+#include "target_kernel.h"
 
 #define SIN_TOL 1e-9
 

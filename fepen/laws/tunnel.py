@@ -29,9 +29,9 @@ __all__ = ["Tunnel", "SECTORS", "CAPACITY", "HEADER", "STATION", "shoulder_of", 
 SECTORS = 16
 #: stations a tunnel has room for (then it ends where it is: 2048 calibres at the default spacing)
 CAPACITY = 4096
-#: tunnel_kernel.c's layout, read from its enums (declared once, in C): the header's length, its fields, a
+#: tunnel_kernel.h's layout, read from its enums (declared once, in C): the header's length, its fields, a
 #: station's fixed part
-_C = native.c_enums(Path(__file__).with_name("tunnel_kernel.c"))
+_C = native.c_enums(Path(__file__).with_name("tunnel_kernel.h"))
 HEADER, STATION = _C["T_HEADER"], _C["T_STATION"]
 T_M, T_CAP, T_S, T_SPACING, T_XI_SH, T_A0, T_COMMIT, T_CS, T_TS, T_FACE = (_C[k] for k in (
     "T_M", "T_CAP", "T_S", "T_SPACING", "T_XI_SH", "T_A0", "T_COMMIT", "T_CS", "T_TS", "T_FACE"))

@@ -14,6 +14,8 @@
 #include <stdlib.h>
 #include <string.h>
 
+#include "rigid_batch.h"
+
 /* The law (law_constants, law_at_point), built as the single path builds
  * target_kernel.c (a * b + c contracted as there) */
 #pragma GCC push_options
@@ -88,16 +90,6 @@ static void moment_points(moment_fn moment, int32_t k, int32_t m, const int32_t 
     moment(n < k ? n : k, arm, f, FM);
     for (int32_t j = 0; j < m; ++j) memset(f + 3 * idx[j], 0, 3 * sizeof(double));
 }
-
-/* per-shot numbers, in this order (fepen/runs/batch.py SHOT_NUMBERS) */
-enum { S_MASS, S_DT, S_HARD_END, S_THICKNESS /* < 0: none */, S_UNTIL_STOPPED, S_HISTORY /* <= 0: none */,
-       S_CRATER /* 1: the linear crater */, S_CRATER_KD, S_CRATER_C, S_KE0, S_STOP_ENERGY,
-       S_TIP /* 3: the tip about the centre */, S_TAIL = S_TIP + 3, S_IINV = S_TAIL + 3 /* 9 */,
-       S_TUNNEL = S_IINV + 9 /* 1: the tunnel (tunnel_kernel.c) */, S_SPACING, S_XI_SH, S_A0, S_RESERVED,
-       S_SHOULDER /* 3: the shoulder's centre about the body's centre */, S_COUNT = S_SHOULDER + 3 };
-/* per-shot results */
-enum { R_T, R_STEPS, R_OUTCOME /* 0 ended, 1 perforated, 2 ricochet, 3 embedded */, R_WORK, R_ENTERED,
-       R_MAX_NOSE /* mm */, R_MAX_ERROR, R_ROWS, R_STATUS /* 0 ok, 1 a non-finite state */, R_COUNT };
 
 typedef struct {
     int32_t k, ng;
@@ -310,7 +302,8 @@ static void one_shot(Body *b, const double *sp, const double *law, double *y, do
         axis_of(y, a);
         outcome = penetration_rule(ymin, ymax, y + 7, a, sp[S_MASS], sp[S_KE0], thk, sp[S_UNTIL_STOPPED] != 0.0,
                                    sp[S_STOP_ENERGY], &entered);
-        if (outcome == 3 && dot3(y + 7, a) <= 0.0) { /* RigidRun.stop_rules: back to where V.a vanishes */
+        /* RigidRun.stop_rules: back to where V.a vanishes */
+        if (outcome == OUTCOME_EMBEDDED && dot3(y + 7, a) <= 0.0) {
             double ap[3];
             axis_of(prev, ap);
             double a0 = dot3(prev + 7, ap), a1 = dot3(y + 7, a);

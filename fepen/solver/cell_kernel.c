@@ -39,6 +39,8 @@
    fepen/laws/materials_kernel.c, its one home, built here as it is built there (no contraction) */
 #include "../laws/materials_kernel.c"
 
+#include "cell_kernel.h"
+
 /* ------------------------------------------------------------------------------------------------------
    Node passes */
 

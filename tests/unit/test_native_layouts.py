@@ -19,9 +19,9 @@ def test_the_reader_follows_c_s_enum_rules(tmp_path):
 
 
 def test_the_laws_layouts_are_their_kernels():
-    m = native.c_enums(native.Path(materials.__file__).with_name("materials_kernel.c"))
+    m = native.c_enums(native.Path(materials.__file__).with_name("materials_kernel.h"))
     assert (materials.N_PARAMS, materials.H_, materials.THERMAL_ON, materials.BILINEAR) == (17, 16, 15, 2)
     assert m["N_PARAMS"] == materials.N_PARAMS and m["JOHNSON_COOK"] == materials.JOHNSON_COOK
-    t = native.c_enums(native.Path(tunnel.__file__).with_name("tunnel_kernel.c"))
+    t = native.c_enums(native.Path(tunnel.__file__).with_name("tunnel_kernel.h"))
     assert (tunnel.HEADER, tunnel.STATION, tunnel.T_TS, tunnel.T_FACE) == (16, 8, 11, 14) == (
         t["T_HEADER"], t["T_STATION"], t["T_TS"], t["T_FACE"])
