@@ -1,7 +1,11 @@
 """fepen's compiled code behind one door (dolfinx's jit.py is the example): every C source fepen builds is named
-in one table (KERNELS: its file beside the Python module it serves, its flags, its functions' ctypes signatures),
-built once per machine with the system's C compiler into one cache, loaded and bound here, and switched by one
-rule.
+in one table (KERNELS: its file beside the Python module it serves, its header, its flags, the functions Python
+binds), built once per machine with the system's C compiler into one cache, loaded and bound here, and switched
+by one rule. A kernel's interface is its header: the ctypes signatures are read from its prototypes
+(c_prototypes), and every layout Python shares with it (a parameter vector, a buffer, result codes) is read from
+its enums (c_enums, enum_values) or, where Python keeps a list of names, held to them member by member when the
+kernel is loaded (shares, check_layout): a header and its Python that disagree stop fepen with a LayoutError
+naming both.
 
     kernel(name)   the bound library (built on first use), or None for an optional kernel that is off or does
                    not build (why_not(name) says why); a required kernel that does not build raises
@@ -275,7 +279,8 @@ def kernel(name: str) -> ctypes.CDLL | None:
     Raises:
         MachineFault: a required kernel that neither builds nor was built before (no C compiler, a cache that
             cannot be written: the message names the compiler or the variable and what to do); OutOfMemory: a
-            library that cannot be mapped (ulimit -v), optional or not.
+            library that cannot be mapped (ulimit -v), optional or not; LayoutError: its header and the Python
+            that binds it or shares its layouts disagree.
     """
     if name in _LOADED:
         return _LOADED[name]

@@ -8,6 +8,7 @@ from __future__ import annotations
 import functools
 import math
 from dataclasses import dataclass
+from pathlib import Path
 
 import numpy as np
 
@@ -323,12 +324,12 @@ def load_on_points(law: TargetLaw, x, v, n, area, radius, R_meridian, sin_phi0, 
         f, sums = kernel(law, x, v, n, area, radius, R_meridian, sin_phi0, axis, tunnel, body_xi)
     if reduce is not None:
         sums = reduce(f, sums)
-    total = sums[:3]
+    total = sums[SUM_FORCE:SUM_FORCE + 3]
     if crater is not None:
         scale = crater.scale(tip_depth, -float(total @ axis))
         f *= scale
         total = total * scale
-    return PointLoad(f, total, int(sums[3]), float(sums[4]))
+    return PointLoad(f, total, int(sums[SUM_LOADED]), float(sums[SUM_AREA]))
 
 
 def point_forces(law: TargetLaw, x, v, n, area, radius, R_meridian, sin_phi0, axis, tunnel=None, body_xi=None):
@@ -430,6 +431,11 @@ _LAW = (
     ("P_SURFACE_RANGE", lambda law: law.surface_range), ("P_RELOAD", lambda law: law.reload),
     ("P_FIELD_SIGMA", lambda law: law.field_sigma), ("P_FIELD_MODES", lambda law: len(law.field_modes) // 4))
 native.shares("target", "P_", [(member, 1) for member, _ in _LAW])
+#: the sums point_forces writes (target_kernel.h's SUM_ enum, all its members): the force (3), the points loaded,
+#: their area; a layout shared as _LAW is
+SUM_FORCE, SUM_LOADED, SUM_AREA, SUM_COUNT = native.enum_values(Path(__file__).with_name("target_kernel.h"),
+                                                                "SUM_FORCE", "SUM_LOADED", "SUM_AREA", "SUM_COUNT")
+native.shares("target", "SUM_", [("SUM_FORCE", 3), ("SUM_LOADED", 1), ("SUM_AREA", 1)])
 
 
 @functools.lru_cache(maxsize=16)
@@ -468,7 +474,7 @@ def _bind(lib):
         moving = [np.ascontiguousarray(a, dtype=float) for a in (x, v, n)]
         ax = None if axis is None else np.ascontiguousarray(axis, dtype=float)
         k = len(moving[0])
-        out = np.empty(4 * k + 5)
+        out = np.empty(4 * k + SUM_COUNT)
         at = out.ctypes.data
         keep: list = []
         count = lib.point_forces(k, *[a.ctypes.data for a in moving],

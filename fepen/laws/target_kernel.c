@@ -254,7 +254,7 @@ int32_t point_forces(int32_t k, const double *x, const double *v, const double *
     if (commit) tunnel_record(T);
     TunnelEnd end;
     if (T) tunnel_end(T, &end);
-    for (int j = 0; j < 5; ++j) sums[j] = 0.0;
+    for (int j = 0; j < SUM_COUNT; ++j) sums[j] = 0.0;
     for (int32_t i = 0; i < k; ++i) {
         double *fi = f + 3 * i;
         fi[0] = fi[1] = fi[2] = 0.0;
@@ -265,8 +265,8 @@ int32_t point_forces(int32_t k, const double *x, const double *v, const double *
         const WallHit *wall = wall_of(T, &end, x + 3 * i, T ? body_xi[i] : 0.0, &hit);
         if (law_at_point(p, &c, x + 3 * i, v + 3 * i, n + 3 * i, area[i], ell, radius[i], Rm[i], sphi0[i],
                          axis, wall, gauss, ng, fi, sig + i) && sig[i] > 0.0) {
-            sums[3] += 1.0;
-            sums[4] += area[i];
+            sums[SUM_LOADED] += 1.0;
+            sums[SUM_AREA] += area[i];
         }
     }
     if (commit) {
@@ -275,9 +275,9 @@ int32_t point_forces(int32_t k, const double *x, const double *v, const double *
         T[T_COMMIT] = 0.0;
     }
     for (int32_t i = 0; i < k; ++i) {
-        sums[0] += f[3 * i];
-        sums[1] += f[3 * i + 1];
-        sums[2] += f[3 * i + 2];
+        sums[SUM_FORCE] += f[3 * i];
+        sums[SUM_FORCE + 1] += f[3 * i + 1];
+        sums[SUM_FORCE + 2] += f[3 * i + 2];
     }
     return law_length(p);
 }

@@ -17,6 +17,9 @@ enum { P_DENSITY, P_Y, P_E, P_T, P_LAM, P_SIGMA_S, P_B, P_THICKNESS /* < 0: none
        P_FIELD_MODES /* its number of modes N; 0: none. The modes follow P_COUNT: (kx, ky, kz, phase) each */,
        P_COUNT };
 
+/* point_forces's sums (5): the force (3, N), the points loaded, their area (m^2) (fepen/laws/target.py reads them) */
+enum { SUM_FORCE, SUM_LOADED = SUM_FORCE + 3, SUM_AREA, SUM_COUNT };
+
 /* sigma_s at the cavity wall for c/a = ca (docs/theory.md §4.1) */
 double cavity_wall_stress(double Y, double lam, double ca);
 

@@ -53,6 +53,9 @@ _RESULT_LAYOUT = (("R_T", "t"), ("R_STEPS", "steps"), ("R_OUTCOME", "outcome"), 
 RESULTS = tuple(name for _, name in _RESULT_LAYOUT)
 native.shares("rigid_batch", "S_", [(member, len(names)) for member, names in _SHOT_LAYOUT])
 native.shares("rigid_batch", "R_", [(member, 1) for member, _ in _RESULT_LAYOUT])
+#: a shot's state as fepen.laws.rigid_body.RigidState.as_array lays it out (centre, quaternion, velocity, angular
+#: momentum): rigid_batch.h's Y_ enum
+native.shares("rigid_batch", "Y_", [("Y_CENTRE", 3), ("Y_QUAT", 4), ("Y_VELOCITY", 3), ("Y_MOMENTUM", 3)])
 #: outcome codes of the kernel (events_kernel.h's, which rigid_batch.c includes: checked with the events kernel)
 OUTCOMES = events.OUTCOMES
 _R = {k: i for i, k in enumerate(RESULTS)}

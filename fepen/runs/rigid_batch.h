@@ -14,6 +14,10 @@ enum { S_MASS, S_DT, S_HARD_END, S_THICKNESS /* < 0: none */, S_UNTIL_STOPPED, S
 /* per-shot results */
 enum { R_T, R_STEPS, R_OUTCOME /* events_kernel.h's OUTCOME_ (0: ended) */, R_WORK, R_ENTERED,
        R_MAX_NOSE /* mm */, R_MAX_ERROR, R_ROWS, R_STATUS /* 0 ok, 1 a non-finite state */, R_COUNT };
+/* a shot's state y, as fepen.laws.rigid_body.RigidState.as_array lays it out: the centre (3), the unit quaternion
+ * (4), the velocity (3), the angular momentum (3) */
+enum { Y_CENTRE, Y_QUAT = Y_CENTRE + 3, Y_VELOCITY = Y_QUAT + 4, Y_MOMENTUM = Y_VELOCITY + 3,
+       Y_COUNT = Y_MOMENTUM + 3 };
 
 /* n shots sharing k load points (rigid_batch.c says what each argument holds); points, moment: rigid_kernel.h's
  * rigid_points and force_moment. Returns S_COUNT * 10000 + R_COUNT * 100 + nlaw, or -1 */

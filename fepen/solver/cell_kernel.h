@@ -4,6 +4,12 @@
 #define FEPEN_CELL_KERNEL_H
 #include <stdint.h>
 
+/* kinematics_pass's out (4): the smallest J = V / V0 over live cells and its cell, the smallest h/c and its cell
+ * (cells as doubles, -1 for none); fepen/solver/ckernel.py reads them */
+enum { KIN_J_MIN, KIN_J_CELL, KIN_DT_MIN, KIN_DT_CELL, KIN_COUNT };
+/* cell_pass's totals (4): plastic work, heat, 0, the largest plastic increment */
+enum { TOT_PLASTIC, TOT_HEAT, TOT_RESERVED, TOT_D_MAX, TOT_COUNT };
+
 /* nodes, before the forces: v, du, u, x; the old forces' work into w */
 void update_begin(int32_t n_nodes, int32_t n_owned, double h, double dt, const double *restrict a,
                   double *restrict v, double *restrict u, const double *restrict X, double *restrict x,

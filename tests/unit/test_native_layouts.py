@@ -8,11 +8,13 @@ fail here and when the kernel is loaded."""
 import ctypes
 import re
 
+import numpy as np
 import pytest
 
 from fepen import native
 from fepen.laws import materials, target, tunnel
 from fepen.runs import batch, events
+from fepen.solver import ckernel
 
 HEADERS = sorted(native.PACKAGE.rglob("*.h"))
 
@@ -95,7 +97,7 @@ def test_the_numba_law_is_typed_by_its_header():
 
 
 #: every layout Python shares with a kernel, by kernel: the prefixes of its header's enums
-SHARED = {"target": {"P_"}, "rigid_batch": {"S_", "R_"}, "events": {"OUTCOME_"}}
+SHARED = {"target": {"P_", "SUM_"}, "rigid_batch": {"S_", "R_", "Y_"}, "events": {"OUTCOME_"}, "cells": {"TOT_"}}
 
 
 def test_every_shared_layout_is_declared_and_agrees():
@@ -125,12 +127,16 @@ def _edited(tmp_path, header: str, old: str, new: str):
     ("runs/rigid_batch.h", "R_", "R_MAX_NOSE", "R_MAX_NOSE_MM", "R_MAX_NOSE"),
     ("laws/target_kernel.h", "P_", "P_MU_DYNAMIC, P_MU_DECAY,", "P_MU_DECAY, P_MU_DYNAMIC,", "P_MU_DYNAMIC"),
     ("laws/target_kernel.h", "P_", "P_COUNT };", "P_EXTRA, P_COUNT };", "P_EXTRA"),
+    ("laws/target_kernel.h", "SUM_", "SUM_LOADED = SUM_FORCE + 3", "SUM_LOADED = SUM_FORCE + 4", "SUM_LOADED"),
+    ("solver/cell_kernel.h", "TOT_", "TOT_PLASTIC, TOT_HEAT,", "TOT_HEAT, TOT_PLASTIC,", "TOT_PLASTIC"),
+    ("runs/rigid_batch.h", "Y_", "Y_VELOCITY = Y_QUAT + 4", "Y_VELOCITY = Y_QUAT + 3", "Y_VELOCITY"),
     ("runs/events_kernel.h", "OUTCOME_", "OUTCOME_RICOCHET, OUTCOME_EMBEDDED", "OUTCOME_EMBEDDED, OUTCOME_RICOCHET",
      "OUTCOME_RICOCHET"),
     ("runs/events_kernel.h", "OUTCOME_", "OUTCOME_EMBEDDED, OUTCOME_COUNT", "OUTCOME_EMBEDDED, OUTCOME_COUNT = 5",
      "OUTCOME_COUNT")])
 def test_a_header_and_its_python_that_disagree_fail_naming_both(tmp_path, header, prefix, old, new, member):
-    name = {"runs/rigid_batch.h": "rigid_batch", "laws/target_kernel.h": "target", "runs/events_kernel.h": "events"}
+    name = {"runs/rigid_batch.h": "rigid_batch", "laws/target_kernel.h": "target", "runs/events_kernel.h": "events",
+            "solver/cell_kernel.h": "cells"}
     (members,) = [m for p, m in native._SHARED[name[header]] if p == prefix]
     native.check_layout(native.PACKAGE / header, prefix, members)  # as it is: agrees
     edited = _edited(tmp_path, header, old, new)
@@ -158,6 +164,24 @@ def test_a_member_a_module_reads_must_be_declared(tmp_path):
         native.enum_values(h, "T_C", "T_ARC")
     assert native.enum_values(native.PACKAGE / "laws/tunnel_kernel.h", "T_C", "T_T", "T_ARC") == (
         tunnel.T_C, tunnel.T_T, tunnel.T_ARC) == (0, 3, 6)
+
+
+def test_the_sums_and_passes_outputs_are_read_from_their_headers():
+    cells = native.c_enums(native.PACKAGE / "solver/cell_kernel.h")
+    assert (ckernel.KIN_J_MIN, ckernel.KIN_J_CELL, ckernel.KIN_DT_MIN, ckernel.KIN_DT_CELL, ckernel.KIN_COUNT) == (
+        cells["KIN_J_MIN"], cells["KIN_J_CELL"], cells["KIN_DT_MIN"], cells["KIN_DT_CELL"], cells["KIN_COUNT"])
+    sums = native.c_enums(native.PACKAGE / "laws/target_kernel.h")
+    assert (target.SUM_FORCE, target.SUM_LOADED, target.SUM_AREA, target.SUM_COUNT) == (0, 3, 4, 5) == (
+        sums["SUM_FORCE"], sums["SUM_LOADED"], sums["SUM_AREA"], sums["SUM_COUNT"])
+
+
+def test_a_rigid_state_s_numbers_are_where_the_batch_reads_them():
+    from fepen.laws.rigid_body import RigidState
+
+    y = RigidState(*(np.arange(a, b, dtype=float) for a, b in ((0, 3), (3, 7), (7, 10), (10, 13)))).as_array()
+    e = native.c_enums(native.PACKAGE / "runs/rigid_batch.h")
+    assert len(y) == e["Y_COUNT"] and [y[e[m]] for m in ("Y_CENTRE", "Y_QUAT", "Y_VELOCITY", "Y_MOMENTUM")] == [
+        0.0, 3.0, 7.0, 10.0]
 
 
 def test_the_outcome_codes_are_the_kernel_s():
