@@ -1,7 +1,11 @@
 """fepen's compiled code behind one door (dolfinx's jit.py is the example): every C source fepen builds is named
-in one table (KERNELS: its file beside the Python module it serves, its flags, its functions' ctypes signatures),
-built once per machine with the system's C compiler into one cache, loaded and bound here, and switched by one
-rule.
+in one table (KERNELS: its file beside the Python module it serves, its header, its flags, the functions Python
+binds), built once per machine with the system's C compiler into one cache, loaded and bound here, and switched
+by one rule. A kernel's interface is its header: the ctypes signatures are read from its prototypes
+(c_prototypes), and every layout Python shares with it (a parameter vector, a buffer, result codes) is read from
+its enums (c_enums, enum_values) or, where Python keeps a list of names, held to them member by member when the
+kernel is loaded (shares, check_layout): a header and its Python that disagree stop fepen with a LayoutError
+naming both.
 
     kernel(name)   the bound library (built on first use), or None for an optional kernel that is off or does
                    not build (why_not(name) says why); a required kernel that does not build raises
@@ -33,14 +37,15 @@ import re
 import shlex
 import stat
 import subprocess
-from dataclasses import dataclass, field
+from dataclasses import dataclass
 from pathlib import Path
 
 from fepen.atomic import replacing
 from fepen.errors import MachineFault, OutOfMemory, describe_os_error, out_of_memory
 
 __all__ = ["FLAGS", "KERNELS", "Kernel", "cache_dir", "compiler", "kernel", "library_path", "why_not", "python_only",
-           "load", "c_enums"]
+           "load", "c_enums", "c_prototypes", "enum_values", "check_layout", "shares", "check_layouts", "signatures",
+           "LayoutError", "C_TYPES"]
 
 #: no fast-math (NaN and inf must propagate); -fno-math-errno only lets sqrt be one instruction (errno is never
 #: read), without which GCC keeps a loop that takes a square root scalar
@@ -50,46 +55,32 @@ FLAGS = ["-O3", "-march=native", "-fopenmp-simd", "-fno-math-errno", "-fPIC", "-
 #: as numpy does, one operation at a time
 NO_CONTRACT = ("-ffp-contract=off",)
 
-_i32, _vp, _dbl = ctypes.c_int32, ctypes.c_void_p, ctypes.c_double
-
 
 @dataclass(frozen=True)
 class Kernel:
-    """One C source: where it is (relative to the package), its extra flags, whether fepen can do without it,
-    and its functions' signatures ({name: (argtypes, restype)})."""
+    """One C source: where it and its header are (relative to the package), its extra flags, whether fepen can
+    do without it, and the functions Python binds, by name: their ctypes signatures are the header's prototypes
+    (c_prototypes), as ffcx's jit reads its declarations instead of typing them again."""
 
     source: str
+    header: str
     flags: tuple = ()
     required: bool = False
-    functions: dict = field(default_factory=dict)
+    functions: tuple = ()
 
 
 #: every compiled kernel fepen builds
 KERNELS = {
-    "target": Kernel("laws/target_kernel.c", (), True, {
-        "point_forces": ([_i32, *[_vp] * 10, _i32, _vp, _vp, _vp, _vp, _vp], _i32),
-        "cavity_wall_stress": ([_dbl] * 3, _dbl),
-        "tunnel_sectors": ([_i32, _vp, _vp, _i32, _vp, _vp], None),
-        "strength_field": ([_i32, _vp, _vp, _vp], _i32)}),
-    "materials": Kernel("laws/materials_kernel.c", NO_CONTRACT, True, {
-        "material_radial_return": ([_dbl] * 5 + [_vp, _vp], _dbl),
-        "material_yield_stress": ([_dbl] * 3 + [_vp], _dbl)}),
-    "events": Kernel("runs/events_kernel.c", NO_CONTRACT, True, {
-        "penetration_outcome": ([_dbl, _dbl, _vp, _vp, _dbl, _dbl, _dbl, _i32, _dbl, _vp], _i32)}),
-    "rigid_body": Kernel("laws/rigid_kernel.c", (), False, {
-        "rigid_points": ([_i32, *[_vp] * 10], None), "force_moment": ([_i32, _vp, _vp, _vp], None)}),
-    "rigid_batch": Kernel("runs/rigid_batch.c", NO_CONTRACT, False, {
-        "rigid_batch": ([_i32, _i32, *[_vp] * 8, _i32, _vp, _vp, _vp, _vp, _i32, _vp, _vp, _vp, _i32, _i32, _vp], _i32),
-        "batch_law": ([_i32, *[_vp] * 11, _i32, _vp, _vp], None)}),
-    "cells": Kernel("solver/cell_kernel.c", NO_CONTRACT, False, {
-        "update_begin": ([_i32, _i32, _dbl, _dbl, *[_vp] * 9], None),
-        "update_end": ([_i32, *[_vp] * 7], None),
-        "nodal_pressure": ([_i32, _vp, _vp, _vp, _i32, _vp], None),
-        "scatter_volumes": ([_i32, _vp, _vp, _vp, _dbl, _i32, _i32, _vp], None),
-        "scatter_forces": ([_i32, _vp, _vp, _dbl, _i32, _vp], None),
-        "kinematics_pass": ([_i32, *[_vp] * 6, _i32, _vp, _vp, _vp, _dbl, _i32, _i32, _vp], None),
-        "cell_pass": ([_i32, _vp, _vp, _dbl, _vp, _vp, _vp, _i32, *[_vp] * 8, _dbl, _i32, _vp, _vp], _i32),
-        "facet_kinematics": ([_i32, *[_vp] * 11], None)}),
+    "target": Kernel("laws/target_kernel.c", "laws/target_kernel.h", (), True,
+                     ("point_forces", "cavity_wall_stress", "tunnel_sectors", "strength_field")),
+    "materials": Kernel("laws/materials_kernel.c", "laws/materials_kernel.h", NO_CONTRACT, True,
+                        ("material_radial_return", "material_yield_stress")),
+    "events": Kernel("runs/events_kernel.c", "runs/events_kernel.h", NO_CONTRACT, True, ("penetration_outcome",)),
+    "rigid_body": Kernel("laws/rigid_kernel.c", "laws/rigid_kernel.h", (), False, ("rigid_points", "force_moment")),
+    "rigid_batch": Kernel("runs/rigid_batch.c", "runs/rigid_batch.h", NO_CONTRACT, False, ("rigid_batch", "batch_law")),
+    "cells": Kernel("solver/cell_kernel.c", "solver/cell_kernel.h", NO_CONTRACT, False,
+                    ("update_begin", "update_end", "nodal_pressure", "scatter_volumes", "scatter_forces",
+                     "kinematics_pass", "cell_pass", "facet_kinematics")),
 }
 PACKAGE = Path(__file__).resolve().parent
 _LOADED: dict[str, ctypes.CDLL | None] = {}
@@ -103,13 +94,12 @@ def c_enums(source) -> dict[str, int]:
     members (+, -, *).
 
     Args:
-        source: the .c file (a path).
+        source: the .c or .h file (a path).
 
     Returns:
         {member: value}.
     """
-    text = re.sub(r"/\*.*?\*/", " ", Path(source).read_text(), flags=re.S)
-    text = re.sub(r"//[^\n]*", " ", text)
+    text = _code(source)
     out: dict[str, int] = {}
     for body in re.findall(r"\benum\s*(?:\w+\s*)?\{([^}]*)\}", text):
         value = -1
@@ -127,6 +117,153 @@ def c_enums(source) -> dict[str, int]:
     return out
 
 
+def _code(source) -> str:
+    """A C file's text without its comments."""
+    text = re.sub(r"/\*.*?\*/", " ", Path(source).read_text(), flags=re.S)
+    return re.sub(r"//[^\n]*", " ", text)
+
+
+#: the C types of a prototype's values as ctypes takes them (any pointer is a c_void_p; void, a result only, is
+#: None): what fepen's headers use, nothing more
+C_TYPES = {"int32_t": ctypes.c_int32, "int": ctypes.c_int32, "double": ctypes.c_double}
+_QUALIFIERS = {"const", "restrict", "volatile", "__restrict", "__restrict__"}
+
+
+class LayoutError(RuntimeError):
+    """A C header and the Python that shares its layout or calls its functions disagree (a bug of fepen's own:
+    the message names the header and the member or function)."""
+
+
+def _c_type(header, function: str, decl: str, result: bool = False):
+    """The ctypes type of one declaration (a parameter with or without its name, or a result's type)."""
+    tokens = [w for w in re.findall(r"\w+|\*|\S", decl) if w not in _QUALIFIERS]
+    stars = tokens.count("*")
+    words = [w for w in tokens if w != "*"]
+    if not words or not all(re.fullmatch(r"\w+", w) for w in words):
+        raise LayoutError(f"{header}: {function}: cannot read the declaration {decl.strip()!r}")
+    base = " ".join(words if result or len(words) == 1 else words[:-1])
+    if stars:
+        return ctypes.c_void_p
+    if result and base == "void":
+        return None
+    if base not in C_TYPES:
+        raise LayoutError(f"{header}: {function}: the C type {base!r} of {decl.strip()!r} has no ctypes type here "
+                          f"(fepen.native.C_TYPES knows {', '.join(C_TYPES)} and pointers)")
+    return C_TYPES[base]
+
+
+def c_prototypes(header) -> dict[str, tuple[list, object]]:
+    """The ctypes signatures of the functions a C header declares, read from its prototypes (as ffcx's jit reads
+    its declarations rather than typing them again): int32_t and int are c_int32, double c_double, any pointer
+    c_void_p, a void result None. Preprocessor lines, comments, enums and typedefs are passed over.
+
+    Args:
+        header: the .h file (a path).
+
+    Returns:
+        {function: (argtypes, restype)}, in the header's order.
+
+    Raises:
+        LayoutError: a declaration this reader does not know (another C type, a function pointer, a definition),
+            naming the header and the function.
+    """
+    text = "\n".join(ln for ln in _code(header).splitlines() if not ln.lstrip().startswith("#"))
+    out: dict[str, tuple[list, object]] = {}
+    for statement in (" ".join(s.split()) for s in text.split(";")):
+        if "(" not in statement or statement.startswith(("typedef", "enum")):
+            continue
+        m = re.fullmatch(r"([\w\s*]+?)\s*\b(\w+)\s*\(([^()]*)\)", statement)
+        if m is None:
+            name = re.search(r"(\w+)\s*\(", statement)
+            raise LayoutError(f"{header}: {name.group(1) if name else statement[:40]}: not a prototype this reader "
+                              f"knows: {statement[:80]!r}")
+        result, name, params = m.groups()
+        params = [] if params.strip() in ("", "void") else params.split(",")
+        out[name] = ([_c_type(header, name, d) for d in params], _c_type(header, name, result, result=True))
+    return out
+
+
+def enum_values(header, *names: str) -> tuple[int, ...]:
+    """The values of the named members of a header's enums (c_enums), in the order asked.
+
+    Raises:
+        LayoutError: a member the header does not declare, naming the header and the member."""
+    enums = c_enums(header)
+    missing = [n for n in names if n not in enums]
+    if missing:
+        raise LayoutError(f"{header} declares no enum member {missing[0]} (fepen's Python reads it)")
+    return tuple(enums[n] for n in names)
+
+
+def check_layout(header, prefix: str, members) -> None:
+    """Python's copy of one of a header's enums against the header, member by member: each member where the
+    widths before it put it, every member of the header's enum with that prefix named, in its order, and
+    ``{prefix}COUNT`` the total.
+
+    Args:
+        header: the .h file. prefix: the enum's members' prefix ("S_"). members: (member, width) pairs, in
+            Python's order (a width of 3: a member that holds three numbers).
+
+    Raises:
+        LayoutError: naming the header and the first member that disagrees (its value in each).
+    """
+    enums = c_enums(header)
+    at = 0
+    for member, width in members:
+        if member not in enums:
+            raise LayoutError(f"{header} declares no enum member {member}, which fepen's Python puts at {at}")
+        if enums[member] != at:
+            raise LayoutError(f"{header}: enum member {member} is {enums[member]}, but fepen's Python puts it at {at}")
+        at += width
+    named = {m for m, _ in members}
+    extra = [m for m in enums if m.startswith(prefix) and m not in named and m != prefix + "COUNT"]
+    if extra:
+        raise LayoutError(f"{header}: enum member {extra[0]} = {enums[extra[0]]} is not in fepen's Python copy")
+    count = enums.get(prefix + "COUNT")
+    if count != at:
+        raise LayoutError(f"{header}: enum member {prefix}COUNT is {count}, but fepen's Python has {at} numbers")
+
+
+#: the layouts Python shares with each kernel (shares()): checked when the kernel is loaded
+_SHARED: dict[str, list[tuple[str, tuple]]] = {}
+
+
+def shares(name: str, prefix: str, members) -> None:
+    """Declare that Python lays out one of a kernel's enums (its header's members with ``prefix``) as
+    ``members`` ((member, width) pairs, in order): check_layout holds the two together when the kernel is
+    loaded, and at once when it already is.
+
+    Raises:
+        LayoutError: the kernel is loaded and its header disagrees."""
+    entry = (prefix, tuple((m, int(w)) for m, w in members))
+    _SHARED.setdefault(name, []).append(entry)
+    if _LOADED.get(name) is not None:
+        check_layout(PACKAGE / KERNELS[name].header, *entry)
+
+
+def check_layouts(name: str) -> None:
+    """Every layout Python shares with the kernel ``name`` (shares()) against its header.
+
+    Raises:
+        LayoutError: the first that disagrees."""
+    for prefix, members in _SHARED.get(name, ()):
+        check_layout(PACKAGE / KERNELS[name].header, prefix, members)
+
+
+def signatures(name: str) -> dict[str, tuple[list, object]]:
+    """The ctypes signatures of the functions a kernel binds, from its header's prototypes.
+
+    Raises:
+        LayoutError: a function the header does not declare, or a declaration c_prototypes cannot read."""
+    k = KERNELS[name]
+    declared = c_prototypes(PACKAGE / k.header)
+    missing = [fn for fn in k.functions if fn not in declared]
+    if missing:
+        raise LayoutError(f"{PACKAGE / k.header} declares no function {missing[0]} (fepen.native.KERNELS[{name!r}] "
+                          "binds it)")
+    return {fn: declared[fn] for fn in k.functions}
+
+
 def python_only() -> bool:
     """FEPEN_KERNEL asks for the Python references of the optional kernels ("python", "numpy" or "numba")."""
     return os.environ.get("FEPEN_KERNEL", "").lower() in ("python", "numpy", "numba")
@@ -142,7 +279,8 @@ def kernel(name: str) -> ctypes.CDLL | None:
     Raises:
         MachineFault: a required kernel that neither builds nor was built before (no C compiler, a cache that
             cannot be written: the message names the compiler or the variable and what to do); OutOfMemory: a
-            library that cannot be mapped (ulimit -v), optional or not.
+            library that cannot be mapped (ulimit -v), optional or not; LayoutError: its header and the Python
+            that binds it or shares its layouts disagree.
     """
     if name in _LOADED:
         return _LOADED[name]
@@ -158,9 +296,10 @@ def kernel(name: str) -> ctypes.CDLL | None:
                 raise
             _WHY_NOT[name] = str(err)
         else:
-            for fn, (args, res) in k.functions.items():
+            for fn, (args, res) in signatures(name).items():
                 getattr(lib, fn).argtypes = args
                 getattr(lib, fn).restype = res
+            check_layouts(name)
     _LOADED[name] = lib
     return lib
 

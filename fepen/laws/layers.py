@@ -14,7 +14,7 @@ from dataclasses import dataclass, replace
 
 import numpy as np
 
-from fepen.laws.target import TargetLaw
+from fepen.laws.target import SUM_COUNT, TargetLaw
 
 
 @dataclass(frozen=True)
@@ -79,7 +79,7 @@ class Layered:
         is zero on the points whose patch lies wholly outside the layer's faces (no force, not counted), so
         the forces are those of the points near it, without gathering them into new arrays every call."""
         f = np.zeros_like(x)
-        sums = np.zeros(5)
+        sums = np.zeros(SUM_COUNT)
         lo, hi = float(x[:, 1].min(initial=np.inf)), float(x[:, 1].max(initial=-np.inf))
         reach = 0.5 * float(np.sqrt(area.max(initial=0.0)))
         for layer in self.layers:

@@ -7,6 +7,7 @@ tension positive.
 
 from __future__ import annotations
 
+import ctypes
 from dataclasses import dataclass
 from pathlib import Path
 
@@ -18,14 +19,14 @@ from fepen import native
 #: fast-math flags that keep IEEE NaN/inf semantics (inverted or NaN elements must still be detected)
 _FAST = {"nsz", "arcp", "contract", "afn", "reassoc"}
 
-# Layout of the parameter vector handed to compiled code, and the kinds: read from materials_kernel.c's enums
-# (declared once, in C)
-_C = native.c_enums(Path(__file__).with_name("materials_kernel.c"))
-KIND, E_, NU, RHO, A_, B_, N_, C_, M_, TMELT, TROOM, EPS0, CP, BETA, RATE_ON, THERMAL_ON, H_ = (_C[k] for k in (
-    "KIND", "E_", "NU", "RHO", "A_", "B_", "N_", "C_", "M_", "TMELT", "TROOM", "EPS0", "CP", "BETA", "RATE_ON",
-    "THERMAL_ON", "H_"))
-N_PARAMS = _C["N_PARAMS"]
-ELASTIC, JOHNSON_COOK, BILINEAR = _C["ELASTIC"], _C["JOHNSON_COOK"], _C["BILINEAR"]
+# Layout of the parameter vector handed to compiled code, and the kinds: read from materials_kernel.h's enums
+# (declared once, in C; a member the header lacks stops the import, naming it)
+_HEADER = Path(__file__).with_name("materials_kernel.h")
+KIND, E_, NU, RHO, A_, B_, N_, C_, M_, TMELT, TROOM, EPS0, CP, BETA, RATE_ON, THERMAL_ON, H_ = native.enum_values(
+    _HEADER, "KIND", "E_", "NU", "RHO", "A_", "B_", "N_", "C_", "M_", "TMELT", "TROOM", "EPS0", "CP", "BETA",
+    "RATE_ON", "THERMAL_ON", "H_")
+(N_PARAMS,) = native.enum_values(_HEADER, "N_PARAMS")
+ELASTIC, JOHNSON_COOK, BILINEAR = native.enum_values(_HEADER, "ELASTIC", "JOHNSON_COOK", "BILINEAR")
 
 
 @dataclass(frozen=True)
@@ -113,12 +114,19 @@ def _law_library() -> None:
     llvm.load_library_permanently(native.library_path("materials"))
 
 
+#: numba's type of each ctypes type fepen.native reads from a prototype
+_NUMBA = {ctypes.c_double: numba.types.double, ctypes.c_int32: numba.types.int32, ctypes.c_void_p: numba.types.voidptr}
+
+
+def _external(name: str) -> numba.types.ExternalFunction:
+    """materials_kernel.h's function ``name`` for numba, its signature read from the header's prototype."""
+    args, result = native.c_prototypes(_HEADER)[name]
+    return numba.types.ExternalFunction(name, _NUMBA[result](*[_NUMBA[a] for a in args]))
+
+
 _law_library()
-_RETURN = numba.types.ExternalFunction("material_radial_return", numba.types.double(
-    numba.types.double, numba.types.double, numba.types.double, numba.types.double, numba.types.double,
-    numba.types.voidptr, numba.types.voidptr))
-_FLOW = numba.types.ExternalFunction("material_yield_stress", numba.types.double(
-    numba.types.double, numba.types.double, numba.types.double, numba.types.voidptr))
+_RETURN = _external("material_radial_return")
+_FLOW = _external("material_yield_stress")
 
 
 @numba.njit(cache=True, error_model="numpy")

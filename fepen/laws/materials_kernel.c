@@ -7,9 +7,7 @@
 #include <math.h>
 #include <stdint.h>
 
-/* the layout of a material's parameter vector (fepen.laws.materials) */
-enum { KIND, E_, NU, RHO, A_, B_, N_, C_, M_, TMELT, TROOM, EPS0, CP, BETA, RATE_ON, THERMAL_ON, H_, N_PARAMS };
-enum { ELASTIC = 0, JOHNSON_COOK = 1, BILINEAR = 2 };
+#include "materials_kernel.h"
 
 
 static double homologous_temperature(double T, const double *p)

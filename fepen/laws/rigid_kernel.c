@@ -4,6 +4,8 @@
  * Built once per machine, called by ctypes: a rigid shot evaluates these some 600 times, on ~1000 points. */
 #include <stdint.h>
 
+#include "rigid_kernel.h"
+
 /* k points; r0, N0 (k, 3) body-frame arms and normals; R (3, 3) row-major; c, V, w (3): centre, velocity,
  * angular velocity (world). Out (k, 3): x = c + R r0, v = V + w x (R r0), n = R N0, arm = R r0. */
 void rigid_points(int32_t k, const double *r0, const double *N0, const double *R, const double *c,

@@ -8,6 +8,7 @@ from __future__ import annotations
 import functools
 import math
 from dataclasses import dataclass
+from pathlib import Path
 
 import numpy as np
 
@@ -323,12 +324,12 @@ def load_on_points(law: TargetLaw, x, v, n, area, radius, R_meridian, sin_phi0, 
         f, sums = kernel(law, x, v, n, area, radius, R_meridian, sin_phi0, axis, tunnel, body_xi)
     if reduce is not None:
         sums = reduce(f, sums)
-    total = sums[:3]
+    total = sums[SUM_FORCE:SUM_FORCE + 3]
     if crater is not None:
         scale = crater.scale(tip_depth, -float(total @ axis))
         f *= scale
         total = total * scale
-    return PointLoad(f, total, int(sums[3]), float(sums[4]))
+    return PointLoad(f, total, int(sums[SUM_LOADED]), float(sums[SUM_AREA]))
 
 
 def point_forces(law: TargetLaw, x, v, n, area, radius, R_meridian, sin_phi0, axis, tunnel=None, body_xi=None):
@@ -411,17 +412,37 @@ def _kernel():
     return _KERNEL["fn"]
 
 
+#: the law as the C kernel takes it: target_kernel.h's P_ members, in their order, and the law's number at each
+#: (the random field's modes follow P_COUNT); checked against the header, member by member, when the kernel is
+#: loaded (fepen.native.shares)
+_LAW = (
+    ("P_DENSITY", lambda law: law.density), ("P_Y", lambda law: law.Y), ("P_E", lambda law: law.E),
+    ("P_T", lambda law: law.T), ("P_LAM", lambda law: law.lam), ("P_SIGMA_S", lambda law: law.sigma_s),
+    ("P_B", lambda law: law.B), ("P_THICKNESS", lambda law: -1.0 if law.thickness is None else law.thickness),
+    ("P_CRATER", lambda law: {"none": 0.0, "linear": 1.0, "energy": 2.0}[law.crater]), ("P_K", lambda law: law.k),
+    ("P_D", lambda law: law.D), ("P_SEPARATION", lambda law: float(law.separation)),
+    ("P_PHI_MIN", lambda law: law.phi_min), ("P_FREE_SURFACE", lambda law: float(law.free_surface)),
+    ("P_FRICTION", lambda law: float(law.friction)), ("P_MU", lambda law: law.mu),
+    ("P_MU_DYNAMIC", lambda law: law.mu if law.mu_dynamic is None else law.mu_dynamic),
+    ("P_MU_DECAY", lambda law: law.mu_decay), ("P_LOCK_DENSITY", lambda law: law.lock_density),
+    ("P_CRUSH_STRAIN", lambda law: law.crush_strain), ("P_C_OVER_A", lambda law: law.c_over_a),
+    ("P_GIVEN_SIGMA_S", lambda law: float(law.given_sigma_s)), ("P_WALL_SHEAR2", lambda law: law.wall_shear2),
+    ("P_TOP", lambda law: law.top), ("P_LOWER", lambda law: -1.0 if law.lower is None else law.lower),
+    ("P_SURFACE_RANGE", lambda law: law.surface_range), ("P_RELOAD", lambda law: law.reload),
+    ("P_FIELD_SIGMA", lambda law: law.field_sigma), ("P_FIELD_MODES", lambda law: len(law.field_modes) // 4))
+native.shares("target", "P_", [(member, 1) for member, _ in _LAW])
+#: the sums point_forces writes (target_kernel.h's SUM_ enum, all its members): the force (3), the points loaded,
+#: their area; a layout shared as _LAW is
+SUM_FORCE, SUM_LOADED, SUM_AREA, SUM_COUNT = native.enum_values(Path(__file__).with_name("target_kernel.h"),
+                                                                "SUM_FORCE", "SUM_LOADED", "SUM_AREA", "SUM_COUNT")
+native.shares("target", "SUM_", [("SUM_FORCE", 3), ("SUM_LOADED", 1), ("SUM_AREA", 1)])
+
+
 @functools.lru_cache(maxsize=16)
 def _law_numbers(law: TargetLaw) -> np.ndarray:
-    """The law as the C kernel's parameter array (the order of its enum)."""
-    return np.array([law.density, law.Y, law.E, law.T, law.lam, law.sigma_s, law.B,
-                     -1.0 if law.thickness is None else law.thickness,
-                     {"none": 0.0, "linear": 1.0, "energy": 2.0}[law.crater], law.k, law.D, float(law.separation),
-                     law.phi_min, float(law.free_surface), float(law.friction), law.mu,
-                     law.mu if law.mu_dynamic is None else law.mu_dynamic, law.mu_decay, law.lock_density,
-                     law.crush_strain, law.c_over_a, float(law.given_sigma_s), law.wall_shear2, law.top,
-                     -1.0 if law.lower is None else law.lower, law.surface_range, law.reload, law.field_sigma,
-                     len(law.field_modes) // 4, *law.field_modes])
+    """The law as the C kernel's parameter array (_LAW: the order of target_kernel.h's P_ enum), then its random
+    field's modes."""
+    return np.array([number(law) for _, number in _LAW] + list(law.field_modes))
 
 
 def _bind(lib):
@@ -453,7 +474,7 @@ def _bind(lib):
         moving = [np.ascontiguousarray(a, dtype=float) for a in (x, v, n)]
         ax = None if axis is None else np.ascontiguousarray(axis, dtype=float)
         k = len(moving[0])
-        out = np.empty(4 * k + 5)
+        out = np.empty(4 * k + SUM_COUNT)
         at = out.ctypes.data
         keep: list = []
         count = lib.point_forces(k, *[a.ctypes.data for a in moving],
@@ -462,7 +483,7 @@ def _bind(lib):
                                  at + 24 * k, at + 32 * k,
                                  None if tunnel is None else constant(body_xi, keep),
                                  None if tunnel is None else tunnel.buf.ctypes.data)
-        assert count == len(p), "target_kernel.c and _law_numbers disagree on the parameters"
+        assert count == len(p), "target_kernel.h and _law_numbers disagree on the parameters"
         return out[: 3 * k].reshape(k, 3), out[3 * k: 4 * k], out[4 * k:]
 
     c_point_forces.gauss = gauss

@@ -8,17 +8,7 @@
 #include <math.h>
 #include <stdint.h>
 
-/* p[]: the TargetLaw as numbers, in this order */
-enum { P_DENSITY, P_Y, P_E, P_T, P_LAM, P_SIGMA_S, P_B, P_THICKNESS /* < 0: none */, P_CRATER /* 2: energy */,
-       P_K, P_D, P_SEPARATION, P_PHI_MIN, P_FREE_SURFACE, P_FRICTION, P_MU, P_MU_DYNAMIC, P_MU_DECAY,
-       P_LOCK_DENSITY, P_CRUSH_STRAIN, P_C_OVER_A, P_GIVEN_SIGMA_S,
-       P_WALL_SHEAR2 /* 2G of the tunnel's wall (Pa): its elastic stiffness 2G/a under a sideways push */,
-       P_TOP /* the material's own faces in a block of layers */, P_LOWER /* < 0: none */,
-       P_SURFACE_RANGE /* the free face's reach in plastic-zone widths */,
-       P_RELOAD /* the tunnel wall's reload strength: the fraction of sigma_s that re-expands its cracked wall */,
-       P_FIELD_SIGMA /* the concrete's random field on sigma_s (§8.8): the standard deviation of its logarithm */,
-       P_FIELD_MODES /* its number of modes N; 0: none. The modes follow P_COUNT: (kx, ky, kz, phase) each */,
-       P_COUNT };
+#include "target_kernel.h"
 
 #define SIN_TOL 1e-9
 
@@ -264,7 +254,7 @@ int32_t point_forces(int32_t k, const double *x, const double *v, const double *
     if (commit) tunnel_record(T);
     TunnelEnd end;
     if (T) tunnel_end(T, &end);
-    for (int j = 0; j < 5; ++j) sums[j] = 0.0;
+    for (int j = 0; j < SUM_COUNT; ++j) sums[j] = 0.0;
     for (int32_t i = 0; i < k; ++i) {
         double *fi = f + 3 * i;
         fi[0] = fi[1] = fi[2] = 0.0;
@@ -275,8 +265,8 @@ int32_t point_forces(int32_t k, const double *x, const double *v, const double *
         const WallHit *wall = wall_of(T, &end, x + 3 * i, T ? body_xi[i] : 0.0, &hit);
         if (law_at_point(p, &c, x + 3 * i, v + 3 * i, n + 3 * i, area[i], ell, radius[i], Rm[i], sphi0[i],
                          axis, wall, gauss, ng, fi, sig + i) && sig[i] > 0.0) {
-            sums[3] += 1.0;
-            sums[4] += area[i];
+            sums[SUM_LOADED] += 1.0;
+            sums[SUM_AREA] += area[i];
         }
     }
     if (commit) {
@@ -285,9 +275,9 @@ int32_t point_forces(int32_t k, const double *x, const double *v, const double *
         T[T_COMMIT] = 0.0;
     }
     for (int32_t i = 0; i < k; ++i) {
-        sums[0] += f[3 * i];
-        sums[1] += f[3 * i + 1];
-        sums[2] += f[3 * i + 2];
+        sums[SUM_FORCE] += f[3 * i];
+        sums[SUM_FORCE + 1] += f[3 * i + 1];
+        sums[SUM_FORCE + 2] += f[3 * i + 2];
     }
     return law_length(p);
 }

@@ -29,12 +29,14 @@ __all__ = ["Tunnel", "SECTORS", "CAPACITY", "HEADER", "STATION", "shoulder_of", 
 SECTORS = 16
 #: stations a tunnel has room for (then it ends where it is: 2048 calibres at the default spacing)
 CAPACITY = 4096
-#: tunnel_kernel.c's layout, read from its enums (declared once, in C): the header's length, its fields, a
+#: tunnel_kernel.h's layout, read from its enums (declared once, in C): the header's length, its fields, a
 #: station's fixed part
-_C = native.c_enums(Path(__file__).with_name("tunnel_kernel.c"))
-HEADER, STATION = _C["T_HEADER"], _C["T_STATION"]
-T_M, T_CAP, T_S, T_SPACING, T_XI_SH, T_A0, T_COMMIT, T_CS, T_TS, T_FACE = (_C[k] for k in (
-    "T_M", "T_CAP", "T_S", "T_SPACING", "T_XI_SH", "T_A0", "T_COMMIT", "T_CS", "T_TS", "T_FACE"))
+_HEADER = Path(__file__).with_name("tunnel_kernel.h")
+HEADER, STATION = native.enum_values(_HEADER, "T_HEADER", "T_STATION")
+T_M, T_CAP, T_S, T_SPACING, T_XI_SH, T_A0, T_COMMIT, T_CS, T_TS, T_FACE = native.enum_values(
+    _HEADER, "T_M", "T_CAP", "T_S", "T_SPACING", "T_XI_SH", "T_A0", "T_COMMIT", "T_CS", "T_TS", "T_FACE")
+#: a station's fields: its centre (3), direction (3) and arc length, then its radii from STATION
+T_C, T_T, T_ARC = native.enum_values(_HEADER, "T_C", "T_T", "T_ARC")
 
 
 def shoulder_of(X: np.ndarray, radius: np.ndarray) -> tuple[float, float]:
@@ -119,7 +121,7 @@ class Tunnel:
         """The recorded stations: centre (m, 3), direction (3), arc length s (m) and radius per sector (m)."""
         m = self.count
         st = self.buf[HEADER:HEADER + m * (STATION + SECTORS)].reshape(m, STATION + SECTORS)
-        return {"centre": st[:, 0:3].copy(), "direction": st[:, 3:6].copy(), "s": st[:, 6].copy(),
+        return {"centre": st[:, T_C:T_C + 3].copy(), "direction": st[:, T_T:T_T + 3].copy(), "s": st[:, T_ARC].copy(),
                 "radius": st[:, STATION:].copy()}
 
     def recorded(self) -> np.ndarray:

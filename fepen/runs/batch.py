@@ -26,6 +26,7 @@ import time
 import numpy as np
 from mpi4py import MPI
 
+from fepen import native
 from fepen.errors import InputError, SimulationError
 from fepen.laws import target as tg
 from fepen.laws import tunnel
@@ -33,14 +34,29 @@ from fepen.runs import events
 
 __all__ = ["summaries", "reason", "kernel", "SHOT_NUMBERS", "RESULTS", "OUTCOMES"]
 
-#: the per-shot numbers the kernel reads, in its order (rigid_batch.c's S_ enum)
-SHOT_NUMBERS = ("mass", "dt", "hard_end", "thickness", "until_stopped", "history_interval", "crater",
-                "crater_kd", "crater_c", "ke0", "stop_energy", "tip_x", "tip_y", "tip_z", "tail_x", "tail_y",
-                "tail_z", *[f"I_inv_{i}{j}" for i in range(3) for j in range(3)], "tunnel", "tunnel_spacing",
-                "shoulder_xi", "shoulder_radius", "reserved", "shoulder_x", "shoulder_y", "shoulder_z")
-#: the per-shot results it writes (its R_ enum)
-RESULTS = ("t", "steps", "outcome", "work", "entered", "max_nose_mm", "max_error", "rows", "status")
-#: outcome codes of the kernel (events_kernel.c's penetration_rule)
+#: the per-shot numbers the kernel reads, in its order: rigid_batch.h's S_ members and the numbers each holds
+#: (checked against the header, member by member, when the kernel is loaded: fepen.native.shares)
+_SHOT_LAYOUT = (
+    ("S_MASS", ("mass",)), ("S_DT", ("dt",)), ("S_HARD_END", ("hard_end",)), ("S_THICKNESS", ("thickness",)),
+    ("S_UNTIL_STOPPED", ("until_stopped",)), ("S_HISTORY", ("history_interval",)), ("S_CRATER", ("crater",)),
+    ("S_CRATER_KD", ("crater_kd",)), ("S_CRATER_C", ("crater_c",)), ("S_KE0", ("ke0",)),
+    ("S_STOP_ENERGY", ("stop_energy",)), ("S_TIP", ("tip_x", "tip_y", "tip_z")),
+    ("S_TAIL", ("tail_x", "tail_y", "tail_z")), ("S_IINV", tuple(f"I_inv_{i}{j}" for i in range(3) for j in range(3))),
+    ("S_TUNNEL", ("tunnel",)), ("S_SPACING", ("tunnel_spacing",)), ("S_XI_SH", ("shoulder_xi",)),
+    ("S_A0", ("shoulder_radius",)), ("S_RESERVED", ("reserved",)),
+    ("S_SHOULDER", ("shoulder_x", "shoulder_y", "shoulder_z")))
+SHOT_NUMBERS = tuple(name for _, names in _SHOT_LAYOUT for name in names)
+#: the per-shot results it writes: its R_ members and their names here (checked as _SHOT_LAYOUT is)
+_RESULT_LAYOUT = (("R_T", "t"), ("R_STEPS", "steps"), ("R_OUTCOME", "outcome"), ("R_WORK", "work"),
+                  ("R_ENTERED", "entered"), ("R_MAX_NOSE", "max_nose_mm"), ("R_MAX_ERROR", "max_error"),
+                  ("R_ROWS", "rows"), ("R_STATUS", "status"))
+RESULTS = tuple(name for _, name in _RESULT_LAYOUT)
+native.shares("rigid_batch", "S_", [(member, len(names)) for member, names in _SHOT_LAYOUT])
+native.shares("rigid_batch", "R_", [(member, 1) for member, _ in _RESULT_LAYOUT])
+#: a shot's state as fepen.laws.rigid_body.RigidState.as_array lays it out (centre, quaternion, velocity, angular
+#: momentum): rigid_batch.h's Y_ enum
+native.shares("rigid_batch", "Y_", [("Y_CENTRE", 3), ("Y_QUAT", 4), ("Y_VELOCITY", 3), ("Y_MOMENTUM", 3)])
+#: outcome codes of the kernel (events_kernel.h's, which rigid_batch.c includes: checked with the events kernel)
 OUTCOMES = events.OUTCOMES
 _R = {k: i for i, k in enumerate(RESULTS)}
 _KERNEL: dict = {}
@@ -51,11 +67,10 @@ def kernel():
     of the law) when the C kernels build and FEPEN_KERNEL is not python (fepen.native), else None."""
     if "fn" not in _KERNEL:
         _KERNEL["fn"] = None
-        from fepen import native
-
         body, lib = native.kernel("rigid_body"), native.kernel("rigid_batch")
         if body is None or lib is None:
             return None
+        native.check_layouts("events")  # the outcome codes the batch returns
         vp = ctypes.c_void_p
         _KERNEL["fn"] = (lib, [ctypes.cast(f, vp).value for f in (body.rigid_points, body.force_moment)],
                          tg.crater_gauss())
@@ -121,20 +136,24 @@ def _single(run):
 
 
 def _shot_numbers(run) -> list[float]:
-    body, crater, law = run.body, run.crater, run.law
-    return [body.mass, run.dt, run.end, -1.0 if law.thickness is None else law.thickness,
-            float(run.rules.until_stopped), run.history.clock.interval, float(crater is not None),
-            crater.kd if crater is not None else 0.0, crater.c if crater is not None else 0.0, run.ke0,
-            events.stop_fraction(body.mass, run.ke0), *run.tip_arm, *(run.tail_ref - body.centre0),
-            *body.I_body_inv.ravel(),
-            *_tunnel_numbers(run.tunnel), *(run.shoulder_arm if run.tunnel is not None else np.zeros(3))]
-
-
-def _tunnel_numbers(t) -> list[float]:
-    if t is None:
-        return [0.0] * 5
-    b = t.buf
-    return [1.0, b[tunnel.T_SPACING], b[tunnel.T_XI_SH], b[tunnel.T_A0], 0.0]
+    """A shot's numbers in the kernel's order (_SHOT_LAYOUT: rigid_batch.h's S_ enum), by member."""
+    body, crater, law, t = run.body, run.crater, run.law, run.tunnel
+    at = {"S_MASS": body.mass, "S_DT": run.dt, "S_HARD_END": run.end,
+          "S_THICKNESS": -1.0 if law.thickness is None else law.thickness,
+          "S_UNTIL_STOPPED": float(run.rules.until_stopped), "S_HISTORY": run.history.clock.interval,
+          "S_CRATER": float(crater is not None), "S_CRATER_KD": crater.kd if crater is not None else 0.0,
+          "S_CRATER_C": crater.c if crater is not None else 0.0, "S_KE0": run.ke0,
+          "S_STOP_ENERGY": events.stop_fraction(body.mass, run.ke0), "S_TIP": run.tip_arm,
+          "S_TAIL": run.tail_ref - body.centre0, "S_IINV": body.I_body_inv.ravel(),
+          "S_TUNNEL": 0.0 if t is None else 1.0, "S_SPACING": 0.0 if t is None else t.buf[tunnel.T_SPACING],
+          "S_XI_SH": 0.0 if t is None else t.buf[tunnel.T_XI_SH], "S_A0": 0.0 if t is None else t.buf[tunnel.T_A0],
+          "S_RESERVED": 0.0, "S_SHOULDER": run.shoulder_arm if t is not None else np.zeros(3)}
+    out: list = []
+    for member, names in _SHOT_LAYOUT:
+        part = list(at[member]) if len(names) > 1 else [at[member]]
+        assert len(part) == len(names), f"{member}: {len(part)} numbers, not {len(names)}"
+        out.extend(part)
+    return out
 
 
 def _tunnel_room(runs) -> int:

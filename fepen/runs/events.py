@@ -11,8 +11,9 @@
                  gives one (fepen.errors)
 
 The penetration rules (perforated, ricochet, embedded) are written once, in C (events_kernel.c, beside this
-module), which the single and deformable runs call through ``penetration`` and the batched rigid shots
-(rigid_batch.c) include; ``StopRules`` keeps their memory (entered, touched) for a run and its checkpoints.
+module; its outcome codes and prototype in events_kernel.h), which the single and deformable runs call through
+``penetration`` and the batched rigid shots (rigid_batch.c) include; ``StopRules`` keeps their memory (entered,
+touched) for a run and its checkpoints.
 """
 
 from __future__ import annotations
@@ -57,8 +58,10 @@ def end_of_path(mass: float, force: float, speed: float = END_SPEED) -> float:
 REBOUND_FREE_S = 20e-6
 
 
-#: the outcomes of events_kernel.c's penetration_rule, by its return code
+#: the outcomes of events_kernel.c's penetration_rule, by its return code: events_kernel.h's OUTCOME_ members
+#: (None: OUTCOME_NONE, go on), checked against the header, name by name, when the kernel is loaded
 OUTCOMES = (None, "perforated", "ricochet", "embedded")
+native.shares("events", "OUTCOME_", [(f"OUTCOME_{(o or 'none').upper()}", 1) for o in OUTCOMES])
 
 
 def penetration(y_min: float, y_max: float, v_cm: np.ndarray, axis: np.ndarray, mass: float, ke0: float,

@@ -14,18 +14,20 @@
 #define FEPEN_EVENTS_KERNEL
 #include <stdint.h>
 
+#include "events_kernel.h"
+
 static inline double events_dot3(const double *a, const double *b) { return a[0] * b[0] + a[1] * b[1] + a[2] * b[2]; }
 
 static inline int32_t penetration_rule(double y_min, double y_max, const double *v, const double *axis, double mass,
                                        double ke0, double thickness, int32_t until_stopped, double stop_energy,
                                        int32_t *entered) {
     *entered = *entered || y_min < 0.0;
-    if (!*entered) return 0;
-    if (thickness >= 0.0 && y_max < -thickness) return 1;
-    if (y_min > 0.0 && v[1] > 0.0) return 2;
+    if (!*entered) return OUTCOME_NONE;
+    if (thickness >= 0.0 && y_max < -thickness) return OUTCOME_PERFORATED;
+    if (y_min > 0.0 && v[1] > 0.0) return OUTCOME_RICOCHET;
     if (until_stopped && (events_dot3(v, axis) <= 0.0 || 0.5 * mass * events_dot3(v, v) <= stop_energy * ke0))
-        return 3;
-    return 0;
+        return OUTCOME_EMBEDDED;
+    return OUTCOME_NONE;
 }
 
 /* penetration_rule for Python: entered is one int32 in and out */

@@ -14,6 +14,8 @@
 #include <stdlib.h>
 #include <string.h>
 
+#include "rigid_batch.h"
+
 /* The law (law_constants, law_at_point), built as the single path builds
  * target_kernel.c (a * b + c contracted as there) */
 #pragma GCC push_options
@@ -37,7 +39,7 @@ __attribute__((noinline)) static int32_t law_points(int32_t k, const double *x, 
     TunnelEnd end;
     if (T) tunnel_end(T, &end);
     int32_t m = 0;
-    for (int j = 0; j < 5; ++j) sums[j] = 0.0;
+    for (int j = 0; j < SUM_COUNT; ++j) sums[j] = 0.0;
     for (int32_t i = 0; i < k; ++i) {
         double sg = 0.0;
         if (above_face(p, x + 3 * i, ell[i]) || !may_load(v + 3 * i, n + 3 * i, T, T ? body_xi[i] : 0.0)) continue;
@@ -47,8 +49,8 @@ __attribute__((noinline)) static int32_t law_points(int32_t k, const double *x, 
                           wall, gauss, ng, f + 3 * i, &sg))
             continue;
         if (sg > 0.0) {
-            sums[3] += 1.0;
-            sums[4] += area[i];
+            sums[SUM_LOADED] += 1.0;
+            sums[SUM_AREA] += area[i];
         }
         sgs[m] = sg;
         idx[m++] = i;
@@ -61,9 +63,9 @@ __attribute__((noinline)) static int32_t law_points(int32_t k, const double *x, 
     }
     for (int32_t j = 0; j < m; ++j) {
         const double *fi = f + 3 * idx[j];
-        sums[0] += fi[0];
-        sums[1] += fi[1];
-        sums[2] += fi[2];
+        sums[SUM_FORCE] += fi[0];
+        sums[SUM_FORCE + 1] += fi[1];
+        sums[SUM_FORCE + 2] += fi[2];
     }
     return m;
 }
@@ -89,22 +91,12 @@ static void moment_points(moment_fn moment, int32_t k, int32_t m, const int32_t 
     for (int32_t j = 0; j < m; ++j) memset(f + 3 * idx[j], 0, 3 * sizeof(double));
 }
 
-/* per-shot numbers, in this order (fepen/runs/batch.py SHOT_NUMBERS) */
-enum { S_MASS, S_DT, S_HARD_END, S_THICKNESS /* < 0: none */, S_UNTIL_STOPPED, S_HISTORY /* <= 0: none */,
-       S_CRATER /* 1: the linear crater */, S_CRATER_KD, S_CRATER_C, S_KE0, S_STOP_ENERGY,
-       S_TIP /* 3: the tip about the centre */, S_TAIL = S_TIP + 3, S_IINV = S_TAIL + 3 /* 9 */,
-       S_TUNNEL = S_IINV + 9 /* 1: the tunnel (tunnel_kernel.c) */, S_SPACING, S_XI_SH, S_A0, S_RESERVED,
-       S_SHOULDER /* 3: the shoulder's centre about the body's centre */, S_COUNT = S_SHOULDER + 3 };
-/* per-shot results */
-enum { R_T, R_STEPS, R_OUTCOME /* 0 ended, 1 perforated, 2 ricochet, 3 embedded */, R_WORK, R_ENTERED,
-       R_MAX_NOSE /* mm */, R_MAX_ERROR, R_ROWS, R_STATUS /* 0 ok, 1 a non-finite state */, R_COUNT };
-
 typedef struct {
     int32_t k, ng;
     const double *r0, *N0, *area, *ell, *radius, *Rm, *sphi0, *gauss;
     points_fn points;
     moment_fn moment;
-    double at[13], R[9], w[3]; /* the state whose points x, v, n, arm hold (at[3] = 2: none), its R and omega */
+    double at[Y_COUNT], R[9], w[3]; /* the state whose points x, v, n, arm hold (at[Y_QUAT] = 2: none), R, omega */
     double *x, *v, *n, *arm, *f; /* scratch (f zero outside the points a law call loads) */
     int32_t *idx;
     const double *xi; /* each point's distance behind the tip, body frame */
@@ -150,12 +142,12 @@ static void points_at(Body *b, const double *sp, const double *y, double *R, dou
         memcpy(w, b->w, sizeof b->w);
         return;
     }
-    quat_to_matrix(y + 3, R);
-    omega_of(R, sp + S_IINV, y + 10, w);
+    quat_to_matrix(y + Y_QUAT, R);
+    omega_of(R, sp + S_IINV, y + Y_MOMENTUM, w);
     double small[18];
     memcpy(small, R, 9 * sizeof(double));
     memcpy(small + 9, y, 3 * sizeof(double));
-    memcpy(small + 12, y + 7, 3 * sizeof(double));
+    memcpy(small + 12, y + Y_VELOCITY, 3 * sizeof(double));
     memcpy(small + 15, w, 3 * sizeof(double));
     b->points(b->k, b->r0, b->N0, small, small + 9, small + 12, small + 15, b->x, b->v, b->n, b->arm);
     memcpy(b->at, y, sizeof b->at);
@@ -163,10 +155,10 @@ static void points_at(Body *b, const double *sp, const double *y, double *R, dou
     memcpy(b->w, w, sizeof b->w);
 }
 
-/* RigidBody.derivative with RigidRun.force_fn: dy (13), the force and moment, the power; loaded, area */
+/* RigidBody.derivative with RigidRun.force_fn: dy (Y_COUNT), the force and moment, the power; loaded, area */
 static void derivative(Body *b, const double *sp, const double *law, const double *y, double *dy, double *FM,
                        double *power, double *loaded, double *area) {
-    double R[9], w[3], tip[3], axis[3], sums[5];
+    double R[9], w[3], tip[3], axis[3], sums[SUM_COUNT];
     points_at(b, sp, y, R, w);
     matvec(R, sp + S_TIP, tip);
     for (int j = 0; j < 3; ++j) tip[j] = y[j] + tip[j];
@@ -189,29 +181,29 @@ static void derivative(Body *b, const double *sp, const double *law, const doubl
             fi[0] *= scale; fi[1] *= scale; fi[2] *= scale;
         }
     }
-    *loaded = sums[3];
-    *area = sums[4];
+    *loaded = sums[SUM_LOADED];
+    *area = sums[SUM_AREA];
     moment_points(b->moment, b->k, m, b->idx, b->arm, b->f, FM);
-    double q[4] = {y[3], y[4], y[5], y[6]};
+    double q[4] = {y[Y_QUAT], y[Y_QUAT + 1], y[Y_QUAT + 2], y[Y_QUAT + 3]};
     double w1 = 0.0, x1 = w[0], y1 = w[1], z1 = w[2], w2 = q[0], x2 = q[1], y2 = q[2], z2 = q[3];
-    for (int j = 0; j < 3; ++j) dy[j] = y[7 + j];
-    dy[3] = 0.5 * (w1 * w2 - x1 * x2 - y1 * y2 - z1 * z2);
-    dy[4] = 0.5 * (w1 * x2 + x1 * w2 + y1 * z2 - z1 * y2);
-    dy[5] = 0.5 * (w1 * y2 - x1 * z2 + y1 * w2 + z1 * x2);
-    dy[6] = 0.5 * (w1 * z2 + x1 * y2 - y1 * x2 + z1 * w2);
-    for (int j = 0; j < 3; ++j) dy[7 + j] = FM[j] / sp[S_MASS];
-    for (int j = 0; j < 3; ++j) dy[10 + j] = FM[3 + j];
-    *power = dot3(FM, y + 7) + dot3(FM + 3, w);
+    for (int j = 0; j < 3; ++j) dy[Y_CENTRE + j] = y[Y_VELOCITY + j];
+    dy[Y_QUAT] = 0.5 * (w1 * w2 - x1 * x2 - y1 * y2 - z1 * z2);
+    dy[Y_QUAT + 1] = 0.5 * (w1 * x2 + x1 * w2 + y1 * z2 - z1 * y2);
+    dy[Y_QUAT + 2] = 0.5 * (w1 * y2 - x1 * z2 + y1 * w2 + z1 * x2);
+    dy[Y_QUAT + 3] = 0.5 * (w1 * z2 + x1 * y2 - y1 * x2 + z1 * w2);
+    for (int j = 0; j < 3; ++j) dy[Y_VELOCITY + j] = FM[j] / sp[S_MASS];
+    for (int j = 0; j < 3; ++j) dy[Y_MOMENTUM + j] = FM[3 + j];
+    *power = dot3(FM, y + Y_VELOCITY) + dot3(FM + 3, w);
 }
 
 /* RigidBody.rk4_step: y advanced by dt in place; the work of the step; F0: the force at its start */
 static double rk4(Body *b, const double *sp, const double *law, double *y, double dt, double *F0) {
-    double k[4][13], s[13], FM[6], P, loaded, area, work = 0.0;
+    double k[4][Y_COUNT], s[Y_COUNT], FM[6], P, loaded, area, work = 0.0;
     static const double c[4] = {0.0, 0.5, 0.5, 1.0}, wt[4] = {1.0, 2.0, 2.0, 1.0};
     for (int i = 0; i < 4; ++i) {
         if (i) {
             double cdt = c[i] * dt;
-            for (int j = 0; j < 13; ++j) s[j] = y[j] + cdt * k[i - 1][j];
+            for (int j = 0; j < Y_COUNT; ++j) s[j] = y[j] + cdt * k[i - 1][j];
         } else {
             memcpy(s, y, sizeof s);
             if (b->T) b->T[T_COMMIT] = 1.0; /* RigidRun.step: the step's first stage records the tunnel */
@@ -221,27 +213,28 @@ static double rk4(Body *b, const double *sp, const double *law, double *y, doubl
         work += wt[i] * P;
     }
     double h = dt / 6.0;
-    for (int j = 0; j < 13; ++j) y[j] = y[j] + h * (((k[0][j] + 2 * k[1][j]) + 2 * k[2][j]) + k[3][j]);
-    double nq = norm4(y + 3);
-    for (int j = 3; j < 7; ++j) y[j] /= nq;
+    for (int j = 0; j < Y_COUNT; ++j) y[j] = y[j] + h * (((k[0][j] + 2 * k[1][j]) + 2 * k[2][j]) + k[3][j]);
+    double nq = norm4(y + Y_QUAT);
+    for (int j = Y_QUAT; j < Y_QUAT + 4; ++j) y[j] /= nq;
     return h * work;
 }
 
 /* the axis (tail to nose) of state y: R (0, -1, 0) */
 static void axis_of(const double *y, double *a) {
     double R[9], down[3] = {0.0, -1.0, 0.0};
-    quat_to_matrix(y + 3, R);
+    quat_to_matrix(y + Y_QUAT, R);
     matvec(R, down, a);
 }
 
 /* a history row's depth of the tip (mm) and energy error at state y (RigidRun.snapshot) */
 static void row_of(const double *sp, const double *y, double work, double *nose, double *error) {
     double R[9], w[3], tip[3];
-    quat_to_matrix(y + 3, R);
-    omega_of(R, sp + S_IINV, y + 10, w);
+    quat_to_matrix(y + Y_QUAT, R);
+    omega_of(R, sp + S_IINV, y + Y_MOMENTUM, w);
     matvec(R, sp + S_TIP, tip);
-    *nose = -(y[1] + tip[1]) * 1e3;
-    double ke = 0.5 * sp[S_MASS] * dot3(y + 7, y + 7) + 0.5 * dot3(w, y + 10), ke0 = sp[S_KE0];
+    *nose = -(y[Y_CENTRE + 1] + tip[1]) * 1e3;
+    double ke = 0.5 * sp[S_MASS] * dot3(y + Y_VELOCITY, y + Y_VELOCITY) + 0.5 * dot3(w, y + Y_MOMENTUM),
+           ke0 = sp[S_KE0];
     double scale = ke0, aw = fabs(work);
     if (aw > scale) scale = aw;
     if (ke > scale) scale = ke;
@@ -250,14 +243,14 @@ static void row_of(const double *sp, const double *y, double work, double *nose,
 }
 
 static int finite13(const double *y) {
-    for (int j = 0; j < 13; ++j)
+    for (int j = 0; j < Y_COUNT; ++j)
         if (!isfinite(y[j])) return 0;
     return 1;
 }
 
-/* One shot from y (13) at t = 0 to its end or stop; y becomes the final state. */
+/* One shot from y (Y_COUNT) at t = 0 to its end or stop; y becomes the final state. */
 static void one_shot(Body *b, const double *sp, const double *law, double *y, double *res) {
-    b->at[3] = 2.0; /* no unit quaternion: nothing kept from the last shot (another inertia) */
+    b->at[Y_QUAT] = 2.0; /* no unit quaternion: nothing kept from the last shot (another inertia) */
     b->T = NULL;
     if (sp[S_TUNNEL] != 0.0 && b->tunnel) { /* fepen.laws.tunnel.Tunnel's header, empty */
         double *T = b->T = b->tunnel;
@@ -265,7 +258,7 @@ static void one_shot(Body *b, const double *sp, const double *law, double *y, do
         T[T_CAP] = b->cap; T[T_S] = b->sectors; T[T_SPACING] = sp[S_SPACING]; T[T_XI_SH] = sp[S_XI_SH];
         T[T_A0] = sp[S_A0];
     }
-    double t = 0.0, work = 0.0, next = 0.0, prev[13], R[9], w[3];
+    double t = 0.0, work = 0.0, next = 0.0, prev[Y_COUNT], R[9], w[3];
     double max_nose = -INFINITY, max_error = -INFINITY, rows = 0.0;
     int64_t steps = 0;
     int outcome = 0, status = 0;
@@ -273,7 +266,7 @@ static void one_shot(Body *b, const double *sp, const double *law, double *y, do
     const double dt = sp[S_DT], interval = sp[S_HISTORY], thk = sp[S_THICKNESS];
     double F[3] = {0.0, 0.0, 0.0}; /* a row's force: at the start of the last step (at t = 0 the initial one) */
     if (interval > 0.0) {
-        double dy[13], FM[6], P, loaded, area;
+        double dy[Y_COUNT], FM[6], P, loaded, area;
         derivative(b, sp, law, y, dy, FM, &P, &loaded, &area);
         memcpy(F, FM, sizeof F);
     }
@@ -308,16 +301,17 @@ static void one_shot(Body *b, const double *sp, const double *law, double *y, do
         }
         double a[3];
         axis_of(y, a);
-        outcome = penetration_rule(ymin, ymax, y + 7, a, sp[S_MASS], sp[S_KE0], thk, sp[S_UNTIL_STOPPED] != 0.0,
-                                   sp[S_STOP_ENERGY], &entered);
-        if (outcome == 3 && dot3(y + 7, a) <= 0.0) { /* RigidRun.stop_rules: back to where V.a vanishes */
+        outcome = penetration_rule(ymin, ymax, y + Y_VELOCITY, a, sp[S_MASS], sp[S_KE0], thk,
+                                   sp[S_UNTIL_STOPPED] != 0.0, sp[S_STOP_ENERGY], &entered);
+        /* RigidRun.stop_rules: back to where V.a vanishes */
+        if (outcome == OUTCOME_EMBEDDED && dot3(y + Y_VELOCITY, a) <= 0.0) {
             double ap[3];
             axis_of(prev, ap);
-            double a0 = dot3(prev + 7, ap), a1 = dot3(y + 7, a);
+            double a0 = dot3(prev + Y_VELOCITY, ap), a1 = dot3(y + Y_VELOCITY, a);
             double lam = a0 - a1 > 0.0 ? a0 / (a0 - a1) : 1.0;
-            for (int j = 0; j < 13; ++j) y[j] = prev[j] + lam * (y[j] - prev[j]);
-            double nq = norm4(y + 3);
-            for (int j = 3; j < 7; ++j) y[j] /= nq;
+            for (int j = 0; j < Y_COUNT; ++j) y[j] = prev[j] + lam * (y[j] - prev[j]);
+            double nq = norm4(y + Y_QUAT);
+            for (int j = Y_QUAT; j < Y_QUAT + 4; ++j) y[j] /= nq;
             t -= (1.0 - lam) * dt;
         }
     }
@@ -335,7 +329,7 @@ static void one_shot(Body *b, const double *sp, const double *law, double *y, do
 /* n shots sharing k load points (r0, N0: body-frame arms and normals; area, ell = sqrt(area), radius, Rm,
  * sphi0: the law's per-point constants; gauss: ng nodes then ng weights; points, moment: rigid_kernel.c's
  * rigid_points and force_moment). Per shot: sp (n, S_COUNT), laws (n, nlaw) the TargetLaw's numbers (P_COUNT and
- * its random field's modes, padded to the longest), y (n, 13) the initial state, overwritten by the final one;
+ * its random field's modes, padded to the longest), y (n, Y_COUNT) the initial state, overwritten by the final one;
  * res (n, R_COUNT). Returns S_COUNT * 10000 + R_COUNT * 100 + nlaw (the caller checks the layouts), or -1 when
  * the scratch is not allocated or a law is longer than nlaw. */
 int32_t rigid_batch(int32_t n, int32_t k, const double *r0, const double *N0, const double *area, const double *ell,
@@ -359,7 +353,8 @@ int32_t rigid_batch(int32_t n, int32_t k, const double *r0, const double *N0, co
     const size_t tlen = (size_t)(T_HEADER + (int64_t)cap * (T_STATION + sectors));
     for (int32_t s = 0; s < n; ++s) {
         b.tunnel = tunnels ? tunnels + (size_t)s * tlen : NULL; /* each shot's own: its final tunnel stays */
-        one_shot(&b, sp + (size_t)s * S_COUNT, laws + (size_t)s * nlaw, y + (size_t)s * 13, res + (size_t)s * R_COUNT);
+        one_shot(&b, sp + (size_t)s * S_COUNT, laws + (size_t)s * nlaw, y + (size_t)s * Y_COUNT,
+                res + (size_t)s * R_COUNT);
     }
     free(scratch);
     free(idx);

@@ -39,6 +39,8 @@
    fepen/laws/materials_kernel.c, its one home, built here as it is built there (no contraction) */
 #include "../laws/materials_kernel.c"
 
+#include "cell_kernel.h"
+
 /* ------------------------------------------------------------------------------------------------------
    Node passes */
 
@@ -233,10 +235,10 @@ void kinematics_pass(int32_t n, const double *restrict x, const int32_t *restric
                 for (int32_t j = 0; j < 4; j++) vol[dofs[4 * e + j] * nmat + m] += c;
             }
     }
-    out[0] = jmin;
-    out[1] = worst;
-    out[2] = dtmin;
-    out[3] = dtcell;
+    out[KIN_J_MIN] = jmin;
+    out[KIN_J_CELL] = worst;
+    out[KIN_DT_MIN] = dtmin;
+    out[KIN_DT_CELL] = dtcell;
 }
 
 /* The fused stress and force pass over cells [0, n), one block of BLOCK cells at a time:
@@ -418,10 +420,10 @@ int32_t cell_pass(int32_t n, const double *restrict x, const double *restrict v,
             }
         }
     }
-    totals[0] = plastic;
-    totals[1] = heat;
-    totals[2] = 0.0;
-    totals[3] = dmax;
+    totals[TOT_PLASTIC] = plastic;
+    totals[TOT_HEAT] = heat;
+    totals[TOT_RESERVED] = 0.0;
+    totals[TOT_D_MAX] = dmax;
     return n_yield;
 }
 

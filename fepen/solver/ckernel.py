@@ -9,6 +9,13 @@ import numpy as np
 
 from fepen import native
 
+#: kinematics_pass's out, read from cell_kernel.h; cell_pass's totals as fepen.solver.explicit and the numba
+#: kernels index them (plastic work, heat, 0, the largest increment), held to the header when the kernel is loaded
+KIN_J_MIN, KIN_J_CELL, KIN_DT_MIN, KIN_DT_CELL, KIN_COUNT = native.enum_values(
+    native.PACKAGE / native.KERNELS["cells"].header, "KIN_J_MIN", "KIN_J_CELL", "KIN_DT_MIN", "KIN_DT_CELL",
+    "KIN_COUNT")
+native.shares("cells", "TOT_", [("TOT_PLASTIC", 1), ("TOT_HEAT", 1), ("TOT_RESERVED", 1), ("TOT_D_MAX", 1)])
+
 
 def library():
     """The loaded C kernel (fepen.native's "cells"), or None (then ``why_not()`` says why) — built on first use."""
@@ -60,7 +67,7 @@ class CellPasses:
         self.dofs32 = np.ascontiguousarray(dofs, dtype=np.int32)
         assert sT.shape == (6, n) and x.shape == v.shape and (Fc is None or Fc.shape == (n, 4, 3))
         assert nvol is None or (nvol.ndim == 2 and len(nvol) == len(x)) and (fint is None or fint.shape == x.shape)
-        self._out = np.zeros(4)
+        self._out = np.zeros(KIN_COUNT)
         self._keep = (x, v, mat, orient, vol0, speed, params, G_m, nodal_p, sT, eps_p, temp, sy0, cvol,
                       cell_dt, Fc, totals, nvol, fint)
         a = _addr
@@ -87,7 +94,7 @@ class CellPasses:
         """
         self._lib.kinematics_pass(*self._kin, int(with_step), *self._kin_out, quantum, *self._kin_sum)
         o = self._out
-        return float(o[0]), int(o[1]), float(o[2]), int(o[3])
+        return float(o[KIN_J_MIN]), int(o[KIN_J_CELL]), float(o[KIN_DT_MIN]), int(o[KIN_DT_CELL])
 
     def cells(self, dt: float, quantum: float = 1.0) -> int:
         """The fused pass over a step dt: stress, return, plastic work, Fc (if given), the internal forces into

@@ -136,7 +136,7 @@ class TargetLoad:
             if deferred:
                 return sums
             t1 = perf_counter()
-            out = _totals(f, hit, sums[3:], comm)
+            out = _totals(f, hit, sums[tg.SUM_LOADED:tg.SUM_AREA + 1], comm)
             comm_s += perf_counter() - t1
             return out
 
@@ -186,7 +186,8 @@ class TargetLoad:
             hit, local, comm = self._pending
             self._pending = None
             out = _totals(self.last_force, hit, local, comm)
-            self._force, self._contact_nodes, self._area = out[:3], int(out[3]), float(out[4])
+            self._force, self._contact_nodes, self._area = (out[tg.SUM_FORCE:tg.SUM_FORCE + 3], int(out[tg.SUM_LOADED]),
+                                                            float(out[tg.SUM_AREA]))
 
     # the last step's totals over the ranks (collective to read while pending: the history rows and
     # checkpoints read them on every rank): force (N, world frame), contact_nodes (loaded points), area (m²)
@@ -269,9 +270,9 @@ class TargetLoad:
 def _totals(f: np.ndarray, hit: np.ndarray, local, comm) -> np.ndarray:
     """(force (3), loaded points, loaded area) over the ranks: the loaded points' forces f[hit] summed exactly
     with each rank's count and area (local (2,)), in one reduction (the same on any partition)."""
-    terms = np.zeros((len(hit) + 1, 5))
-    terms[:-1, :3] = f[hit]
-    terms[-1, 3:] = local
+    terms = np.zeros((len(hit) + 1, tg.SUM_COUNT))  # target_kernel.h's sums
+    terms[:-1, tg.SUM_FORCE:tg.SUM_FORCE + 3] = f[hit]
+    terms[-1, tg.SUM_LOADED:tg.SUM_AREA + 1] = local
     return assembly.exact_sum(terms, comm)
 
 

@@ -1,0 +1,34 @@
+/* The batched rigid shots' interface (rigid_batch.c): the per-shot numbers and results as Python lays them out
+ * (fepen/runs/batch.py's SHOT_NUMBERS and RESULTS, checked against these enums, name by name, when the kernel is
+ * loaded) and the functions fepen.native binds (their ctypes signatures are read from these prototypes). */
+#ifndef FEPEN_RIGID_BATCH_H
+#define FEPEN_RIGID_BATCH_H
+#include <stdint.h>
+
+/* per-shot numbers, in this order (fepen/runs/batch.py SHOT_NUMBERS) */
+enum { S_MASS, S_DT, S_HARD_END, S_THICKNESS /* < 0: none */, S_UNTIL_STOPPED, S_HISTORY /* <= 0: none */,
+       S_CRATER /* 1: the linear crater */, S_CRATER_KD, S_CRATER_C, S_KE0, S_STOP_ENERGY,
+       S_TIP /* 3: the tip about the centre */, S_TAIL = S_TIP + 3, S_IINV = S_TAIL + 3 /* 9 */,
+       S_TUNNEL = S_IINV + 9 /* 1: the tunnel (tunnel_kernel.c) */, S_SPACING, S_XI_SH, S_A0, S_RESERVED,
+       S_SHOULDER /* 3: the shoulder's centre about the body's centre */, S_COUNT = S_SHOULDER + 3 };
+/* per-shot results */
+enum { R_T, R_STEPS, R_OUTCOME /* events_kernel.h's OUTCOME_ (0: ended) */, R_WORK, R_ENTERED,
+       R_MAX_NOSE /* mm */, R_MAX_ERROR, R_ROWS, R_STATUS /* 0 ok, 1 a non-finite state */, R_COUNT };
+/* a shot's state y, as fepen.laws.rigid_body.RigidState.as_array lays it out: the centre (3), the unit quaternion
+ * (4), the velocity (3), the angular momentum (3) */
+enum { Y_CENTRE, Y_QUAT = Y_CENTRE + 3, Y_VELOCITY = Y_QUAT + 4, Y_MOMENTUM = Y_VELOCITY + 3,
+       Y_COUNT = Y_MOMENTUM + 3 };
+
+/* n shots sharing k load points (rigid_batch.c says what each argument holds); points, moment: rigid_kernel.h's
+ * rigid_points and force_moment. Returns S_COUNT * 10000 + R_COUNT * 100 + nlaw, or -1 */
+int32_t rigid_batch(int32_t n, int32_t k, const double *r0, const double *N0, const double *area, const double *ell,
+                    const double *radius, const double *Rm, const double *sphi0, const double *gauss, int32_t ng,
+                    void *points, void *moment, const double *sp, const double *laws, int32_t nlaw, double *y,
+                    double *res, const double *xi, int32_t cap, int32_t sectors, double *tunnels);
+
+/* the batch's law on one set of points, for the tests against point_forces */
+void batch_law(int32_t k, const double *x, const double *v, const double *n, const double *area, const double *ell,
+               const double *radius, const double *Rm, const double *sphi0, const double *axis, const double *p,
+               const double *gauss, int32_t ng, double *f, double *sums);
+
+#endif
