@@ -175,9 +175,10 @@ def cache_dir() -> Path:
 _CAD_FIELDS = {"cad_file": "", "cad_scale": 1.0, "cad_digest": "", "tip_point": (), "tail_point": ()}
 
 
-def _record(body: Shape | CadBody) -> dict:
+@functools.singledispatch
+def _record(body) -> dict:
     """The body as the mesh-cache key and sidecar hold it, in the layout of the one Shape type that held
-    CAD bodies too.
+    CAD bodies too, by the body's kind.
 
     Args:
         body: a Shape or a CadBody.
@@ -186,13 +187,23 @@ def _record(body: Shape | CadBody) -> dict:
         A Shape's fields and _CAD_FIELDS; for a CadBody, nose "cad", its calibre, length and CAD fields and
         every other Shape field at its default.
     """
-    if not body.exact:  # a CadBody
-        rec = {f.name: f.default for f in fields(Shape)}
-        rec.update(diameter=body.diameter, length=body.length, nose="cad", cad_file=body.file,
-                   cad_scale=body.scale, cad_digest=body.digest, tip_point=body.tip_point,
-                   tail_point=body.tail_point)
-        return rec
+    raise TypeError(f"no mesh-cache record for a {type(body).__name__}")
+
+
+@_record.register(Shape)
+def _shape_record(body) -> dict:
+    """A Shape's fields and _CAD_FIELDS at a parametric shape's values."""
     return {**asdict(body), **_CAD_FIELDS}
+
+
+@_record.register(CadBody)
+def _cad_record(body) -> dict:
+    """Nose "cad", the CAD body's calibre, length and CAD fields, every other Shape field at its default."""
+    rec = {f.name: f.default for f in fields(Shape)}
+    rec.update(diameter=body.diameter, length=body.length, nose="cad", cad_file=body.file,
+               cad_scale=body.scale, cad_digest=body.digest, tip_point=body.tip_point,
+               tail_point=body.tail_point)
+    return rec
 
 
 def _from_record(rec: dict) -> Shape | CadBody:
@@ -274,10 +285,33 @@ def _verify_model(shape: Shape | CadBody, charge: bool, mass, rho_s, rho_c) -> N
         got = _gmsh_mass(rho_s, rho_c)
         if abs(got - mass) > max(MASS_TOLERANCE, 0.01 * mass):  # the sizing may stop short of its tolerance
             raise _BadEntry(f"its mass is {got:.6g} kg, the shot's {mass:.6g} kg")
-    if not shape.exact:
-        return
+    _verify_extent(shape, charge)
+
+
+@functools.singledispatch
+def _verify_extent(shape, charge: bool) -> None:
+    """Rank 0: the mesh in gmsh against the body's exact volume and extent (_BadEntry when it disagrees), by the
+    body's kind.
+
+    Args:
+        shape: a Shape or a CadBody. charge: the charge is meshed.
+    """
+    raise TypeError(f"no extent to verify for a {type(shape).__name__}")
+
+
+@_verify_extent.register(CadBody)
+def _cad_extent(shape, charge: bool) -> None:
+    """A CAD body: no exact volume; its extent is the file's (nothing to check)."""
+
+
+@_verify_extent.register(Shape)
+def _exact_extent(shape, charge: bool) -> None:
+    """The exact body: its volume within VOLUME_TOLERANCE, its nodes within the calibre, from the tip at y = 0
+    to the base at y = length (to 1e-6 of the length)."""
+    import gmsh
+
     volume = gmsh_model.tet_volumes(tags.SHELL).sum() + (gmsh_model.tet_volumes(tags.CHARGE).sum() if charge else 0.0)
-    exact = shape.outer_volume() if charge else shape.shell_volume()
+    exact = shape.exact_volume(charge)
     if abs(volume / exact - 1.0) > VOLUME_TOLERANCE:
         raise _BadEntry(f"its volume is {volume:.6g} m^3, the body's {exact:.6g} m^3")
     x = np.asarray(gmsh.model.mesh.getNodes()[1]).reshape(-1, 3)
@@ -695,8 +729,7 @@ def metrics(pm: ProjectileMesh, density: dict, speed: dict, safety: float, nomin
 
     shell_v = total(vol[tag == tags.SHELL])
     charge_v = total(vol[tag == tags.CHARGE])
-    cad = not pm.shape.exact  # no exact volume, no cavity sized
-    exact_total = None if cad else pm.shape.outer_volume() if pm.charge else pm.shape.shell_volume()
+    exact_total = pm.shape.exact_volume(pm.charge)  # a CAD body's: None (no exact volume)
     volume = shell_v + charge_v
     h = nominal_size
     shortest = smallest(alt)
@@ -714,7 +747,7 @@ def metrics(pm: ProjectileMesh, density: dict, speed: dict, safety: float, nomin
         "nominal_size_m": h,
         "altitude_over_size": shortest / h,
         "stable_dt_s": safety * smallest(alt / c),
-        "cavity_length_m": 0.0 if cad else pm.shape.cavity_length,
+        "cavity_length_m": pm.shape.cavity_length,  # a CAD body's: 0.0 (no cavity sized)
         "mesh_s": pm.mesh_s,
         "from_cache": pm.cached,
         "ranks": comm.size,

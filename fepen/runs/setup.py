@@ -337,7 +337,7 @@ def check_supported(scene, built: Built | None = None) -> Built:
         from fepen import dolfinx_api
 
         dolfinx_api.check_version()  # a mesh is made: only on the dolfinx releases fepen supports
-    if scene.effects.fidelity != "rigid" or not built.shape.exact:  # a volume mesh is made
+    if built.shape.needs_volume_mesh(scene.effects.fidelity):
         check_mesh_cost(scene, MPI.COMM_WORLD, built)
     if scene.target.kind == "concrete":
         check_friction(scene)
@@ -446,9 +446,9 @@ def envelope_facts(scene, built: Built | None = None) -> dict:
     target = ("layered" if scene.get("target.layers") else "a rigid wall" if t.kind != "concrete" else t.material)
     mass = scene.get("projectile.mass")  # absent for a fixed cavity or a CAD body: from the body
     fc = scene.derived["target.fc_cylinder"]  # a layered target's are its layers' (its verdict: not validated)
-    if mass is None and built is not None and built.shape.exact:  # a CAD body's: from its mesh
+    if mass is None and built is not None:  # the body's, when known before any mesh (a CAD body's: None)
         fill = scene.charge.material.density if scene.effects.charge else None
-        mass = built.shape.mass(built.shell_density, fill)
+        mass = built.shape.exact_mass(built.shell_density, fill)
     values = {"D_m": D, "L_over_D": L / D, "crh": scene.get("projectile.crh"), "mass_kg": mass, "V_m_s": i.velocity,
               "fc_cylinder_Pa": None if isinstance(fc, list) else fc,
               "rho_kg_m3": t.density, "obliquity_deg": i.obliquity_deg, "attack_deg": i.attack_deg}
