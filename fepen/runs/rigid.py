@@ -188,7 +188,7 @@ class RigidRun(Run):
         self.dt = sh.rigid_step or budget.default_step(self.mass, self.v0, sh.nominal_diameter, self.law)
         if sh.end_time is None:  # a shot that never stops (a body slower than its first ring's reach) ends
             self.end = min(self.end, (budget.MAX_RIGID_STEPS - 0.5) * self.dt)  # in the step budget, "ended"
-        if sh.tunnel and sh.rigid_step is None and isinstance(self.law, tg.TargetLaw):  # the wall's spring
+        if sh.tunnel and sh.rigid_step is None:  # the wall's spring (a tunnel: a target of one material)
             self.dt = min(self.dt, budget.wall_step(self.mass, self.shape.diameter, self.shape.length, self.law))
         self.tip_ref = np.zeros(3)
         self.tail_ref = np.array([0.0, self.shape.length, 0.0])

@@ -86,6 +86,23 @@ def test_body_kinds_carry_their_own_behaviour():
     assert not found, found
 
 
+#: modules that still branch on the target's kind, each removed by its own owner (issue 60, item 5):
+#: fepen/studies/ (bands, spec, uncertainty: target.kind != "concrete"), laws/target.py (load_on_points'
+#: getattr(law, "layered"): TargetLaw.point_forces replaces it), runs/batch.py (isinstance(run.law, TargetLaw))
+TARGET_KIND_PENDING = ("studies/", "laws/target.py", "runs/batch.py")
+
+
+def test_target_kinds_carry_their_own_behaviour():
+    """No branch on the target's kind outside the kinds themselves (fepen.runs.targets, fepen.laws.layers): no
+    target.kind == or !=, no layered flag read, no isinstance on TargetLaw or Layered (issue 60, item 5); a
+    caller asks the Shot's kind (law, check, plates, envelope_name, hard_end, tunnel, crossings)."""
+    homes = {"runs/targets.py", "laws/layers.py"}
+    pattern = (r"target\.kind\s*[!=]=|\.kind\s*[!=]=\s*\"(concrete|rigid-wall)\"|\.layered\b|"
+               r"getattr\([^)]*\"layered\"|isinstance\([^)]*\b(TargetLaw|Layered)\b")
+    found = _lines_matching(pattern, homes, TARGET_KIND_PENDING)
+    assert not found, found
+
+
 def test_tests_mirror_the_package():
     """Every subpackage of fepen has its folder of unit tests, holding at least one test file."""
     unit = Path(__file__).resolve().parent
