@@ -22,7 +22,7 @@ from fepen.geometry.shape import Shape
 
 SHELL, CHARGE = 1, 2
 OUTER, CAVITY = 11, 12
-#: the charge's side of the cavity wall when it has nodes of its own (fepen.mesh.split_wall)
+#: the charge's side of the cavity wall when it has nodes of its own (fepen.geometry.partition.split_wall)
 CHARGE_FACE = 13
 
 

@@ -79,7 +79,7 @@ def test_body_kinds_carry_their_own_behaviour():
     """No isinstance on a body kind (Shape, CadBody) and no ``.exact`` flag read outside the body kinds' own
     modules (issue 60, item 5): a caller asks the body (nose_length, outer_radius, meshed_volume, exact_volume,
     exact_mass, needs_volume_mesh, crater_nose_factor, after_meshing) or calls a function registered per kind
-    (functools.singledispatch: gmsh_model._build, mesh._record, mesh._verify_extent, surface.facet_points,
+    (functools.singledispatch: gmsh_model._build, mesh_cache.record, mesh_cache._verify_extent, surface.facet_points,
     revolution.nose_zone, rigid.body_points, probes.outside_radially)."""
     homes = {"geometry/shape.py", "geometry/cad.py"}
     found = _lines_matching(r"isinstance\([^)]*\b(CadBody|Shape)\b|\.exact\b", homes)

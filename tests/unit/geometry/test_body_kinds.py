@@ -4,8 +4,7 @@ through one method or one function registered per kind (issue 60, item 5): no ca
 import numpy as np
 import pytest
 
-from fepen.geometry import gmsh_model, revolution
-from fepen.geometry import mesh as fmesh
+from fepen.geometry import gmsh_model, mesh_cache, revolution
 from fepen.geometry.cad import CadBody
 from fepen.geometry.shape import Shape
 
@@ -57,8 +56,9 @@ def test_every_per_kind_behaviour_is_registered_for_both_kinds(registry):
     from fepen.runs import probes, rigid
     from fepen.solver import surface
 
-    fn = {"gmsh model": gmsh_model._build, "cache record": fmesh._record, "cached extent": fmesh._verify_extent,
-          "load points": surface.facet_points, "rigid body": rigid.body_points, "nose zone": revolution.nose_zone,
+    fn = {"gmsh model": gmsh_model._build, "cache record": mesh_cache.record,
+          "cached extent": mesh_cache._verify_extent, "load points": surface.facet_points,
+          "rigid body": rigid.body_points, "nose zone": revolution.nose_zone,
           "probe outline": probes.outside_radially}[registry]
     assert {Shape, CadBody} <= set(fn.registry)
     assert fn.registry[Shape] is not fn.registry[CadBody]
