@@ -2,4 +2,4 @@
 bodies, gmsh model, distributed dolfinx mesh, tags, tetrahedra."""
 
 __all__ = ["shape", "profile", "checks", "mass_rule", "projection", "revolution", "cad", "tags", "tetra", "frames",
-           "gmsh_model", "mesh"]
+           "gmsh_model", "mesh", "mesh_cache", "partition"]

@@ -40,10 +40,10 @@ class CadBody:
     tip_point: tuple = ()
     tail_point: tuple = ()
 
-    #: not an exact solid: no meridian, surface or volume but its mesh's (Shape.exact is True)
-    exact: ClassVar[bool] = False
     #: a CAD body is meshed solid: fepen sizes no cavity in it
     has_cavity: ClassVar[bool] = False
+    #: no cavity sized (mesh.json's cavity_length_m)
+    cavity_length: ClassVar[float] = 0.0
     #: the nose's length is not known (taken as 0: the whole body is calibre)
     nose_length: ClassVar[float] = 0.0
 
@@ -73,6 +73,40 @@ class CadBody:
     def meshed_volume(self, charge: bool) -> float:
         """The volume gmsh fills, as known before meshing (m^3): the enclosing cylinder's."""
         return math.pi / 4.0 * self.diameter ** 2 * self.length
+
+    def exact_volume(self, charge: bool) -> None:
+        """The exact volume its mesh approximates: not known (no meridian), None.
+
+        Args:
+            charge: unused (a CAD body has no charge).
+
+        Returns:
+            None.
+        """
+        return None
+
+    def exact_mass(self, shell_density: float, charge_density: float | None = None) -> None:
+        """The mass known before any mesh: none, None (it comes from the mesh).
+
+        Args:
+            shell_density, charge_density: unused.
+
+        Returns:
+            None.
+        """
+        return None
+
+    def needs_volume_mesh(self, fidelity: str) -> bool:
+        """Whether a run of this fidelity meshes the body: always (the rigid body's load points and mass
+        properties come from its mesh, fepen.runs.rigid.mesh_points).
+
+        Args:
+            fidelity: effects.fidelity (unused).
+
+        Returns:
+            True.
+        """
+        return True
 
     def crater_nose_factor(self) -> float:
         """N* the linear crater takes: 0, as fepen always took it (a CAD body has no meridian)."""

@@ -11,6 +11,7 @@ The nose tip (0, 0, 0) and the tail centre (0, L, 0) are mesh nodes (see :func:`
 
 from __future__ import annotations
 
+import functools
 import math
 from dataclasses import dataclass
 
@@ -21,7 +22,7 @@ from fepen.geometry.shape import Shape
 
 SHELL, CHARGE = 1, 2
 OUTER, CAVITY = 11, 12
-#: the charge's side of the cavity wall when it has nodes of its own (fepen.mesh.split_wall)
+#: the charge's side of the cavity wall when it has nodes of its own (fepen.geometry.partition.split_wall)
 CHARGE_FACE = 13
 
 
@@ -148,13 +149,28 @@ def build(shape: Shape | cad.CadBody, opts: MeshOptions, charge: bool, seed: int
         charge: mesh the cavity as a second volume (the explosive) when True; else it is a void.
         seed: gmsh's random seed (different seeds give different, equally valid meshes).
     """
+    _stage("building")
+    _build(shape, opts, charge, seed)
+
+
+@functools.singledispatch
+def _build(shape, opts: MeshOptions, charge: bool, seed: int) -> None:
+    """The body in the current gmsh model, meshed, by the body's kind (build's arguments)."""
+    raise TypeError(f"no gmsh model for a {type(shape).__name__}")
+
+
+@_build.register(cad.CadBody)
+def _build_cad(shape, opts: MeshOptions, charge: bool, seed: int) -> None:
+    """A CadBody: imported as its file draws it, not revolved (no charge)."""
+    cad.build(shape.file, shape.scale)
+    _size_and_mesh(opts, 0.0, seed)
+
+
+@_build.register(Shape)
+def _build_exact(shape, opts: MeshOptions, charge: bool, seed: int) -> None:
+    """The exact solid: its meridians revolved, tagged, the tip and tail centre made nodes."""
     import gmsh
 
-    _stage("building")
-    if not shape.exact:  # a CadBody: imported, not revolved
-        cad.build(shape.file, shape.scale)
-        _size_and_mesh(opts, 0.0, seed)
-        return
     gmsh.model.add("projectile")
     _revolve(shape, charge)
     outer_s = _tag(shape, charge)

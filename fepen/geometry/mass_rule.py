@@ -1,5 +1,6 @@
 """The mass-reaching rule (docs/theory.md §1.1): the projectile of a given outside with a given total mass, its
-cavity sized, reduced or dropped (reach_mass), and the cavity length that gives a mass (with_mass).
+cavity sized, reduced or dropped (reach_mass), the cavity length that gives a mass (with_mass), and on the
+mesh, the cavity length corrected until gmsh's mesh has the mass (mesh_to_mass).
 """
 
 from __future__ import annotations
@@ -8,6 +9,7 @@ import math
 from dataclasses import dataclass, replace
 
 from fepen.errors import InputError
+from fepen.geometry import gmsh_model, tags
 from fepen.geometry.cad import CadBody
 from fepen.geometry.checks import check, fits, front_limit, max_cavity_length, min_wall
 from fepen.geometry.shape import Shape
@@ -179,3 +181,51 @@ def _one_cylinder(shape, solid, widest, length, mass, shell_density, charge_dens
                                    f"{1e3 * length:.1f} mm and steel density adjusted to {rho:.1f} kg/m^3 "
                                    f"({rho / shell_density - 1:+.1%}; lighter than any cavity makes it)")
     return None
+
+
+# ---------------------------------------------------------------------------------------------------------
+# the cavity sized to the mass on the mesh
+# ---------------------------------------------------------------------------------------------------------
+#: mesh-mass tolerance of the cavity sizing (kg)
+MASS_TOLERANCE = 2.5e-4
+
+
+def mesh_mass(rho_s: float, rho_c: float | None) -> float:
+    """Rank 0: the mass of the mesh in gmsh (kg): its shell at rho_s, its charge at rho_c unless None."""
+    m = rho_s * gmsh_model.tet_volumes(tags.SHELL).sum()
+    if rho_c is not None:
+        m += rho_c * gmsh_model.tet_volumes(tags.CHARGE).sum()
+    return m
+
+
+def mesh_to_mass(shape: Shape | CadBody, opts: gmsh_model.MeshOptions, charge: bool, mass: float | None,
+                 rho_s: float, rho_c: float | None) -> Shape | CadBody:
+    """Rank 0: the body meshed in gmsh, its cavity length corrected until the mesh's mass is within
+    MASS_TOLERANCE of ``mass`` (five tries on seed 1's meshes), then the seeds tried for the best altitude (the
+    surface mesh, hence the mass, kept).
+
+    Args:
+        shape: the checked body (its cavity length a first guess). opts: gmsh's sizes and optimiser.
+        charge: mesh the charge. mass: the mass to reach (kg), or None. rho_s, rho_c: the shell's and the
+            charge's densities (kg/m^3; rho_c None: no charge).
+
+    Returns:
+        The body as meshed: its cavity length as corrected, a CAD body's tracked ends the mesh's nodes.
+    """
+    import gmsh
+
+    current = shape
+    for attempt in range(5):  # the cavity sized to the mass on seed 1's meshes; then the seeds for the altitude
+        gmsh.clear()
+        gmsh_model.build(current, opts, charge, 1)
+        if mass is None or not current.has_cavity:
+            break
+        error = mesh_mass(rho_s, rho_c) - mass
+        if abs(error) <= MASS_TOLERANCE or attempt == 4:
+            break
+        r = 0.5 * current.cavity_diameter
+        step = error / ((rho_s - (rho_c or 0.0)) * math.pi * r * r)
+        current = replace(current, cavity_length=current.cavity_length + step)
+        check(current)
+    gmsh_model.best_seed(opts)  # the volumes again with other seeds: the surface mesh, hence the mass, kept
+    return current.after_meshing()  # a CAD body's tracked ends: mesh nodes

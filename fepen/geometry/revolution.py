@@ -6,11 +6,13 @@ Body frame of fepen.geometry.shape: nose tip at the origin, axis along +y, x and
 
 from __future__ import annotations
 
+import functools
 import math
 
 import numpy as np
 
 from fepen.geometry import profile
+from fepen.geometry.cad import CadBody
 from fepen.geometry.shape import Shape
 
 
@@ -76,23 +78,42 @@ def load_points(shape: Shape, size: float, n_theta: int | None = None, n_gauss: 
     return dict(X=X, area0=area / n_theta, N=N, radius=r, R_meridian=Rm, sin_phi0=sphi)
 
 
-def nose_zone(shape, X: np.ndarray, radius: np.ndarray) -> tuple[float, float]:
-    """The nose zone that wear shortens (docs/theory.md §14.3): from the tip to where the outer radius first
-    reaches the calibre, or to the front of a cavity if that comes first; and the outer radius there.
+@functools.singledispatch
+def nose_zone(shape, X: np.ndarray, radius: np.ndarray, comm=None) -> tuple[float, float]:
+    """The nose zone that wear shortens (docs/theory.md §14.3), by the body's kind: from the tip to where the
+    outer radius first reaches the calibre, or to the front of a cavity if that comes first; and the outer
+    radius there.
 
     Args:
-        shape: the Shape, or a CadBody (no meridian: its zone from the surface points, assumed solid).
+        shape: the Shape (its zone from its meridian), or a CadBody (no meridian: its zone from the surface
+            points, the body taken as solid).
         X: points on the outer surface (k, 3) (m), axis +y from the tip. radius: their distances from the
-            axis (k,) (m).
+            axis (k,) (m). comm: the MPI communicator sharing the points (None: all here).
 
     Returns:
-        (y_c, r_c) (m).
+        (y_c, r_c) (m), the same on every rank of comm.
     """
-    if not shape.exact:
-        y_c = float(X[radius >= (1.0 - 1e-3) * radius.max(), 1].min())
-        return y_c, float(radius.max())
+    raise TypeError(f"no nose zone for a {type(shape).__name__}")
+
+
+@nose_zone.register(Shape)
+def _exact_nose_zone(shape, X, radius, comm=None) -> tuple[float, float]:
+    """The exact solid's, from its meridian (the points are not read)."""
     y_c = shape.nose_length
     inner = shape.inner_path
     if inner:
         y_c = min(y_c, min(min(seg.p0[1], seg.p1[1]) for seg in inner))
     return y_c, float(shape.outer_radius(y_c))
+
+
+@nose_zone.register(CadBody)
+def _cad_nose_zone(shape, X, radius, comm=None) -> tuple[float, float]:
+    """A CAD body's, from the surface points: to the foremost point within 1e-3 of the largest radius."""
+    if comm is None:
+        r_max = float(radius.max())
+        return float(X[radius >= (1.0 - 1e-3) * r_max, 1].min()), r_max
+    from mpi4py import MPI
+
+    r_max = comm.allreduce(float(radius.max(initial=0.0)), op=MPI.MAX)
+    y = X[radius >= (1.0 - 1e-3) * r_max, 1]
+    return comm.allreduce(float(y.min(initial=np.inf)), op=MPI.MIN), r_max

@@ -14,7 +14,6 @@ from __future__ import annotations
 import functools
 import math
 from dataclasses import dataclass
-from typing import ClassVar
 
 import numpy as np
 
@@ -198,12 +197,20 @@ class Shape:
         segs.append(P.Segment.line((r_prev, z_prev), (0.0, z_prev)))
         return segs
 
-    #: an exact solid of revolution: its meridian, surface and volumes are known (CadBody.exact is False)
-    exact: ClassVar[bool] = True
-
     def meshed_volume(self, charge: bool) -> float:
         """The volume gmsh fills (m^3): the outside with a meshed charge, the shell without."""
         return self.outer_volume() if charge else self.shell_volume()
+
+    #: the exact volume its mesh approximates (m^3), the meshed volume (a CadBody's is not known: None)
+    exact_volume = meshed_volume
+
+    def needs_volume_mesh(self, fidelity: str) -> bool:
+        """Whether a run of ``fidelity`` (effects.fidelity) meshes the body: the deformable ones only (a rigid
+        body's load points and mass properties are the exact solid's, fepen.geometry.revolution).
+
+        Returns:
+            True when a volume mesh is made."""
+        return fidelity != "rigid"
 
     def crater_nose_factor(self) -> float | None:
         """N* the linear crater takes: None (Forrestal's ogive formula) for a sharp ogive, else nose_factor."""
@@ -291,6 +298,9 @@ class Shape:
         if charge_density is not None:
             m += charge_density * self.cavity_volume()
         return m
+
+    #: the mass known before any mesh (kg): mass() (a CadBody's comes from its mesh: None)
+    exact_mass = mass
 
     def nose_factor(self) -> float:
         """N* of the nose: (1/(π a²)) ∫ (−n_y)³ dA over the surface facing forward, so that a rigid nose moving

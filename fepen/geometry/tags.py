@@ -6,7 +6,7 @@ shell's side of the shell-charge interface), CHARGE_FACE (the charge's side of a
 
 SHELL, CHARGE = 1, 2
 OUTER, CAVITY = 11, 12
-#: the charge's side of the cavity wall when it has nodes of its own (fepen.geometry.mesh.split_wall)
+#: the charge's side of the cavity wall when it has nodes of its own (fepen.geometry.partition.split_wall)
 CHARGE_FACE = 13
 
 __all__ = ["SHELL", "CHARGE", "OUTER", "CAVITY", "CHARGE_FACE"]

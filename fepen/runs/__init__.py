@@ -3,6 +3,7 @@
     shot         the scene resolved once (Shot): the only reader of the scene in fepen.runs
     budget       what a shot will cost, before it starts: mesh cells and memory, the rigid step
     setup        the builders of every law, shape and mesh from a scene (used by shot)
+    targets      the target's kinds (one material, layered, rigid wall): each its law, checks, end, tunnel
     run          the Run skeleton both fidelities share: loop, stop, summary, history rows
     rigid        RigidRun: the rigid body (no mesh by default)
     batch        rigid shots in batches: one compiled call per projectile, bitwise RigidRun's summaries
@@ -25,8 +26,8 @@ from fepen.runs import setup, shot
 from fepen.runs.rigid import RigidRun
 from fepen.runs.shot import Shot, resolve
 
-__all__ = ["shot", "budget", "setup", "run", "rigid", "batch", "sensitivity", "model", "deformable", "closing",
-           "charge_safety", "events", "outputs",
+__all__ = ["shot", "budget", "setup", "targets", "run", "rigid", "batch", "sensitivity", "model", "deformable",
+           "closing", "charge_safety", "events", "outputs",
            "probes", "checkpoint", "interrupts", "run_scene", "run_in_directory", "expected_end", "resolve", "Shot",
            "RigidRun"]
 

@@ -115,12 +115,7 @@ def build(sh, comm: MPI.Comm = MPI.COMM_WORLD) -> Model:
 
 
 def _nose_zone(s, surf, shape) -> float:
-    """The nose zone's end y_c (m) of the meshed body (fepen.geometry.revolution.nose_zone); a CAD body's
-    from its surface nodes on every rank (collective)."""
-    if shape.exact:
-        return revolution.nose_zone(shape, np.zeros((0, 3)), np.zeros(0))[0]
+    """The nose zone's end y_c (m) of the meshed body (fepen.geometry.revolution.nose_zone by its kind: a Shape's
+    from its meridian, a CAD body's from its surface nodes on every rank; collective)."""
     xb = s.X[np.unique(surf.tri.ravel())]
-    r = np.hypot(xb[:, 0], xb[:, 2])
-    r_max = s.comm.allreduce(float(r.max(initial=0.0)), op=MPI.MAX)
-    y = xb[r >= (1.0 - 1e-3) * r_max, 1]
-    return s.comm.allreduce(float(y.min(initial=np.inf)), op=MPI.MIN)
+    return revolution.nose_zone(shape, xb, np.hypot(xb[:, 0], xb[:, 2]), s.comm)[0]

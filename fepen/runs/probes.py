@@ -12,10 +12,14 @@ motion of the point, its acceleration from the force and moment at the row's sta
 
 from __future__ import annotations
 
+import functools
+
 import numpy as np
 
 from fepen.errors import InputError
+from fepen.geometry.cad import CadBody
 from fepen.geometry.frames import unit_axis
+from fepen.geometry.shape import Shape
 from fepen.io import probes as probes_io
 from fepen.post import signals
 
@@ -32,8 +36,34 @@ def _outside_why(shape, point, charged: bool) -> str | None:
     tol = OUTLINE_TOLERANCE
     if not -tol <= y <= shape.length + tol:
         return f"y = {y:g} m is outside the body's length [0, {shape.length:g}] m (nose tip at the origin, axis +y)"
-    if not shape.exact:  # a CadBody: its enclosing cylinder
-        return None if r <= shape.radius + tol else f"its radius {r:g} m is past the body's {shape.radius:g} m"
+    return outside_radially(shape, y, r, charged, tol)
+
+
+@functools.singledispatch
+def outside_radially(shape, y: float, r: float, charged: bool, tol: float) -> str | None:
+    """Why a point at y along the axis (within the body's length) and r from it lies outside the body, by the
+    body's kind; None when inside.
+
+    Args:
+        shape: a Shape (its exact outline and cavity) or a CadBody (its enclosing cylinder). y, r: the point's
+            axial position and distance from the axis (m). charged: the charge fills the cavity (a point there
+            is inside). tol: how far outside still counts as on the outline (m).
+
+    Returns:
+        The reason, or None.
+    """
+    raise TypeError(f"no outline for a {type(shape).__name__}")
+
+
+@outside_radially.register(CadBody)
+def _outside_cylinder(shape, y, r, charged, tol):
+    """A CAD body: its enclosing cylinder (no exact outline)."""
+    return None if r <= shape.radius + tol else f"its radius {r:g} m is past the body's {shape.radius:g} m"
+
+
+@outside_radially.register(Shape)
+def _outside_exact(shape, y, r, charged, tol):
+    """The exact solid: past its outside, or in its cavity unless charged."""
     outer = float(shape.outer_radius(y))
     if r > outer + tol:
         return f"its distance from the axis {r:g} m is past the outside's radius {outer:g} m at y = {y:g} m"

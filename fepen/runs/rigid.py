@@ -8,6 +8,7 @@ vanishes.
 
 from __future__ import annotations
 
+import functools
 import time
 
 import numpy as np
@@ -16,6 +17,8 @@ from mpi4py import MPI
 from fepen.errors import Interrupted, SimulationError
 from fepen.geometry import mesh as fmesh
 from fepen.geometry import revolution, tags
+from fepen.geometry.cad import CadBody
+from fepen.geometry.shape import Shape
 from fepen.io import results
 from fepen.laws import energy, wear
 from fepen.laws import target as tg
@@ -102,6 +105,44 @@ def default_body(sh: shot.Shot):
 UNSTABLE_ENERGY_ERROR = 0.1
 
 
+@functools.singledispatch
+def body_points(shape, sh, comm, points: dict | None, mass_properties: tuple | None) -> tuple[dict, tuple, int]:
+    """The rigid body's load points and mass properties where not given, by the body's kind.
+
+    Args:
+        shape: the built body (a Shape or a CadBody). sh: the Shot. comm: the communicator.
+        points, mass_properties: as RigidRun takes them (None: the kind's own).
+
+    Returns:
+        (points, (mass, centre, inertia), the volume mesh's cells: 0 without one).
+    """
+    raise TypeError(f"no rigid body for a {type(shape).__name__}")
+
+
+@body_points.register(Shape)
+def _exact_body_points(shape, sh, comm, points, mass_properties):
+    """The exact solid of revolution: rings on its surface and its exact mass properties, no mesh."""
+    if points is None and mass_properties is None:
+        points, mass_properties = default_body(sh)
+    if points is None:
+        points = ring_points(shape, sh.mesh.rigid_panel)
+    if mass_properties is None:
+        mass_properties = revolution.mass_properties(shape, sh.built.shell_density, _charge_density(sh))
+    return points, mass_properties, 0
+
+
+@body_points.register(CadBody)
+def _cad_body_points(shape, sh, comm, points, mass_properties):
+    """A CAD body: only its mesh knows its surface and mass (mesh_points, its mass properties too when no
+    points are given)."""
+    if points is None:
+        return mesh_points(sh, comm)
+    if mass_properties is None:
+        _, mass_properties, cells = mesh_points(sh, comm)
+        return points, mass_properties, cells
+    return points, mass_properties, 0
+
+
 class RigidRun(Run):
     """One rigid-projectile penetration.
 
@@ -129,15 +170,10 @@ class RigidRun(Run):
         if not history:
             self.history.clock.interval = 0.0  # never due: finish_loop records the final row
         self.check_finite = not history
-        self.cells = 0  # no volume mesh unless asked for
-        if points is None and mass_properties is None and sh.built.shape.exact:
-            points, mass_properties = default_body(sh)
-        if points == "mesh" or (points is None and not sh.built.shape.exact):  # a CAD body: only its mesh
+        if points == "mesh":
             points, mass_properties, self.cells = mesh_points(sh, comm)
-        if points is None:
-            points = ring_points(sh.built.shape, sh.mesh.rigid_panel)
-        if mass_properties is None:
-            mass_properties = revolution.mass_properties(sh.built.shape, sh.built.shell_density, _charge_density(sh))
+        else:  # what the body's kind gives where not given
+            points, mass_properties, self.cells = body_points(sh.built.shape, sh, comm, points, mass_properties)
         self.shape = sh.built.shape
         self.mass, c0, inertia = mass_properties
         self.initial_mass = self.mass
@@ -152,7 +188,7 @@ class RigidRun(Run):
         self.dt = sh.rigid_step or budget.default_step(self.mass, self.v0, sh.nominal_diameter, self.law)
         if sh.end_time is None:  # a shot that never stops (a body slower than its first ring's reach) ends
             self.end = min(self.end, (budget.MAX_RIGID_STEPS - 0.5) * self.dt)  # in the step budget, "ended"
-        if sh.tunnel and sh.rigid_step is None and isinstance(self.law, tg.TargetLaw):  # the wall's spring
+        if sh.tunnel and sh.rigid_step is None:  # the wall's spring (a tunnel: a target of one material)
             self.dt = min(self.dt, budget.wall_step(self.mass, self.shape.diameter, self.shape.length, self.law))
         self.tip_ref = np.zeros(3)
         self.tail_ref = np.array([0.0, self.shape.length, 0.0])

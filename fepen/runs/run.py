@@ -22,7 +22,6 @@ from mpi4py import MPI
 
 from fepen.errors import stop_outcome
 from fepen.io import columns, files, results, rundir
-from fepen.laws import layers as fl
 from fepen.runs import events, interrupts, outputs
 from fepen.runs.shot import Shot
 
@@ -106,7 +105,7 @@ class Run:
         self.history_text = results.history_rows()  # history.csv's rows, each formatted once
         law = shot.law
         self.rules = events.StopRules(law.thickness if law is not None else None, shot.end_time is None)
-        self.crossings = fl.Crossings(law.faces()) if shot.layered else None
+        self.crossings = shot.target.crossings(law)  # a layered target's entries and exits, else None
         self.removing = shot.wear is not None or shot.erosion is not None
         self.history = outputs.History(shot.outputs.history_interval, grid=not shot.rigid)
         self.outputs: list = [self.history]

@@ -11,7 +11,6 @@ from dataclasses import dataclass, replace
 import numpy as np
 from mpi4py import MPI
 
-from fepen.data import CONSTANTS, TARGETS
 from fepen.errors import InputError
 from fepen.geometry import gmsh_model, profile, tags, tetra
 from fepen.geometry import mesh as fmesh
@@ -19,8 +18,8 @@ from fepen.geometry.cad import CadBody
 from fepen.geometry.checks import check
 from fepen.geometry.mass_rule import Built, reach_mass
 from fepen.geometry.shape import Shape
-from fepen.laws import layers as fl
-from fepen.laws import target as tg
+from fepen.runs import targets
+from fepen.runs.targets import check_friction, material_law, strength_field, target_law  # noqa: F401 - their names here
 from fepen.scene import SCHEMA
 
 
@@ -55,91 +54,6 @@ def charge_material(scene):
 
     c = scene.charge.material
     return M.bilinear(c.youngs_modulus, c.poisson_ratio, c.density, c.yield_stress, c.tangent_modulus)
-
-
-def target_law(scene):
-    """The target's law (docs/theory.md §8, §16, §17): a TargetLaw of target.material, or a Layered target of
-    target.layers."""
-    layers = scene.get("target.layers")
-    fc = scene.derived["target.fc_cylinder"]
-    if layers:
-        layers = [{**c, "fc_cylinder": f} for c, f in zip(layers, fc)]
-        return fl.build(layers, lambda c: material_law(scene, c, c.get("thickness")))
-    c = {k: scene.get(f"target.{k}") for k in CONSTANTS}
-    c["fc_cylinder"] = fc
-    c["crater"] = scene.effects.crater
-    c["family"] = TARGETS[scene.target.material]["family"]
-    return material_law(scene, c, scene.get("target.thickness"))
-
-
-def material_law(scene, c: dict, thickness: float | None) -> tg.TargetLaw:
-    """The TargetLaw of one target material's constants ``c`` (target.* names without the prefix, absent ones
-    None or missing, plus "crater", "family" and "fc_cylinder", Scene.derived's strength), with the scene's
-    effects, friction and separation.
-
-    Families (fepen/data/targets.toml): concrete, rock and soil by the Mohr–Coulomb cavity expansion (σ_s by
-    target.strength_model), metal by Forrestal–Warren's power-law cavity expansion (fepen.laws.target.
-    metal_cavity_stress)."""
-    t, e = scene.target, scene.effects
-    get = c.get
-    B = get("inertial_factor") if get("inertial_factor") is not None else SCHEMA["target.inertial_factor"].default
-    lock = get("lock_density") or SCHEMA["target.lock_density"].default
-    k = get("crater_depth_factor") if get("crater_depth_factor") is not None else SCHEMA[
-        "target.crater_depth_factor"].default
-    given = get("quasi_static_stress")
-    model = get("strength_model")
-    if c.get("family") == "metal":
-        Y, E, n = get("yield_stress"), get("youngs_modulus"), get("hardening_exponent")
-        sigma_s = given if given is not None else tg.metal_cavity_stress(E, Y, n)
-        T, lam, ca, crush, density = Y, 0.0, tg.metal_cavity_ratio(E, Y), 0.0, get("density")
-        given_flag = True
-    else:
-        Y = get("fc_cylinder")  # the compressive strength on the cylinder basis (Scene.derived)
-        T, lam = get("tensile_strength"), get("pressure_hardening")
-        E = get("youngs_modulus") or tg.youngs_modulus_aci(Y)
-        density = get("density")
-        if given is not None:
-            sigma_s = given
-        elif model in tg.S_MODELS:
-            a, b, size = tg.S_MODELS[model]
-            if model == "scaled-S" and e.wear:  # refitted with the calibrated wear on (docs/wear.md §2)
-                a, b, size = tg.SCALED_S_WEAR
-            a = get("S_coefficient") or a
-            b = get("S_exponent") if get("S_exponent") is not None else b
-            size = get("S_size") or size
-            sigma_s = tg.strength_S(Y, scene.projectile.diameter, a, b, size) * Y
-        else:
-            sigma_s = float(tg.quasi_static_stress(Y, E, T, lam))
-        ca, crush = tg.cavity_ratio(Y, E, T), get("crush_strain") or 1.0 - density / lock
-        given_flag = given is not None or model != "cavity-expansion"
-    factor = scene.get("target.resistance_factor")  # the whole normal stress σ_s + B ρ (v·n)² times it
-    if factor != 1.0:
-        sigma_s, B, given_flag = sigma_s * factor, B * factor, True  # given: the free face scales it (§8.3)
-    return tg.TargetLaw(
-        density=density, Y=Y, E=E, T=T, lam=lam, sigma_s=sigma_s, B=B,
-        thickness=thickness, crater=get("crater"), k=k,
-        D=scene.projectile.diameter, separation=e.separation,
-        phi_min=math.radians(get("separation_angle_deg") if get("separation_angle_deg") is not None
-                             else t.separation_angle_deg),
-        free_surface=e.free_surface, friction=e.friction, mu=t.friction,
-        mu_dynamic=scene.get("target.friction_dynamic"), mu_decay=t.friction_decay,
-        lock_density=lock, crush_strain=crush, c_over_a=ca, given_sigma_s=given_flag,
-        surface_range=get("free_surface_range") or SCHEMA["target.free_surface_range"].default,
-        wall_shear2=tg.wall_modulus(E, tg.WALL_POISSON.get(c.get("family"), tg.WALL_POISSON_DEFAULT),
-                                    1.0 if c.get("family") == "metal" else ca),
-        reload=scene.get("target.tunnel_reload") if scene.get("target.tunnel_reload") is not None else (
-            1.0 if c.get("family") == "metal" else tg.reload_fraction(Y, lam, ca)),
-        **strength_field(scene))
-
-
-def strength_field(scene) -> dict:
-    """The TargetLaw's random field on σ_s (docs/theory.md §8.8) of target.heterogeneity_*: none at cv 0."""
-    cv = scene.get("target.heterogeneity_cv")
-    if not cv > 0.0:
-        return {}
-    return {"field_sigma": tg.field_log_sigma(cv),
-            "field_modes": tg.random_field_modes(scene.get("target.heterogeneity_seed"),
-                                                 scene.get("target.heterogeneity_length"))}
 
 
 #: cavity keys that, when the user gives any of them, fix the cavity (its length is still sized to the mass)
@@ -262,32 +176,14 @@ def thin_target_note(scene, built: Built) -> str | None:
     """A line when the target, or one of its layers, is thinner than the nose is long: the nose is through
     before its shoulder enters, and the cavity-expansion law is a law of thick targets (docs/theory.md §16)."""
     nose = built.shape.nose_length  # a CAD body's is unknown: 0
-    layers = scene.get("target.layers")
-    if scene.target.kind != "concrete" or not nose:
+    if not nose:
         return None
-    for i, layer in enumerate(layers or [{"thickness": scene.get("target.thickness")}]):
-        t = layer.get("thickness")
+    for key, t in targets.of(scene).plates(scene):  # a rigid wall's: none
         if t is not None and t < nose:
-            key = f"target.layers[{i}].thickness" if layers else "target.thickness"
             return (f"{key} {1e3 * t:g} mm is less than the nose length {1e3 * nose:.3g} mm: the nose is through "
                     "before its shoulder enters; the cavity-expansion law is a thick-target law, and a thin "
                     "plate's plugging, petalling or scabbing is beyond the method (docs/theory.md §16)")
     return None
-
-
-def check_friction(scene) -> None:
-    """Refuse effects.friction with the calibrated scaled-S strength and no constants of the user's own
-    (InputError on effects.friction): its σ_s was fitted to depths that contain the interface's resistance, so
-    friction on top counts it twice, and the friction refit predated the separation angle, the free face and
-    the tunnel (it drove C3 37 % too deep); docs/theory.md §8.1."""
-    t = scene.target
-    if scene.effects.friction and t.strength_model == "scaled-S" and not scene.get("target.S_coefficient") \
-            and scene.get("target.quasi_static_stress") is None:
-        raise InputError("effects.friction", "true needs a strength fitted with friction on: give target.S_coefficient "
-                                             "and target.S_size (refit: fepen study calibration --set "
-                                             "effects.friction=true), target.quasi_static_stress, or another "
-                                             "target.strength_model (the scaled-S constants have friction's share "
-                                             "in sigma_s; docs/theory.md 8.1)")
 
 
 def announce(scene, comm, built: Built | None = None) -> Built:
@@ -337,13 +233,9 @@ def check_supported(scene, built: Built | None = None) -> Built:
         from fepen import dolfinx_api
 
         dolfinx_api.check_version()  # a mesh is made: only on the dolfinx releases fepen supports
-    if scene.effects.fidelity != "rigid" or not built.shape.exact:  # a volume mesh is made
+    if built.shape.needs_volume_mesh(scene.effects.fidelity):
         check_mesh_cost(scene, MPI.COMM_WORLD, built)
-    if scene.target.kind == "concrete":
-        check_friction(scene)
-    if scene.effects.fidelity == "rigid" and scene.target.kind != "concrete":
-        raise InputError("effects.fidelity", "'rigid' runs against target.kind = 'concrete'; a rigid "
-                                             "projectile on a rigid wall has nothing to compute")
+    targets.of(scene).check(scene)  # the friction's strength; a rigid wall refuses the rigid fidelity
     return built
 
 
@@ -443,12 +335,12 @@ def envelope_facts(scene, built: Built | None = None) -> dict:
     p, i, t = scene.projectile, scene.impact, scene.target
     D = built.shape.diameter if built is not None else p.diameter
     L = built.shape.length if built is not None else p.length
-    target = ("layered" if scene.get("target.layers") else "a rigid wall" if t.kind != "concrete" else t.material)
+    target = targets.of(scene).envelope_name(scene)  # "layered", "a rigid wall" or target.material
     mass = scene.get("projectile.mass")  # absent for a fixed cavity or a CAD body: from the body
     fc = scene.derived["target.fc_cylinder"]  # a layered target's are its layers' (its verdict: not validated)
-    if mass is None and built is not None and built.shape.exact:  # a CAD body's: from its mesh
+    if mass is None and built is not None:  # the body's, when known before any mesh (a CAD body's: None)
         fill = scene.charge.material.density if scene.effects.charge else None
-        mass = built.shape.mass(built.shell_density, fill)
+        mass = built.shape.exact_mass(built.shell_density, fill)
     values = {"D_m": D, "L_over_D": L / D, "crh": scene.get("projectile.crh"), "mass_kg": mass, "V_m_s": i.velocity,
               "fc_cylinder_Pa": None if isinstance(fc, list) else fc,
               "rho_kg_m3": t.density, "obliquity_deg": i.obliquity_deg, "attack_deg": i.attack_deg}

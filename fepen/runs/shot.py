@@ -17,14 +17,11 @@ from fepen.geometry.mass_rule import Built
 from fepen.laws import target as tg
 from fepen.laws import wear
 from fepen.runs import probes as run_probes
-from fepen.runs import setup
+from fepen.runs import setup, targets
 from fepen.scene import to_toml
 
 #: the longest a run without run.end_time may last (s): deformable, rigid
 MAX_TIME = {"deformable": 5e-3, "rigid": 5e-2}
-#: a layered target's run without run.end_time lasts at least this many times the time to reach its last
-#: face at the striking speed (the layered demo's soil stops its body at 67 ms, where 20 x gave 60 ms)
-LAYERED_TIME = 30.0
 
 
 @dataclass(frozen=True)
@@ -113,6 +110,8 @@ class Shot:
         fidelity: "rigid", "elastic" or "plastic".
         built: the projectile (fepen.geometry.shape.Built), built once.
         law: the target law (TargetLaw, or Layered), None on the rigid wall.
+        target: the target's kind (fepen.runs.targets): what differs between a target of one material, a layered
+            target and the rigid wall (the hard end, the tunnel, the layer crossings).
         rotation, velocity: the body's rotation about the nose tip (3x3) and its velocity at impact (3,).
         angular_velocity: the body's angular velocity at impact (3, rad/s, world).
         crh: the nose's calibre-radius-head (for Forrestal's linear crater).
@@ -145,6 +144,7 @@ class Shot:
     fidelity: str
     built: Built
     law: object
+    target: targets.TargetKind
     rotation: np.ndarray
     velocity: np.ndarray
     crh: float
@@ -182,10 +182,6 @@ class Shot:
         """The striking speed (m/s)."""
         return float(np.linalg.norm(self.velocity))
 
-    @property
-    def layered(self) -> bool:
-        return getattr(self.law, "layered", False)
-
     def crater(self, mass: float) -> tg.ForrestalCrater | None:
         """Forrestal's linear crater for a projectile of ``mass`` (kg) when effects.crater = "linear", else None
         (the energy crater is in the law)."""
@@ -196,13 +192,12 @@ class Shot:
 
 
 
-def _hard_end(law, end_time: float | None, speed: float, kind: str) -> float:
-    """run.end_time, else MAX_TIME, long enough for a layered target to reach its last face."""
+def _hard_end(target: targets.TargetKind, law, end_time: float | None, speed: float, kind: str) -> float:
+    """run.end_time, else MAX_TIME as the target's kind lengthens it (a layered target's: to reach its last
+    face)."""
     if end_time is not None:
         return end_time
-    if getattr(law, "layered", False):
-        return max(MAX_TIME[kind], LAYERED_TIME * law.faces()[-1][0] / speed)
-    return MAX_TIME[kind]
+    return target.hard_end(law, MAX_TIME[kind], speed)
 
 
 def _wear(scene) -> WearParameters | None:
@@ -250,14 +245,16 @@ def resolve(scene, toml: bool = True, built: Built | None = None) -> Shot:
     """
     built = setup.check_supported(scene, built)
     rigid = scene.effects.fidelity == "rigid"
-    law = setup.target_law(scene) if scene.target.kind == "concrete" else None
+    target = targets.of(scene)
+    law = target.law(scene)  # a rigid wall's: None
     R, v, w = setup.placement(scene)
     end = scene.get("run.end_time")
     materials = () if rigid else tuple(setup.materials(scene, built))
     from fepen.runs import budget
 
+    hard_end = _hard_end(target, law, end, float(np.linalg.norm(v)), "rigid" if rigid else "deformable")
     if not rigid:
-        budget.check_outputs(_hard_end(law, end, float(np.linalg.norm(v)), "deformable"), scene.run.output_interval,
+        budget.check_outputs(hard_end, scene.run.output_interval,
                              bool(scene.run.fields), scene.run.checkpoint_interval)
     else:
         budget.check_rigid_step(scene.get("run.rigid_step"), built.shape, built.shell_density,
@@ -266,17 +263,18 @@ def resolve(scene, toml: bool = True, built: Built | None = None) -> Shot:
     probes = tuple(scene.get("output.probes") or ())
     run_probes.check_inside(built.shape, probes, scene.effects.charge)
     return Shot(
-        fidelity=scene.effects.fidelity, built=built, law=law, rotation=R, velocity=v, angular_velocity=w,
+        fidelity=scene.effects.fidelity, built=built, law=law, target=target, rotation=R, velocity=v,
+        angular_velocity=w,
         crh=scene.projectile.crh,
         wear=_wear(scene), erosion=ErosionParameters(e.strain, e.step_ratio) if scene.effects.erosion else None,
-        end_time=end, hard_end=_hard_end(law, end, float(np.linalg.norm(v)), "rigid" if rigid else "deformable"),
+        end_time=end, hard_end=hard_end,
         failure_strain=scene.get("projectile.failure_strain"), outputs=_outputs(scene), mesh=setup.mesh_request(scene),
         materials=materials, safety_factor=scene.run.safety_factor, stable_step=scene.run.stable_step,
         charge_friction=scene.charge.friction, rigid_step=scene.get("run.rigid_step"),
         nominal_diameter=scene.projectile.diameter,
         experiment=scene.get("impact.shot"), scene=scene.as_dict(), body_key=setup.body_key(scene),
         scene_toml=to_toml(scene) if toml else "", probes=probes, envelope=setup.envelope_facts(scene, built),
-        tunnel=bool(scene.effects.tunnel and law is not None and not getattr(law, "layered", False)),
+        tunnel=target.tunnel(scene),
         load_points=_load_points(scene),
         inputs=inputs_record(scene) if toml else {},
         safety=safety_thresholds(scene) if scene.effects.charge and not rigid else None)

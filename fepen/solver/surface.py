@@ -4,6 +4,7 @@ normal turned with the facet and its curved patch's area stretched with it (docs
 
 from __future__ import annotations
 
+import functools
 import math
 from dataclasses import dataclass
 
@@ -13,6 +14,8 @@ from mpi4py import MPI
 
 from fepen import dolfinx_api as dx
 from fepen.geometry import projection, tags
+from fepen.geometry.cad import CadBody
+from fepen.geometry.shape import Shape
 from fepen.solver import ckernel
 
 SUBDIVISION = 4  # facet patch areas: 4 x 4 sub-triangles projected on the exact surface
@@ -325,14 +328,39 @@ def outer_surface(V, facet_tags, shape, tag: int = tags.OUTER) -> Surface:
     """
     X = node_positions(V)
     tri, cells = oriented_facets(V, facet_tags, tag, with_cells=True)
-    if not shape.exact:  # a CadBody: no exact surface: the facets' areas, their normals smoothed across smooth edges
-        empty = np.zeros(0, dtype=np.int64)
-        surf = Surface(np.zeros((0, 3), dtype=np.int64), np.zeros((0, 3)), np.zeros(0), np.zeros(0),
-                       np.zeros((0, 3)), np.zeros((0, 3)), np.zeros(0), np.zeros(0), np.zeros(0), empty)
-        surf.append_flat(X, tri, cells)
-        surf.N0 = smoothed_normals(X[tri], surf.n_flat0, surf.flat0, V.mesh.comm)
-        surf.sin_phi0 = np.abs(surf.N0[:, 1])
-        return surf
+    return facet_points(shape, X, tri, cells, V.mesh.comm)
+
+
+@functools.singledispatch
+def facet_points(shape, X, tri, cells, comm) -> Surface:
+    """The load points of oriented outer facets, by the body's kind.
+
+    Args:
+        shape: the body the mesh was built from (a Shape or a CadBody). X: the node positions (n, 3) (m).
+        tri: the facets' nodes (k, 3), oriented outward. cells: each facet's cell (k,). comm: the mesh's
+            communicator.
+
+    Returns:
+        The Surface.
+    """
+    raise TypeError(f"no load points for a {type(shape).__name__}")
+
+
+@facet_points.register(CadBody)
+def _cad_facet_points(shape, X, tri, cells, comm) -> Surface:
+    """A CadBody: no exact surface: the facets' own areas, their normals smoothed across smooth edges."""
+    empty = np.zeros(0, dtype=np.int64)
+    surf = Surface(np.zeros((0, 3), dtype=np.int64), np.zeros((0, 3)), np.zeros(0), np.zeros(0),
+                   np.zeros((0, 3)), np.zeros((0, 3)), np.zeros(0), np.zeros(0), np.zeros(0), empty)
+    surf.append_flat(X, tri, cells)
+    surf.N0 = smoothed_normals(X[tri], surf.n_flat0, surf.flat0, comm)
+    surf.sin_phi0 = np.abs(surf.N0[:, 1])
+    return surf
+
+
+@facet_points.register(Shape)
+def _exact_facet_points(shape, X, tri, cells, comm) -> Surface:
+    """The exact solid: each facet's centroid projected on its meridian segment, the exact patch area."""
     av = area_vectors(X, tri)
     flat = np.linalg.norm(av, axis=1)
     nflat = av / np.maximum(flat, 1e-300)[:, None]

@@ -11,7 +11,7 @@ import pytest
 from mpi4py import MPI
 
 from fepen import scene
-from fepen.geometry import mesh
+from fepen.geometry import mesh_cache
 from fepen.runs import setup
 
 SETS = ["mesh.size=0.008", "mesh.optimize=none"]  # a coarse mesh with its cavity sized to the mass: < 1 s
@@ -71,7 +71,7 @@ def test_a_good_entry_is_reused(cache, pristine, monkeypatch, warnings):
     msh, side = entry(cache)
     meta = json.loads(side.read_text())
     assert meta["sha256"] == hashlib.sha256(msh.read_bytes()).hexdigest()
-    assert {k: meta[k] for k in ("fepen", "gmsh", "code")} == mesh._entry_stamp()
+    assert {k: meta[k] for k in ("fepen", "gmsh", "code")} == mesh_cache.entry_stamp()
     pm = build(cache, monkeypatch)
     assert pm.cached
     assert np.array_equal(pm.mesh.geometry.x, pristine[1])
@@ -176,7 +176,7 @@ def test_a_cache_others_can_write_is_named_once_and_its_entries_still_checked(ca
     import os
 
     os.chmod(cache, 0o777)
-    mesh._warned_shared.clear()
+    mesh_cache._warned_shared.clear()
     msh, side = entry(cache)
     forged_shrunk(msh, side)
     pm = build(cache, monkeypatch)

@@ -42,26 +42,26 @@ def test_docs_scenes_md_is_what_fepen_keys_prints(capsys):
 # ---- the mesh cache where meshes/README.md says ------------------------------------------------------------
 def test_the_mesh_cache_of_a_source_checkout_is_its_meshes_cache(monkeypatch):
     """Run from this checkout (the README's editable install), meshes go to the checkout's meshes/cache."""
-    from fepen.geometry import mesh
+    from fepen.geometry import mesh_cache
 
     monkeypatch.delenv("FEPEN_MESH_CACHE", raising=False)
-    assert mesh.cache_dir() == ROOT / "meshes" / "cache"
+    assert mesh_cache.cache_dir() == ROOT / "meshes" / "cache"
 
 
 def test_fepen_mesh_cache_comes_first_and_an_installed_fepen_caches_in_home(monkeypatch, tmp_path):
     """$FEPEN_MESH_CACHE wins; a fepen outside a checkout (site-packages: no pyproject.toml beside it, even
     with a meshes/ folder there) caches in ~/.cache/fepen/meshes."""
-    from fepen.geometry import mesh
+    from fepen.geometry import mesh_cache
 
     monkeypatch.setenv("FEPEN_MESH_CACHE", str(tmp_path / "mine"))
-    assert mesh.cache_dir() == tmp_path / "mine"
+    assert mesh_cache.cache_dir() == tmp_path / "mine"
     monkeypatch.delenv("FEPEN_MESH_CACHE")
     site = tmp_path / "site-packages"
     (site / "fepen" / "geometry").mkdir(parents=True)
     (site / "meshes").mkdir()
-    monkeypatch.setattr(mesh, "__file__", str(site / "fepen" / "geometry" / "mesh.py"))
+    monkeypatch.setattr(mesh_cache, "__file__", str(site / "fepen" / "geometry" / "mesh_cache.py"))
     monkeypatch.setenv("HOME", str(tmp_path / "home"))
-    assert mesh.cache_dir() == tmp_path / "home" / ".cache" / "fepen" / "meshes"
+    assert mesh_cache.cache_dir() == tmp_path / "home" / ".cache" / "fepen" / "meshes"
 
 
 # ---- fepen view: what it says without a display, when ParaView fails, and where a run has no fields --------

@@ -65,16 +65,41 @@ def test_no_class_over_40_attributes():
     assert not many, "\n".join(f"{path}:{line} {name} ({n} attributes)" for path, line, name, n in many)
 
 
-def test_body_kinds_carry_their_own_behaviour():
-    """No isinstance on a body kind (Shape, CadBody) outside the body kinds' own modules: a branch asks the
-    body (its exact flag, nose_length, outer_radius, meshed_volume, crater_nose_factor, after_meshing)."""
+def _lines_matching(pattern: str, homes: set, skip: tuple = ()) -> list[str]:
+    """path:line of every line of fepen's modules matching ``pattern``, outside ``homes`` and the folders
+    ``skip``."""
     import re
 
+    return [f"{rel}:{i}" for p in sorted(layout.PACKAGE.rglob("*.py"))
+            if (rel := str(p.relative_to(layout.PACKAGE))) not in homes and not rel.startswith(skip)
+            for i, line in enumerate(p.read_text().splitlines(), 1) if re.search(pattern, line)]
+
+
+def test_body_kinds_carry_their_own_behaviour():
+    """No isinstance on a body kind (Shape, CadBody) and no ``.exact`` flag read outside the body kinds' own
+    modules (issue 60, item 5): a caller asks the body (nose_length, outer_radius, meshed_volume, exact_volume,
+    exact_mass, needs_volume_mesh, crater_nose_factor, after_meshing) or calls a function registered per kind
+    (functools.singledispatch: gmsh_model._build, mesh_cache.record, mesh_cache._verify_extent, surface.facet_points,
+    revolution.nose_zone, rigid.body_points, probes.outside_radially)."""
     homes = {"geometry/shape.py", "geometry/cad.py"}
-    found = [f"{p.relative_to(layout.PACKAGE)}:{i}" for p in sorted(layout.PACKAGE.rglob("*.py"))
-             if str(p.relative_to(layout.PACKAGE)) not in homes
-             for i, line in enumerate(p.read_text().splitlines(), 1)
-             if re.search(r"isinstance\([^)]*\b(CadBody|Shape)\b", line)]
+    found = _lines_matching(r"isinstance\([^)]*\b(CadBody|Shape)\b|\.exact\b", homes)
+    assert not found, found
+
+
+#: modules that still branch on the target's kind, each removed by its own owner (issue 60, item 5):
+#: fepen/studies/ (bands, spec, uncertainty: target.kind != "concrete"), laws/target.py (load_on_points'
+#: getattr(law, "layered"): TargetLaw.point_forces replaces it), runs/batch.py (isinstance(run.law, TargetLaw))
+TARGET_KIND_PENDING = ("studies/", "laws/target.py", "runs/batch.py")
+
+
+def test_target_kinds_carry_their_own_behaviour():
+    """No branch on the target's kind outside the kinds themselves (fepen.runs.targets, fepen.laws.layers): no
+    target.kind == or !=, no layered flag read, no isinstance on TargetLaw or Layered (issue 60, item 5); a
+    caller asks the Shot's kind (law, check, plates, envelope_name, hard_end, tunnel, crossings)."""
+    homes = {"runs/targets.py", "laws/layers.py"}
+    pattern = (r"target\.kind\s*[!=]=|\.kind\s*[!=]=\s*\"(concrete|rigid-wall)\"|\.layered\b|"
+               r"getattr\([^)]*\"layered\"|isinstance\([^)]*\b(TargetLaw|Layered)\b")
+    found = _lines_matching(pattern, homes, TARGET_KIND_PENDING)
     assert not found, found
 
 

@@ -4,7 +4,7 @@ the one Shape type that once held both: the same body keeps its key (but for the
 import json
 from dataclasses import replace
 
-from fepen.geometry import mesh as fmesh
+from fepen.geometry import mesh_cache
 from fepen.geometry.cad import CadBody
 from fepen.geometry.shape import Shape
 
@@ -24,18 +24,18 @@ def test_a_cad_body_tracks_its_ends():
 
 def test_the_cache_record_of_a_cad_body_is_the_former_shapes():
     body = CadBody(0.0236, 0.144, "/x/body.step", 0.001, "abc", (0.0, 0.0, 0.0), (0.0, 0.144, 0.0))
-    rec = json.loads(json.dumps(fmesh._record(body)))
+    rec = json.loads(json.dumps(mesh_cache.record(body)))
     assert set(rec) == LEGACY_FIELDS
     assert rec["nose"] == "cad" and rec["crh"] == 3.0 and rec["cavity_diameter"] == 0.0 and rec["cavity_table"] == []
     assert (rec["cad_file"], rec["cad_scale"], rec["cad_digest"]) == ("/x/body.step", 0.001, "abc")
-    assert fmesh._from_record(rec) == body
+    assert mesh_cache.from_record(rec) == body
 
 
 def test_the_cache_record_of_a_shape_holds_the_cad_fields_at_their_defaults():
     shape = Shape(0.0236, 0.144, "cone", cavity_diameter=0.012, cavity_length=0.06, nose_length_given=0.03,
                   cavity_table=((0.01, 0.006),))
-    rec = json.loads(json.dumps(fmesh._record(shape)))
+    rec = json.loads(json.dumps(mesh_cache.record(shape)))
     assert set(rec) == LEGACY_FIELDS
     assert (rec["cad_file"], rec["cad_scale"], rec["cad_digest"], rec["tip_point"], rec["tail_point"]) == (
         "", 1.0, "", [], [])
-    assert fmesh._from_record(rec) == shape
+    assert mesh_cache.from_record(rec) == shape

@@ -4,7 +4,7 @@ each band's two halves across the plane of the shot (z = 0), mirrored."""
 import numpy as np
 import pytest
 
-from fepen.geometry.mesh import mirror_parts
+from fepen.geometry.partition import mirror_parts
 
 
 def _cylinder_cells(n=4000, seed=0):
