@@ -55,7 +55,6 @@ class Layered:
     layers: tuple
     block_tops: tuple
 
-    layered = True  # tells fepen.laws.target.load_on_points to go layer by layer
 
     @property
     def thickness(self) -> float | None:

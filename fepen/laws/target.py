@@ -231,6 +231,18 @@ class TargetLaw:
         touching layers), else ``thickness``; None: semi-infinite."""
         return self.thickness if self.bottom is None else self.bottom
 
+    def point_forces(self, kernel, x, v, n, area, radius, R_meridian, sin_phi0, axis, tunnel=None, body_xi=None):
+        """The law on every point: forces (k, 3) and their sums, as fepen.laws.target.point_forces returns them
+        (the one signature of every target law's point_forces; fepen.laws.layers.Layered's goes layer by layer).
+
+        Args:
+            kernel: fepen.laws.target.point_forces. x ... axis, tunnel, body_xi: as it takes them.
+
+        Returns:
+            (forces (k, 3), sums (the header's SUM_ layout)).
+        """
+        return kernel(self, x, v, n, area, radius, R_meridian, sin_phi0, axis, tunnel, body_xi)
+
 
 #: Poisson's ratio of the tunnel's wall: concrete's, rock's and soil's 0.2 (EN 1992-1-1 §3.1.3: uncracked
 #: concrete), a metal's 0.33 (aluminium's; a steel's 0.29 makes its wall 3 % stiffer)
@@ -317,11 +329,7 @@ def load_on_points(law: TargetLaw, x, v, n, area, radius, R_meridian, sin_phi0, 
     Returns:
         The PointLoad.
     """
-    kernel = point_forces
-    if getattr(law, "layered", False):  # a fepen.laws.layers.Layered target: layer by layer, no tunnel
-        f, sums = law.point_forces(kernel, x, v, n, area, radius, R_meridian, sin_phi0, axis)
-    else:
-        f, sums = kernel(law, x, v, n, area, radius, R_meridian, sin_phi0, axis, tunnel, body_xi)
+    f, sums = law.point_forces(point_forces, x, v, n, area, radius, R_meridian, sin_phi0, axis, tunnel, body_xi)
     if reduce is not None:
         sums = reduce(f, sums)
     total = sums[SUM_FORCE:SUM_FORCE + 3]

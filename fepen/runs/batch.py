@@ -85,8 +85,9 @@ def reason(run) -> str | None:
         return "it writes a results directory"
     if run.wear is not None:
         return "wear"
-    if not isinstance(run.law, tg.TargetLaw):
-        return "a layered or non-concrete target"
+    why = run.shot.target.not_batched()
+    if why is not None:
+        return why
     if run.crossings is not None or len(run.outputs) != 1 or run.history.clock.next != 0.0:
         return "layer crossings or outputs"
     if run.t != 0.0 or run.step_count != 0:

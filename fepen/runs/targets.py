@@ -74,9 +74,29 @@ class TargetKind:
         """The record of the layers' entries and exits of a run (None: no layers)."""
         return None
 
+    def not_batched(self) -> str | None:
+        """Why a rigid shot into this target cannot go in a batch (fepen.runs.batch), or None: it can."""
+        return None
+
+    def no_public_errors(self, scene) -> str | None:
+        """Why fepen's errors on public data (fepen.stats.interval) do not apply to this target, or None: they
+        do, by its strength model."""
+        return None
+
+    def striking_prior(self, prior):
+        """The prior of what a test does not record (fepen.stats.striking.Prior) for shots into this target:
+        the concrete's random field (concrete_cv) lives in one concrete only."""
+        from dataclasses import replace
+
+        return replace(prior, concrete_cv=0.0)
+
 
 class SingleTarget(TargetKind):
     """A cavity-expansion target of one material (target.kind = "concrete" without target.layers)."""
+
+    def striking_prior(self, prior):
+        """The prior as it is: the random field is this concrete's."""
+        return prior
 
     def law(self, scene) -> tg.TargetLaw:
         """The TargetLaw of target.material with the scene's constants."""
@@ -115,6 +135,9 @@ class LayeredTarget(TargetKind):
         """Each layer's entry and exit (fepen.laws.layers.Layered.crossings)."""
         return law.crossings()
 
+    def not_batched(self) -> str:
+        return "a layered target"
+
 
 class RigidWall(TargetKind):
     """The rigid wall of a Taylor test (target.kind = "rigid-wall"): no law, the deformable fidelities only.
@@ -144,6 +167,12 @@ class RigidWall(TargetKind):
     def tunnel(self, scene) -> bool:
         """No tunnel in a wall."""
         return False
+
+    def not_batched(self) -> str:
+        return "a rigid wall"
+
+    def no_public_errors(self, scene) -> str:
+        return f"no errors on public data for target.material = {scene.target.material!r}"
 
 
 #: the kinds by (target.kind, whether target.layers are given)

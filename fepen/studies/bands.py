@@ -56,16 +56,15 @@ def striking_inputs(resolved: fscene.Scene, keys: list, inputs: list, seed: int)
     Returns:
         (keys, inputs) with the drawn keys.
     """
-    import dataclasses
 
     from fepen.stats import striking as fstriking
 
     clash = [k for k in keys if k in STRIKING_KEYS]
     if clash:
         raise InputError("--striking", f"draws {clash[0]} itself; leave it out of the --scatter file's vary")
-    prior = fstriking.PRIOR
-    if resolved.target.kind != "concrete" or resolved.get("target.layers"):
-        prior = dataclasses.replace(prior, concrete_cv=0.0)  # the field lives in one concrete
+    from fepen.runs import targets
+
+    prior = targets.of(resolved).striking_prior(fstriking.PRIOR)  # the field lives in one concrete
     out = []
     for i, s in enumerate(inputs):
         v, ob, at = (s[k] if k in s else resolved.get(k) for k in ("impact.velocity", "impact.obliquity_deg",

@@ -338,15 +338,17 @@ def _product(lists):
 
 def check_shots(spec: Spec) -> None:
     """Resolve every shot's scene and build each distinct projectile once: bad input before any shot runs."""
-    from fepen.runs import setup
+    from fepen.runs import setup, targets
 
     seen = set()
     for i in range(len(spec.shots)):
         sc = spec.scene(i)
         try:
             key = setup.body_key(sc)
-            if key not in seen or (sc.effects.fidelity == "rigid" and sc.target.kind != "concrete"):
+            if key not in seen:
                 seen.add(key)
                 setup.check_supported(sc)  # builds the projectile: once per distinct one
+            else:
+                targets.of(sc).check(sc)  # the target's own checks, shot by shot
         except InputError as err:
             raise InputError(f"shot {i}: {err.key}", err.message) from None

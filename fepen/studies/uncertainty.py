@@ -200,10 +200,12 @@ def _label(sc: fscene.Scene, scene_path, scatter_path, spec) -> str:
 
 def model_of(sc: fscene.Scene):
     """(the ErrorModel of the scene's concrete and law, or None; why not, or None)."""
+    from fepen.runs import targets
     from fepen.stats import interval
 
-    if sc.target.kind != "concrete" and not sc.get("target.layers"):
-        return None, f"no errors on public data for target.material = {sc.target.material!r}"
+    why = targets.of(sc).no_public_errors(sc)
+    if why is not None:
+        return None, why
     m = interval.model("depth", sc.target.strength_model, "rigid")
     if m is None:
         return None, f"no errors on public data for target.strength_model = {sc.target.strength_model!r}"

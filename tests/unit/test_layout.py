@@ -86,10 +86,8 @@ def test_body_kinds_carry_their_own_behaviour():
     assert not found, found
 
 
-#: modules that still branch on the target's kind, each removed by its own owner (issue 60, item 5):
-#: fepen/studies/ (bands, spec, uncertainty: target.kind != "concrete"), laws/target.py (load_on_points'
-#: getattr(law, "layered"): TargetLaw.point_forces replaces it), runs/batch.py (isinstance(run.law, TargetLaw))
-TARGET_KIND_PENDING = ("studies/", "laws/target.py", "runs/batch.py")
+#: modules allowed to branch on the target's kind besides its homes: none (issue 60, item 5)
+TARGET_KIND_PENDING = ()
 
 
 def test_target_kinds_carry_their_own_behaviour():

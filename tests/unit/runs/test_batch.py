@@ -152,7 +152,7 @@ def test_wear_and_layers_take_the_single_path():
     assert batch.reason(RigidRun(worn, None, MPI.COMM_SELF)) == "wear"
     assert_same(single(worn), batch.summaries([worn])[0])
     layered = scene.Scene(LAYERS, sets=["effects.fidelity=rigid"])
-    assert batch.reason(RigidRun(layered, None, MPI.COMM_SELF)) == "a layered or non-concrete target"
+    assert batch.reason(RigidRun(layered, None, MPI.COMM_SELF)) == "a layered target"
     assert_same(single(layered), batch.summaries([layered])[0])
     assert batch.reason(RigidRun(rigid(), None, MPI.COMM_SELF)) is None
 

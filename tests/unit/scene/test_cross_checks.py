@@ -36,7 +36,7 @@ def refused(sets, key, words, built=False):
 def _laws(sc):
     """The target law of a scene, one per layer."""
     law = setup.target_law(sc)
-    return [layer.law for layer in law.layers] if getattr(law, "layered", False) else [law]
+    return [layer.law for layer in law.layers] if hasattr(law, "layers") else [law]
 
 
 # ---------------------------------------------------------------------------------------------- materials
