@@ -383,9 +383,17 @@ def history_columns(tmp: Path) -> str:
     return columns.markdown()
 
 
+def run_tables(tmp: Path) -> str:
+    """A run's other CSV tables, from their declarations (fepen.io.columns.TABLES)."""
+    from fepen.io import columns
+
+    return columns.tables_markdown()
+
+
 #: name -> (page, generator, rough cost on 2 cores)
 BLOCKS = {
     "history-columns": ("docs/results.md", history_columns, "0 s"),
+    "run-tables": ("docs/results.md", run_tables, "0 s"),
     "table1": ("docs/validation.md", table1, "5 min"),
     "ballistic-limit": ("docs/studies.md", ballistic_limit, "15 s"),
     "ricochet": ("docs/studies.md", ricochet, "20 s"),

@@ -28,6 +28,8 @@ import numpy as np
 from fepen.geometry.frames import unit_axis
 
 __all__ = ["Quantity", "Group", "Row", "HISTORY", "history", "values", "markdown", "final_axis_deg", "G0", "BASE",
+           "TABLES", "HAZARD", "STRAINS", "ACCELERATION_TABLE", "ACCELERATION_CHARGE", "CHARGE_SECTIONS",
+           "tables_markdown", "table_columns",
            "ACCELERATIONS", "BODIES", "RESULTANT", "INTERFACE", "REMOVAL", "LOADS", "ATTITUDE"]
 
 
@@ -352,6 +354,68 @@ ATTITUDE = Group(
 HISTORY = (BASE, ACCELERATIONS, BODIES, RESULTANT, INTERFACE, REMOVAL, LOADS, ATTITUDE)
 
 
+# ------------------------------------------------------------------------------------- a run's other tables
+#: hazard.csv (deformable runs): per 2 mm bin of the undeformed axis, the surface's and the whole section's peaks
+HAZARD = Group(
+    'hazard.csv', '',
+    ('`hazard.csv` (deformable runs), the paper\'s hazard map ([paper.md §8](paper.md)): one row per 2 mm bin of '
+     'the undeformed axis, from the nose tip.'),
+    (
+        Quantity(('axial_from_nose_mm',), 'mm', 'the centre of the bin, from the nose tip along the undeformed axis'),
+        Quantity(('max_surface_peeq',), '–', 'the largest PEEQ of the surface cells in the bin, at the end'),
+        Quantity(('peak_surface_von_mises_Pa',), 'Pa',
+                 'the largest von Mises stress of the surface cells in the bin over the history rows: where an '
+                 'elastic shot came nearest to yielding'),
+        Quantity(('max_peeq',), '–',
+                 'the largest PEEQ over every cell of the bin, the inside included (bending yields the skin, a '
+                 'nose crushed along its axis the core)'),
+        Quantity(('peak_von_mises_Pa',), 'Pa', 'the largest von Mises stress over every cell of the bin'),
+    ))
+#: strains.csv (deformable runs): the strain gauges, a column per gauge
+STRAINS = Group(
+    'strains.csv', '',
+    ('`strains.csv` (deformable runs): the strain gauges, four surface cells at 1/3 L and at 1/2 L from the '
+     'nose; top and bottom lie in the plane of incidence (±x of the body), the sides across it (±z). Bending '
+     'shows as top/bottom ≫ sides.'),
+    (
+        Quantity(('t_s',), 's', 'the history row\'s time'),
+        Quantity(('top_33pctL', 'bottom_33pctL', 'side+_33pctL', 'side-_33pctL', 'top_50pctL', 'bottom_50pctL',
+                  'side+_50pctL', 'side-_50pctL'), '–',
+                 'the axial logarithmic strain ln ‖F a0‖ (a0 the reference axis) of the gauge\'s cell'),
+    ))
+#: accelerations.csv (deformable runs): raw and filtered
+ACCELERATION_TABLE = Group(
+    'accelerations.csv', '',
+    ('`accelerations.csv` (deformable runs): the history\'s accelerations, raw and low-pass filtered '
+     '(zero-phase Butterworth at `run.acceleration_filter_hz`, [theory.md §13](theory.md)).'),
+    (
+        Quantity(('t_s',), 's', 'the history row\'s time'),
+        Quantity(('decel_g', 'decel_filtered_g'), 'g', 'history.csv\'s `decel_g`, raw and filtered'),
+    ))
+ACCELERATION_CHARGE = Group(
+    'accelerations.csv', 'charged', None,
+    (
+        Quantity(('shell_acc_g', 'shell_acc_filtered_g', 'charge_acc_g', 'charge_acc_filtered_g'), 'g',
+                 'with a charge: history.csv\'s `shell_acc_g` and `charge_acc_g`, each raw and filtered'),
+    ))
+#: charge_sections.csv (charged deformable runs): a column per point and stress
+CHARGE_SECTIONS = Group(
+    'charge_sections.csv', 'charged',
+    ('`charge_sections.csv` (with a charge): the charge\'s stresses at points of its sections. The points: '
+     '`front_r0`, `front_r33`, `front_r67`, `front_r90` (at 0, 1/3, 2/3 and 0.9 of the cavity radius on the '
+     'charge\'s front face), `nose_end_r0` … `nose_end_r90` (at the nose/cylinder interface), `mid_r0` … '
+     '`mid_r90` (at half the charge\'s length), and `axis0` … `axis4` (five points along the axis, front to '
+     'rear).'),
+    (
+        Quantity(('t_s',), 's', 'the history row\'s time'),
+        Quantity(('<point>_axial_Pa', '<point>_shear_Pa'), 'Pa',
+                 'the axial and the shear stress at the point (compression negative)'),
+    ))
+#: a run's other tables, each file's groups in order (docs/results.md's block "run-tables")
+TABLES = {"hazard.csv": (HAZARD,), "strains.csv": (STRAINS,),
+          "accelerations.csv": (ACCELERATION_TABLE, ACCELERATION_CHARGE), "charge_sections.csv": (CHARGE_SECTIONS,)}
+
+
 def history(run) -> list[str]:
     """The history.csv header of a run (a Run: its properties say which groups it writes)."""
     return [c for g in HISTORY if g.on(run) for c in g.columns]
@@ -373,14 +437,24 @@ def values(run, t: float, s) -> list:
     return [v for g in groups for q in g.quantities for v in q.values(row)]
 
 
-def markdown(groups=HISTORY, width: int = 115) -> str:
+def markdown(groups=HISTORY, width: int = 115, file: str = "history.csv") -> str:
     """docs/results.md's column tables: each group's intro, then its table (a group without one continues the
-    previous table)."""
+    previous table); ``file`` heads the tables' first column."""
     out: list[str] = []
     for g in groups:
         if g.intro is not None:
             out += ([""] if out else []) + textwrap.wrap(g.intro, width, break_long_words=False,
                                                              break_on_hyphens=False)
-            out += ["", "| `history.csv` column | unit | meaning |", "|---|---|---|"]
+            out += ["", f"| `{file}` column | unit | meaning |", "|---|---|---|"]
         out += [f"| {', '.join(f'`{n}`' for n in q.names)} | {q.unit} | {q.doc} |" for q in g.quantities]
     return "\n".join(out).strip("\n")
+
+
+def tables_markdown(width: int = 115) -> str:
+    """docs/results.md's tables of a run's other CSV files (TABLES), each after its paragraph."""
+    return "\n\n".join(markdown(groups, width, file) for file, groups in TABLES.items())
+
+
+def table_columns(file: str, run=None) -> list[str]:
+    """The declared columns of one of TABLES (the groups ``run`` writes; None: every group)."""
+    return [c for g in TABLES[file] if run is None or g.on(run) for c in g.columns]

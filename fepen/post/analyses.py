@@ -23,12 +23,11 @@ from mpi4py import MPI
 
 from fepen.geometry import tags
 from fepen.geometry.frames import unit_axis
-from fepen.io import table
+from fepen.io import columns, table
 from fepen.solver import diagnostics, probes
 
-#: hazard.csv's columns: per bin of the axis, the surface's and the whole section's peaks
-HAZARD_COLUMNS = [
-    "axial_from_nose_mm", "max_surface_peeq", "peak_surface_von_mises_Pa", "max_peeq", "peak_von_mises_Pa"]
+#: hazard.csv's columns (declared in fepen.io.columns with their units and meanings)
+HAZARD_COLUMNS = columns.HAZARD.columns
 GAUGE_NAMES = ["top", "bottom", "side+", "side-"]
 GAUGE_DIRECTIONS = np.array([[1.0, 0.0, 0.0], [-1.0, 0.0, 0.0], [0.0, 0.0, 1.0], [0.0, 0.0, -1.0]])
 

@@ -100,3 +100,18 @@ def test_a_new_declaration_is_a_new_column_in_both_fidelities(tmp_path, monkeypa
     for line in lines[1:]:
         v = [float(x) for x in line.split(",")]
         assert v[i] == pytest.approx(v[y] / 10, rel=1e-8, abs=1e-12)
+
+
+def test_the_run_tables_in_the_docs_are_their_declarations():
+    """docs/results.md's tables of hazard.csv, strains.csv, accelerations.csv and charge_sections.csv are
+    fepen.io.columns.TABLES (python tools/make_docs.py --only run-tables), and the writers use them."""
+    from fepen.post import analyses
+
+    page = (ROOT / "docs" / "results.md").read_text()
+    m = re.search(r"<!-- make docs: run-tables -->\n(.*?)\n<!-- /make docs: run-tables -->", page, re.S)
+    assert m and m.group(1) == columns.tables_markdown(), "python tools/make_docs.py --only run-tables"
+    assert analyses.HAZARD_COLUMNS == columns.table_columns("hazard.csv")
+    for groups in columns.TABLES.values():
+        for g in groups:
+            for q in g.quantities:
+                assert q.doc and q.unit and "|" not in q.doc
