@@ -97,11 +97,13 @@ def parent(name: str) -> str:
 
 def written_names(path: Path) -> set[str]:
     """The names a file holds: a JSON file's keys (flat_names), a CSV file's header (a probe's name as
-    ``<name>``)."""
+    ``<name>``, a charge section's point as ``<point>``)."""
     if path.suffix == ".json":
         return set(flat_names(json.loads(path.read_text())))
     with path.open(newline="") as f:
         header = next(csv.reader(f))
+    if path.name == "charge_sections.csv":  # the docs write a section point's name as <point>
+        return {re.sub(r"^.+_(axial|shear)_Pa$", r"<point>_\1_Pa", c) for c in header}
     return {PROBE_NAMES.sub("<name>_", c) for c in header} if path.name == "probes.csv" else set(header)
 
 
