@@ -17,59 +17,11 @@
 
 #include "rigid_batch.h"
 
-/* The law (law_constants, law_at_point), built as the single path builds
- * target_kernel.c (a * b + c contracted as there) */
+/* The law (target_kernel.c's law_points, point_forces's own driver, and law_at_point), built as the single path
+ * builds target_kernel.c (a * b + c contracted as there) */
 #pragma GCC push_options
 #pragma GCC optimize("fp-contract=fast")
 #include "../laws/target_kernel.c"
-
-
-/* The law (target_kernel.c's law_at_point, with point_forces's tunnel: a step's first stage records a station
- * and lets the wall yield) on k points with one shortcut that changes no bit: ell = sqrt(area) given. f is
- * written only at the points it loads (their indices into idx, in order; their stresses into sg), and only their
- * forces are summed (the others are zero). Returns how many. */
-__attribute__((noinline)) static int32_t law_points(int32_t k, const double *x, const double *v, const double *n,
-                                                    const double *area, const double *ell, const double *radius,
-                                                    const double *Rm, const double *sphi0, const double *axis,
-                                                    const double *p, const double *gauss, int32_t ng, double *f,
-                                                    int32_t *idx, double *sums, const double *body_xi, double *T,
-                                                    double *sgs) {
-    const LawConstants c = law_constants(p);
-    const int commit = T && T[T_COMMIT] != 0.0;
-    if (commit) tunnel_record(T);
-    TunnelEnd end;
-    if (T) tunnel_end(T, &end);
-    int32_t m = 0;
-    for (int j = 0; j < SUM_COUNT; ++j) sums[j] = 0.0;
-    for (int32_t i = 0; i < k; ++i) {
-        double sg = 0.0;
-        if (above_face(p, x + 3 * i, ell[i]) || !may_load(v + 3 * i, n + 3 * i, T, T ? body_xi[i] : 0.0)) continue;
-        WallHit hit;
-        const WallHit *wall = wall_of(T, &end, x + 3 * i, T ? body_xi[i] : 0.0, &hit);
-        if (!law_at_point(p, &c, x + 3 * i, v + 3 * i, n + 3 * i, area[i], ell[i], radius[i], Rm[i], sphi0[i], axis,
-                          wall, gauss, ng, f + 3 * i, &sg))
-            continue;
-        if (sg > 0.0) {
-            sums[SUM_LOADED] += 1.0;
-            sums[SUM_AREA] += area[i];
-        }
-        sgs[m] = sg;
-        idx[m++] = i;
-    }
-    if (commit) {
-        for (int32_t j = 0; j < m; ++j)
-            if (sgs[j] > 0.0)
-                wall_yield(T, &end, p, &c, x + 3 * idx[j], v + 3 * idx[j], radius[idx[j]], body_xi[idx[j]]);
-        T[T_COMMIT] = 0.0;
-    }
-    for (int32_t j = 0; j < m; ++j) {
-        const double *fi = f + 3 * idx[j];
-        sums[SUM_FORCE] += fi[0];
-        sums[SUM_FORCE + 1] += fi[1];
-        sums[SUM_FORCE + 2] += fi[2];
-    }
-    return m;
-}
 
 #pragma GCC pop_options
 
@@ -182,7 +134,7 @@ static void derivative(Body *b, const double *sp, const double *law, const doubl
         }
     }
     int32_t m = law_points(b->k, b->x, b->v, b->n, b->area, b->ell, b->radius, b->Rm, b->sphi0, axis, law,
-                           b->gauss, b->ng, b->f, b->idx, sums, b->xi, b->T, b->sg);
+                           b->gauss, b->ng, b->f, b->sg, b->idx, sums, b->xi, b->T);
     if (sp[S_CRATER] != 0.0) { /* ForrestalCrater.scale(-tip[1], -(total . axis)) */
         double depth = -tip[1], axial = -dot3(sums, axis), scale = 1.0;
         if (!(depth >= sp[S_CRATER_KD] || axial <= 0.0)) scale = fmax(depth, 0.0) * sp[S_CRATER_C] / axial;
@@ -418,7 +370,7 @@ void batch_law(int32_t k, const double *x, const double *v, const double *n, con
     double *sg = malloc(sizeof(double) * (size_t)(k > 0 ? k : 1));
     if (idx && sg) {
         for (int32_t i = 0; i < 3 * k; ++i) f[i] = 0.0;
-        law_points(k, x, v, n, area, ell, radius, Rm, sphi0, axis, p, gauss, ng, f, idx, sums, NULL, NULL, sg);
+        law_points(k, x, v, n, area, ell, radius, Rm, sphi0, axis, p, gauss, ng, f, sg, idx, sums, NULL, NULL);
     }
     free(idx);
     free(sg);
