@@ -78,7 +78,7 @@ KERNELS = {
     "events": Kernel("runs/events_kernel.c", "runs/events_kernel.h", NO_CONTRACT, True, ("penetration_outcome",)),
     "rigid_body": Kernel("laws/rigid_kernel.c", "laws/rigid_kernel.h", (), False, ("rigid_points", "force_moment")),
     "rigid_batch": Kernel("runs/rigid_batch.c", "runs/rigid_batch.h", NO_CONTRACT, False,
-                          ("rigid_batch", "rigid_step", "batch_law")),
+                          ("rigid_batch", "rigid_step", "rigid_stop_back", "batch_law")),
     "cells": Kernel("solver/cell_kernel.c", "solver/cell_kernel.h", NO_CONTRACT, False,
                     ("update_begin", "update_end", "nodal_pressure", "scatter_volumes", "scatter_forces",
                      "kinematics_pass", "cell_pass", "facet_kinematics")),

@@ -312,16 +312,29 @@ class RigidRun(Run):
     def stop_rules(self) -> str | None:
         """The rules of Run; a stop on V·a ≤ 0 is interpolated to where the speed along the axis vanishes."""
         outcome = super().stop_rules()
-        s, prev = self.state, self.prev
-        if outcome == "embedded" and float(s.V @ self.axis(s)) <= 0.0:
-            a0, a1 = float(prev.V @ self.axis(prev)), float(s.V @ self.axis(s))
-            lam = a0 / (a0 - a1) if a0 - a1 > 0.0 else 1.0
-            s = RigidState.from_array(prev.as_array() + lam * (s.as_array() - prev.as_array()))
-            s.q /= np.linalg.norm(s.q)
-            self.state = s
+        if outcome != "embedded":
+            return outcome
+        lam = self.compiled.stop_back(self) if self.compiled is not None else self.stop_back()
+        if lam is not None:
             self.t -= (1.0 - lam) * self.dt
             self.angular_impulse = self.angular_impulse - (1.0 - lam) * self.body.angular_impulse_step
         return outcome
+
+    def stop_back(self) -> float | None:
+        """An embedded stop's interpolation in numpy (the oracle of rigid_batch.c's rigid_stop_back, which the
+        compiled step takes): when V·a ≤ 0, the state taken back along the step to where V·a vanishes.
+
+        Returns:
+            The fraction of the step kept, or None when the state stays."""
+        s, prev = self.state, self.prev
+        if not float(s.V @ self.axis(s)) <= 0.0:
+            return None
+        a0, a1 = float(prev.V @ self.axis(prev)), float(s.V @ self.axis(s))
+        lam = a0 / (a0 - a1) if a0 - a1 > 0.0 else 1.0
+        s = RigidState.from_array(prev.as_array() + lam * (s.as_array() - prev.as_array()))
+        s.q /= np.linalg.norm(s.q)
+        self.state = s
+        return lam
 
     def finish_loop(self) -> None:
         """The final state's row, with the force at that state; a run whose energy balance has run away (the
@@ -543,6 +556,18 @@ class CompiledStep:
             raise MemoryError("rigid_step: no memory for its scratch arrays")
         assert check == len(SHOT_NUMBERS) * 100 + len(self.out), "rigid_batch.c and fepen.runs.rigid disagree"
         return self.out
+
+    def stop_back(self, run) -> float | None:
+        """RigidRun.stop_back by rigid_batch.c's rigid_stop_back, the batch's: the run's state taken back along
+        its last step to where V·a vanishes, when V·a ≤ 0.
+
+        Returns:
+            The fraction of the step kept, or None when the state stays."""
+        prev, y, lam = run.prev.as_array(), run.state.as_array(), np.zeros(1)
+        if not self.lib.rigid_stop_back(prev.ctypes.data, y.ctypes.data, lam.ctypes.data):
+            return None
+        run.state = RigidState.from_array(y)
+        return float(lam[0])
 
 
 def shot_numbers(run) -> list[float]:

@@ -1,5 +1,6 @@
 /* The rigid run's RK4 step, single or batched (docs/theory.md §9): rigid_step advances one shot by one step for
- * fepen.runs.rigid.RigidRun.step (the single path), and rigid_batch runs many shots of one projectile in one call
+ * fepen.runs.rigid.RigidRun.step (the single path) and rigid_stop_back takes an embedded stop back to V.a = 0 for
+ * its stop rules, and rigid_batch runs many shots of one projectile in one call
  * (fepen/runs/batch.py), each shot's loop (one_shot: the same step, rk4, then the stop rules and the history maxima
  * as RigidRun advances it) with no Python per stage. The load points and the force sums are rigid_kernel.c's
  * rigid_points and force_moment (passed in as function pointers and called on all the points: they are
@@ -211,6 +212,25 @@ static void row_of(const double *sp, const double *y, double work, double *nose,
     *error = fabs((((ke + 0.0) + 0.0) - ke0 - work) - 0.0) / scale;
 }
 
+/* An embedded stop's interpolation (RigidRun.stop_rules, the batch's and the single path's): when V.a <= 0 at y,
+ * y is taken back along the step from prev (Y_COUNT each) to where the speed along the axis vanishes, V.a = 0 by
+ * linear interpolation, its quaternion normalised again; lam: the fraction of the step kept (1 when y stays).
+ * Returns 1 when it moved y, else 0. */
+int32_t rigid_stop_back(const double *prev, double *y, double *lam) {
+    double a[3], ap[3];
+    axis_of(y, a);
+    *lam = 1.0;
+    if (!(dot3(y + Y_VELOCITY, a) <= 0.0)) return 0;
+    axis_of(prev, ap);
+    const double a0 = dot3(prev + Y_VELOCITY, ap), a1 = dot3(y + Y_VELOCITY, a);
+    const double l = a0 - a1 > 0.0 ? a0 / (a0 - a1) : 1.0;
+    for (int j = 0; j < Y_COUNT; ++j) y[j] = prev[j] + l * (y[j] - prev[j]);
+    const double nq = norm4(y + Y_QUAT);
+    for (int j = Y_QUAT; j < Y_QUAT + 4; ++j) y[j] /= nq;
+    *lam = l;
+    return 1;
+}
+
 static int finite13(const double *y) {
     for (int j = 0; j < Y_COUNT; ++j)
         if (!isfinite(y[j])) return 0;
@@ -276,16 +296,8 @@ static void one_shot(Body *b, const double *sp, const double *law, double *y, do
         outcome = penetration_rule(ymin, ymax, y + Y_VELOCITY, a, sp[S_MASS], sp[S_KE0], thk,
                                    sp[S_UNTIL_STOPPED] != 0.0, sp[S_STOP_ENERGY], &entered);
         /* RigidRun.stop_rules: back to where V.a vanishes */
-        if (outcome == OUTCOME_EMBEDDED && dot3(y + Y_VELOCITY, a) <= 0.0) {
-            double ap[3];
-            axis_of(prev, ap);
-            double a0 = dot3(prev + Y_VELOCITY, ap), a1 = dot3(y + Y_VELOCITY, a);
-            double lam = a0 - a1 > 0.0 ? a0 / (a0 - a1) : 1.0;
-            for (int j = 0; j < Y_COUNT; ++j) y[j] = prev[j] + lam * (y[j] - prev[j]);
-            double nq = norm4(y + Y_QUAT);
-            for (int j = Y_QUAT; j < Y_QUAT + 4; ++j) y[j] /= nq;
-            t -= (1.0 - lam) * dt;
-        }
+        double lam;
+        if (outcome == OUTCOME_EMBEDDED && rigid_stop_back(prev, y, &lam)) t -= (1.0 - lam) * dt;
     }
     res[R_T] = t;
     res[R_STEPS] = (double)steps;

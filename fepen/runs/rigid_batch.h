@@ -37,6 +37,10 @@ int32_t rigid_step(int32_t k, const double *r0, const double *N0, const double *
                    void *points, void *moment, const double *sp, const double *law, double *y, const double *xi,
                    double *T, double *out, double *stages);
 
+/* an embedded stop's interpolation back to V.a = 0 (prev, y: Y_COUNT; y moved in place, lam the fraction of the
+ * step kept). Returns 1 when it moved y */
+int32_t rigid_stop_back(const double *prev, double *y, double *lam);
+
 /* the batch's law on one set of points, for the tests against point_forces */
 void batch_law(int32_t k, const double *x, const double *v, const double *n, const double *area, const double *ell,
                const double *radius, const double *Rm, const double *sphi0, const double *axis, const double *p,

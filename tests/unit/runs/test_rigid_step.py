@@ -82,6 +82,31 @@ def test_a_run_on_the_compiled_step_is_the_oracles_run_bitwise(sets):
     assert oracle.rows == run.rows
 
 
+def test_the_compiled_stop_back_is_the_numpy_one_bitwise():
+    """An embedded stop's interpolation back to V·a = 0 (rigid_batch.c's rigid_stop_back, the batch's): as
+    RigidRun.stop_back's numpy on random pairs of states, moving forward or backward along the axis."""
+    from fepen.laws.rigid_body import RigidState
+
+    run = RigidRun(rigid(), None, MPI.COMM_SELF)
+    rng = np.random.default_rng(11)
+    moved = 0
+    for _ in range(300):
+        pair_ = []
+        for _ in range(2):
+            q = rng.normal(0.0, 1.0, 4)
+            pair_.append(RigidState(rng.normal(0.0, 0.1, 3), q / np.linalg.norm(q), rng.normal(0.0, 300.0, 3),
+                                    rng.normal(0.0, 0.1, 3)))
+        got = []
+        for back in (run.stop_back, lambda: run.compiled.stop_back(run)):
+            run.prev, run.state = pair_
+            got.append((back(), run.state.as_array()))
+        (lam0, y0), (lam1, y1) = got
+        assert (lam0 is None) == (lam1 is None)
+        same([lam0 or 1.0, *y0], [lam1 or 1.0, *y1], "the state taken back")
+        moved += lam0 is not None
+    assert 50 < moved < 250
+
+
 def test_what_the_compiled_step_does_not_cover_takes_the_numpy_step(monkeypatch):
     """A layered target steps in numpy; so does every shot without the C kernels (FEPEN_KERNEL=numpy)."""
     from test_batch import LAYERS
