@@ -200,7 +200,9 @@ class RigidBody:
         return float(F @ s.V + M @ (self.omega(s) if w is None else w))
 
     def rk4_step(self, s: RigidState, dt: float, force_fn):
-        """One classical Runge–Kutta step.
+        """One classical Runge–Kutta step, in numpy: the oracle of the rigid run's compiled step (fepen/runs/
+        rigid_batch.c's rigid_step, which RigidRun takes where the C kernels build; tests/unit/runs/
+        test_rigid_step.py holds the two together, bitwise), and the step where they do not build.
 
         Returns:
             (new state, force and moment at the start, work of the external force and moment over the step

@@ -1,5 +1,5 @@
 /* The rigid body's load-point kernel's interface (rigid_kernel.c): the functions Python calls (their ctypes
- * signatures are read from these prototypes; fepen/runs/batch.py passes their addresses to rigid_batch.c). */
+ * signatures are read from these prototypes; fepen/runs/rigid.py passes their addresses to rigid_batch.c). */
 #ifndef FEPEN_RIGID_KERNEL_H
 #define FEPEN_RIGID_KERNEL_H
 #include <stdint.h>

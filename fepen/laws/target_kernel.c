@@ -6,6 +6,7 @@
  * linear-crater scaling). tests/unit/laws/test_target_kernel.py checks it against an independent numpy
  * oracle of the equations and against their limits. Built once per machine, called by ctypes. */
 #include <math.h>
+#include <stddef.h>
 #include <stdint.h>
 
 #include "target_kernel.h"
@@ -239,6 +240,61 @@ static void wall_yield(double *T, TunnelEnd *e, const double *p, const LawConsta
     tunnel_widen(T, kn, sec, rho - WALL_TOL * hit.a - limit / wall_stiffness(p, &hit));
 }
 
+/* The law on k points, its one driver: point_forces's, and the rigid run's step's (fepen/runs/rigid_batch.c, which
+ * includes this file). ell (k): each patch's sqrt(area) when given (NULL: taken here, the same bits); idx: NULL, or
+ * room for k indices. The law is evaluated at the points that may load (above_face, may_load), their forces into f
+ * and stresses into sig, and the others left as they are: the caller zeroes them (point_forces: every point;
+ * the step: at the points it loaded before). With idx the evaluated points' indices go into it, in order, and only
+ * their forces are summed (the others are zero: a zero term changes no sum, and a sum from +0 is never -0); without
+ * it every point's is. A call with T[T_COMMIT] set first records a station, then lets the wall yield where the
+ * points press it past its reload limit (wall_yield), and clears the flag. Returns how many points it evaluated. */
+__attribute__((noinline)) static int32_t law_points(int32_t k, const double *x, const double *v, const double *n,
+                                                    const double *area, const double *ell, const double *radius,
+                                                    const double *Rm, const double *sphi0, const double *axis,
+                                                    const double *p, const double *gauss, int32_t ng, double *f,
+                                                    double *sig, int32_t *idx, double *sums, const double *body_xi,
+                                                    double *T) {
+    const LawConstants c = law_constants(p);
+    const int commit = T && T[T_COMMIT] != 0.0;
+    if (commit) tunnel_record(T);
+    TunnelEnd end;
+    if (T) tunnel_end(T, &end);
+    int32_t m = 0;
+    for (int j = 0; j < SUM_COUNT; ++j) sums[j] = 0.0;
+    for (int32_t i = 0; i < k; ++i) {
+        double sg = 0.0;
+        const double ell_i = ell ? ell[i] : sqrt(area[i]);
+        if (above_face(p, x + 3 * i, ell_i) || !may_load(v + 3 * i, n + 3 * i, T, T ? body_xi[i] : 0.0)) continue;
+        WallHit hit;
+        const WallHit *wall = wall_of(T, &end, x + 3 * i, T ? body_xi[i] : 0.0, &hit);
+        if (!law_at_point(p, &c, x + 3 * i, v + 3 * i, n + 3 * i, area[i], ell_i, radius[i], Rm[i], sphi0[i], axis,
+                          wall, gauss, ng, f + 3 * i, &sg))
+            continue;
+        if (sg > 0.0) {
+            sums[SUM_LOADED] += 1.0;
+            sums[SUM_AREA] += area[i];
+        }
+        sig[i] = sg;
+        if (idx) idx[m] = i;
+        m++;
+    }
+    const int32_t some = idx ? m : k; /* the points the loops below visit: idx's, or all */
+    if (commit) {
+        for (int32_t j = 0; j < some; ++j) {
+            const int32_t i = idx ? idx[j] : j;
+            if (sig[i] > 0.0) wall_yield(T, &end, p, &c, x + 3 * i, v + 3 * i, radius[i], body_xi[i]);
+        }
+        T[T_COMMIT] = 0.0;
+    }
+    for (int32_t j = 0; j < some; ++j) {
+        const double *fi = f + 3 * (idx ? idx[j] : j);
+        sums[SUM_FORCE] += fi[0];
+        sums[SUM_FORCE + 1] += fi[1];
+        sums[SUM_FORCE + 2] += fi[2];
+    }
+    return m;
+}
+
 /* k points; x, v, n (k, 3); area, radius, Rm, sphi0 (k); axis (3) or NULL; gauss: ng nodes then ng weights;
  * body_xi (k): each point's distance behind the tip in the body frame, and T: the tunnel (tunnel_kernel.c; NULL:
  * none, body_xi unread). A call with T[T_COMMIT] set (a step's first stage) first records a station, then
@@ -249,36 +305,11 @@ int32_t point_forces(int32_t k, const double *x, const double *v, const double *
                      const double *radius, const double *Rm, const double *sphi0, const double *axis,
                      const double *p, const double *gauss, int32_t ng, double *f, double *sig, double *sums,
                      const double *body_xi, double *T) {
-    const LawConstants c = law_constants(p);
-    const int commit = T && T[T_COMMIT] != 0.0;
-    if (commit) tunnel_record(T);
-    TunnelEnd end;
-    if (T) tunnel_end(T, &end);
-    for (int j = 0; j < SUM_COUNT; ++j) sums[j] = 0.0;
     for (int32_t i = 0; i < k; ++i) {
-        double *fi = f + 3 * i;
-        fi[0] = fi[1] = fi[2] = 0.0;
+        f[3 * i] = f[3 * i + 1] = f[3 * i + 2] = 0.0;
         sig[i] = 0.0;
-        const double ell = sqrt(area[i]);
-        if (above_face(p, x + 3 * i, ell) || !may_load(v + 3 * i, n + 3 * i, T, T ? body_xi[i] : 0.0)) continue;
-        WallHit hit;
-        const WallHit *wall = wall_of(T, &end, x + 3 * i, T ? body_xi[i] : 0.0, &hit);
-        if (law_at_point(p, &c, x + 3 * i, v + 3 * i, n + 3 * i, area[i], ell, radius[i], Rm[i], sphi0[i],
-                         axis, wall, gauss, ng, fi, sig + i) && sig[i] > 0.0) {
-            sums[SUM_LOADED] += 1.0;
-            sums[SUM_AREA] += area[i];
-        }
     }
-    if (commit) {
-        for (int32_t i = 0; i < k; ++i)
-            if (sig[i] > 0.0) wall_yield(T, &end, p, &c, x + 3 * i, v + 3 * i, radius[i], body_xi[i]);
-        T[T_COMMIT] = 0.0;
-    }
-    for (int32_t i = 0; i < k; ++i) {
-        sums[SUM_FORCE] += f[3 * i];
-        sums[SUM_FORCE + 1] += f[3 * i + 1];
-        sums[SUM_FORCE + 2] += f[3 * i + 2];
-    }
+    law_points(k, x, v, n, area, NULL, radius, Rm, sphi0, axis, p, gauss, ng, f, sig, NULL, sums, body_xi, T);
     return law_length(p);
 }
 

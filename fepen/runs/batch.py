@@ -3,10 +3,10 @@ instead of one ``RigidRun.run()`` each, for the studies that run thousands of th
 studies, ``fepen validate-depth``).
 
 Each shot is set up by ``RigidRun`` as usual (its projectile, load points, law, crater, step, initial state);
-the kernel then advances every shot of a projectile with the single path's RK4, its stop rules (perforated,
-ricochet, embedded with its interpolation back to V·a = 0, the hard end) and its history clock (the largest
-nose depth and energy error of the rows the single path would record), calling the single path's own
-compiled load-point, force-sum and target-law functions; the final row and the summary are then made by
+the kernel then advances every shot of a projectile with the single path's own compiled RK4 step (rk4, which
+RigidRun.step calls through rigid_step: Step), its stop rules (perforated, ricochet, embedded with its
+interpolation back to V·a = 0, the hard end) and its history clock (the largest nose depth and energy error of
+the rows the single path would record); the final row and the summary are then made by
 ``RigidRun`` itself from the final state. The single path (``RigidRun.run``) stays the reference: the batch
 gives its summaries bitwise (tests/unit/runs/test_batch.py), and falls back to it, shot by shot and
 automatically, for what the kernel does not cover:
@@ -20,7 +20,6 @@ automatically, for what the kernel does not cover:
 
 from __future__ import annotations
 
-import ctypes
 import time
 
 import numpy as np
@@ -31,50 +30,19 @@ from fepen.errors import InputError, SimulationError
 from fepen.laws import target as tg
 from fepen.laws import tunnel
 from fepen.runs import events
+from fepen.runs.rigid import SHOT_NUMBERS, RigidRun, kernel, point_arrays, shot_numbers
 
 __all__ = ["summaries", "reason", "kernel", "SHOT_NUMBERS", "RESULTS", "OUTCOMES"]
 
-#: the per-shot numbers the kernel reads, in its order: rigid_batch.h's S_ members and the numbers each holds
-#: (checked against the header, member by member, when the kernel is loaded: fepen.native.shares)
-_SHOT_LAYOUT = (
-    ("S_MASS", ("mass",)), ("S_DT", ("dt",)), ("S_HARD_END", ("hard_end",)), ("S_THICKNESS", ("thickness",)),
-    ("S_UNTIL_STOPPED", ("until_stopped",)), ("S_HISTORY", ("history_interval",)), ("S_CRATER", ("crater",)),
-    ("S_CRATER_KD", ("crater_kd",)), ("S_CRATER_C", ("crater_c",)), ("S_KE0", ("ke0",)),
-    ("S_STOP_ENERGY", ("stop_energy",)), ("S_TIP", ("tip_x", "tip_y", "tip_z")),
-    ("S_TAIL", ("tail_x", "tail_y", "tail_z")), ("S_IINV", tuple(f"I_inv_{i}{j}" for i in range(3) for j in range(3))),
-    ("S_TUNNEL", ("tunnel",)), ("S_SPACING", ("tunnel_spacing",)), ("S_XI_SH", ("shoulder_xi",)),
-    ("S_A0", ("shoulder_radius",)), ("S_RESERVED", ("reserved",)),
-    ("S_SHOULDER", ("shoulder_x", "shoulder_y", "shoulder_z")))
-SHOT_NUMBERS = tuple(name for _, names in _SHOT_LAYOUT for name in names)
-#: the per-shot results it writes: its R_ members and their names here (checked as _SHOT_LAYOUT is)
+#: the per-shot results it writes: its R_ members and their names here (checked as fepen.runs.rigid's shot numbers are)
 _RESULT_LAYOUT = (("R_T", "t"), ("R_STEPS", "steps"), ("R_OUTCOME", "outcome"), ("R_WORK", "work"),
                   ("R_ENTERED", "entered"), ("R_MAX_NOSE", "max_nose_mm"), ("R_MAX_ERROR", "max_error"),
                   ("R_ROWS", "rows"), ("R_STATUS", "status"))
 RESULTS = tuple(name for _, name in _RESULT_LAYOUT)
-native.shares("rigid_batch", "S_", [(member, len(names)) for member, names in _SHOT_LAYOUT])
 native.shares("rigid_batch", "R_", [(member, 1) for member, _ in _RESULT_LAYOUT])
-#: a shot's state as fepen.laws.rigid_body.RigidState.as_array lays it out (centre, quaternion, velocity, angular
-#: momentum): rigid_batch.h's Y_ enum
-native.shares("rigid_batch", "Y_", [("Y_CENTRE", 3), ("Y_QUAT", 4), ("Y_VELOCITY", 3), ("Y_MOMENTUM", 3)])
 #: outcome codes of the kernel (events_kernel.h's, which rigid_batch.c includes: checked with the events kernel)
 OUTCOMES = events.OUTCOMES
 _R = {k: i for i, k in enumerate(RESULTS)}
-_KERNEL: dict = {}
-
-
-def kernel():
-    """(the rigid_batch library, the addresses of rigid_kernel.c's rigid_points and force_moment, the Gauss rule
-    of the law) when the C kernels build and FEPEN_KERNEL is not python (fepen.native), else None."""
-    if "fn" not in _KERNEL:
-        _KERNEL["fn"] = None
-        body, lib = native.kernel("rigid_body"), native.kernel("rigid_batch")
-        if body is None or lib is None:
-            return None
-        native.check_layouts("events")  # the outcome codes the batch returns
-        vp = ctypes.c_void_p
-        _KERNEL["fn"] = (lib, [ctypes.cast(f, vp).value for f in (body.rigid_points, body.force_moment)],
-                         tg.crater_gauss())
-    return _KERNEL["fn"]
 
 
 def reason(run) -> str | None:
@@ -107,7 +75,6 @@ def summaries(scenes, comm=None, history: bool = True) -> list:
         One item per shot, in order: its summary, or the InputError or SimulationError it raised.
     """
     from fepen.runs import shot
-    from fepen.runs.rigid import RigidRun
 
     comm = MPI.COMM_SELF if comm is None else comm
     out: list = [None] * len(scenes)
@@ -136,27 +103,6 @@ def _single(run):
         return err
 
 
-def _shot_numbers(run) -> list[float]:
-    """A shot's numbers in the kernel's order (_SHOT_LAYOUT: rigid_batch.h's S_ enum), by member."""
-    body, crater, law, t = run.body, run.crater, run.law, run.tunnel
-    at = {"S_MASS": body.mass, "S_DT": run.dt, "S_HARD_END": run.end,
-          "S_THICKNESS": -1.0 if law.thickness is None else law.thickness,
-          "S_UNTIL_STOPPED": float(run.rules.until_stopped), "S_HISTORY": run.history.clock.interval,
-          "S_CRATER": float(crater is not None), "S_CRATER_KD": crater.kd if crater is not None else 0.0,
-          "S_CRATER_C": crater.c if crater is not None else 0.0, "S_KE0": run.ke0,
-          "S_STOP_ENERGY": events.stop_fraction(body.mass, run.ke0), "S_TIP": run.tip_arm,
-          "S_TAIL": run.tail_ref - body.centre0, "S_IINV": body.I_body_inv.ravel(),
-          "S_TUNNEL": 0.0 if t is None else 1.0, "S_SPACING": 0.0 if t is None else t.buf[tunnel.T_SPACING],
-          "S_XI_SH": 0.0 if t is None else t.buf[tunnel.T_XI_SH], "S_A0": 0.0 if t is None else t.buf[tunnel.T_A0],
-          "S_RESERVED": 0.0, "S_SHOULDER": run.shoulder_arm if t is not None else np.zeros(3)}
-    out: list = []
-    for member, names in _SHOT_LAYOUT:
-        part = list(at[member]) if len(names) > 1 else [at[member]]
-        assert len(part) == len(names), f"{member}: {len(part)} numbers, not {len(names)}"
-        out.extend(part)
-    return out
-
-
 def _tunnel_room(runs) -> int:
     """Stations a batch's tunnels need at most: the shoulder's path within the hard end, at most twice the
     striking speed times it (speed only falls; the turning adds the arm's sweep), over the spacing."""
@@ -171,9 +117,8 @@ def _integrate(runs: list) -> list:
     lib, (points, moment), gauss = kernel()
     g, body = runs[0].pts, runs[0].body
     n, k = len(runs), len(body.r0)
-    const = [np.ascontiguousarray(a, dtype=float) for a in (body.r0, body.N0, g["area0"], np.sqrt(g["area0"]),
-                                                              g["radius"], g["R_meridian"], g["sin_phi0"])]
-    sp = np.ascontiguousarray([_shot_numbers(r) for r in runs], dtype=float)
+    const = point_arrays(runs[0])
+    sp = np.ascontiguousarray([shot_numbers(r) for r in runs], dtype=float)
     numbers = [tg._law_numbers(r.law) for r in runs]  # padded to the longest (the random fields' modes)
     laws = np.zeros((n, max(len(a) for a in numbers)))
     for row, a in zip(laws, numbers):

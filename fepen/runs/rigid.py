@@ -1,19 +1,22 @@
 """The rigid fidelity (``effects.fidelity = "rigid"``): the projectile as one rigid body in the concrete
 target law (docs/theory.md §9). By default without any mesh: the mass properties of the exact solid of
 revolution and load points in rings on its exact surface (fepen.geometry.revolution); the volume mesh's
-(mesh_points) on request. Every rank integrates the same ODE on all the points. The
-stop rules are fepen.runs.events'; a stop on V·a ≤ 0 is interpolated to where the speed along the axis
-vanishes.
+(mesh_points) on request. Every rank integrates the same ODE on all the points, by the compiled step
+(fepen/runs/rigid_batch.c's rigid_step, the batch's own) where the C kernels build and the target is one
+material, else by the numpy step (fepen.laws.rigid_body.RigidBody.rk4_step, its oracle). The stop rules are
+fepen.runs.events'; a stop on V·a ≤ 0 is interpolated to where the speed along the axis vanishes.
 """
 
 from __future__ import annotations
 
+import ctypes
 import functools
 import time
 
 import numpy as np
 from mpi4py import MPI
 
+from fepen import native
 from fepen.errors import Interrupted, SimulationError
 from fepen.geometry import mesh as fmesh
 from fepen.geometry import revolution, tags
@@ -31,7 +34,7 @@ from fepen.laws.rigid_body import (
     tet_mass_properties,
 )
 from fepen.laws.tunnel import Tunnel
-from fepen.runs import budget, outputs, setup, shot
+from fepen.runs import budget, events, outputs, setup, shot
 from fepen.runs import probes as run_probes
 from fepen.runs.run import Removal, Run, Snapshot
 
@@ -219,6 +222,9 @@ class RigidRun(Run):
         self.F = self.body.derivative(self.state, self.force_fn)[1]  # the force at the state (no target: zero)
         if sh.probes and history and self.out is not None:
             self.probes = run_probes.RigidProbes(sh.probes)
+        #: the compiled step (rigid_batch.c's rigid_step, the batch's own), or None: the numpy step
+        #: (RigidBody.rk4_step, the oracle), with FEPEN_KERNEL=numpy/python, without C kernels, or a layered target
+        self.compiled = CompiledStep(self) if covers(self) else None
 
     # ------------------------------------------------------------------------------------------------
     def _load(self, s: RigidState, R, x, v, n):
@@ -262,20 +268,41 @@ class RigidRun(Run):
     def step(self) -> None:
         """One RK4 step, then the wear (a history row evaluates the target's load at its own state)."""
         self.prev = s = self.state
-        if self.tunnel is not None:
-            self.tunnel.commit = True  # the first stage records the tunnel at the step's start
-        s, self.F, _, work = self.body.rk4_step(s, self.dt, self.force_fn)
-        self.w_ext += work
+        if self.compiled is not None:
+            s = self._compiled_step(s)
+        else:
+            if self.tunnel is not None:
+                self.tunnel.commit = True  # the first stage records the tunnel at the step's start
+            s, self.F, _, work = self.body.rk4_step(s, self.dt, self.force_fn)
+            self.w_ext += work
         self.angular_impulse = self.angular_impulse + self.body.angular_impulse_step
         if self.wear is not None:
             s = self.wear.step(self.body, s, self.dt)
             self.tip_ref[1] = self.wear.shortening
             self.tip_arm = self.tip_ref - self.body.centre0  # the worn nose's tip (force_fn's crater depth)
+            if self.compiled is not None:
+                self.compiled.refresh()  # the worn body's mass, inertia, points and tip
         self.state = s
         self.t += self.dt
         self.step_count += 1
         if self.check_finite:  # what the history rows would have caught
             results.finite_row(s.as_array().tolist(), self.step_count, self.t)
+
+    def _compiled_step(self, s: RigidState) -> RigidState:
+        """RigidBody.rk4_step with force_fn, compiled (rigid_batch.c's rigid_step): the state after the step,
+        with the force at its start, its work, its angular impulse (the body's, as rk4_step leaves it), the last
+        stage's load and the wear's four stages, as the numpy step gives them."""
+        y = s.as_array()
+        out = self.compiled(y)
+        at = STEP
+        self.F = out[at["force"]:at["force"] + 3].copy()
+        self.w_ext += float(out[at["work"]])
+        self.body.angular_impulse_step = out[at["angular"]:at["angular"] + 3].copy()
+        self.loaded, self.area = int(out[at["loaded"]]), float(out[at["area"]])
+        if self.wear is not None:
+            for f, v, n in self.compiled.stages:
+                self.wear.stage(f, n, v)
+        return RigidState.from_array(y)
 
     def extent(self):
         s = self.state
@@ -285,16 +312,29 @@ class RigidRun(Run):
     def stop_rules(self) -> str | None:
         """The rules of Run; a stop on V·a ≤ 0 is interpolated to where the speed along the axis vanishes."""
         outcome = super().stop_rules()
-        s, prev = self.state, self.prev
-        if outcome == "embedded" and float(s.V @ self.axis(s)) <= 0.0:
-            a0, a1 = float(prev.V @ self.axis(prev)), float(s.V @ self.axis(s))
-            lam = a0 / (a0 - a1) if a0 - a1 > 0.0 else 1.0
-            s = RigidState.from_array(prev.as_array() + lam * (s.as_array() - prev.as_array()))
-            s.q /= np.linalg.norm(s.q)
-            self.state = s
+        if outcome != "embedded":
+            return outcome
+        lam = self.compiled.stop_back(self) if self.compiled is not None else self.stop_back()
+        if lam is not None:
             self.t -= (1.0 - lam) * self.dt
             self.angular_impulse = self.angular_impulse - (1.0 - lam) * self.body.angular_impulse_step
         return outcome
+
+    def stop_back(self) -> float | None:
+        """An embedded stop's interpolation in numpy (the oracle of rigid_batch.c's rigid_stop_back, which the
+        compiled step takes): when V·a ≤ 0, the state taken back along the step to where V·a vanishes.
+
+        Returns:
+            The fraction of the step kept, or None when the state stays."""
+        s, prev = self.state, self.prev
+        if not float(s.V @ self.axis(s)) <= 0.0:
+            return None
+        a0, a1 = float(prev.V @ self.axis(prev)), float(s.V @ self.axis(s))
+        lam = a0 / (a0 - a1) if a0 - a1 > 0.0 else 1.0
+        s = RigidState.from_array(prev.as_array() + lam * (s.as_array() - prev.as_array()))
+        s.q /= np.linalg.norm(s.q)
+        self.state = s
+        return lam
 
     def finish_loop(self) -> None:
         """The final state's row, with the force at that state; a run whose energy balance has run away (the
@@ -413,3 +453,141 @@ class Wear:
         body.N0[:] = N
         body._last = None  # the cached load points of the last state are the uncontracted nose's
         g["X"][:], g["N"][:], g["area0"][:], g["sin_phi0"][:], g["R_meridian"][:] = X, N, A, sphi, Rm
+
+
+# ------------------------------------------------------------------------------------------------------------
+# The compiled step: rigid_batch.c's rk4, the one RK4 step of the rigid run, single (RigidRun.step, through
+# rigid_step) or batched (fepen.runs.batch, through rigid_batch)
+
+#: the per-shot numbers the kernel reads, in its order: rigid_batch.h's S_ members and the numbers each holds
+#: (checked against the header, member by member, when the kernel is loaded: fepen.native.shares)
+_SHOT_LAYOUT = (
+    ("S_MASS", ("mass",)), ("S_DT", ("dt",)), ("S_HARD_END", ("hard_end",)), ("S_THICKNESS", ("thickness",)),
+    ("S_UNTIL_STOPPED", ("until_stopped",)), ("S_HISTORY", ("history_interval",)), ("S_CRATER", ("crater",)),
+    ("S_CRATER_KD", ("crater_kd",)), ("S_CRATER_C", ("crater_c",)), ("S_KE0", ("ke0",)),
+    ("S_STOP_ENERGY", ("stop_energy",)), ("S_TIP", ("tip_x", "tip_y", "tip_z")),
+    ("S_TAIL", ("tail_x", "tail_y", "tail_z")), ("S_IINV", tuple(f"I_inv_{i}{j}" for i in range(3) for j in range(3))),
+    ("S_TUNNEL", ("tunnel",)), ("S_SPACING", ("tunnel_spacing",)), ("S_XI_SH", ("shoulder_xi",)),
+    ("S_A0", ("shoulder_radius",)), ("S_RESERVED", ("reserved",)),
+    ("S_SHOULDER", ("shoulder_x", "shoulder_y", "shoulder_z")))
+SHOT_NUMBERS = tuple(name for _, names in _SHOT_LAYOUT for name in names)
+native.shares("rigid_batch", "S_", [(member, len(names)) for member, names in _SHOT_LAYOUT])
+#: a shot's state as fepen.laws.rigid_body.RigidState.as_array lays it out (centre, quaternion, velocity, angular
+#: momentum): rigid_batch.h's Y_ enum
+native.shares("rigid_batch", "Y_", [("Y_CENTRE", 3), ("Y_QUAT", 4), ("Y_VELOCITY", 3), ("Y_MOMENTUM", 3)])
+#: one RK4 step's numbers (rigid_step's out): rigid_batch.h's STEP_ enum (checked when the kernel is loaded)
+_STEP_LAYOUT = (("STEP_FORCE", 3), ("STEP_WORK", 1), ("STEP_ANGULAR", 3), ("STEP_LOADED", 1), ("STEP_AREA", 1))
+#: where each of them starts in the step's numbers, by name
+STEP = {m[5:].lower(): sum(w for _, w in _STEP_LAYOUT[:i]) for i, (m, _) in enumerate(_STEP_LAYOUT)}
+STEP_COUNT = sum(w for _, w in _STEP_LAYOUT)
+_KERNEL: dict = {}
+
+
+def kernel():
+    """(the rigid_batch library, the addresses of rigid_kernel.c's rigid_points and force_moment, the Gauss rule
+    of the law) when the C kernels build and FEPEN_KERNEL is not python (fepen.native), else None."""
+    if "fn" not in _KERNEL:
+        _KERNEL["fn"] = None
+        body, lib = native.kernel("rigid_body"), native.kernel("rigid_batch")
+        if body is None or lib is None:
+            return None
+        native.check_layouts("events")  # the outcome codes the batch returns
+        native.check_layout(native.PACKAGE / native.KERNELS["rigid_batch"].header, "STEP_", _STEP_LAYOUT)
+        vp = ctypes.c_void_p
+        _KERNEL["fn"] = (lib, [ctypes.cast(f, vp).value for f in (body.rigid_points, body.force_moment)],
+                         tg.crater_gauss())
+    return _KERNEL["fn"]
+
+
+def covers(run) -> bool:
+    """Whether the compiled step (CompiledStep) can advance a RigidRun: the C kernels are built (FEPEN_KERNEL is not
+    python or numpy), the shot has a target law and its target kind is one the batch takes (not layered)."""
+    return kernel() is not None and run.law is not None and run.shot.target.not_batched() is None
+
+
+def point_arrays(run) -> list:
+    """A run's per-point arrays as rigid_batch.c reads them: r0, N0, area, ell = sqrt(area), radius, Rm, sphi0."""
+    g, body = run.pts, run.body
+    return [np.ascontiguousarray(a, dtype=float) for a in (body.r0, body.N0, g["area0"], np.sqrt(g["area0"]),
+                                                           g["radius"], g["R_meridian"], g["sin_phi0"])]
+
+
+class CompiledStep:
+    """One RigidRun's compiled RK4 step: rigid_batch.c's rigid_step, the batch's own step (RigidBody.rk4_step
+    with RigidRun.force_fn, operation by operation: tests/unit/runs/test_rigid_step.py holds them together).
+
+    Args:
+        run: the RigidRun (covers(run)); its tunnel's buffer is advanced in place. With wear, each step also
+            gives its four stages' point forces, velocities and normals (``stages``, (4, 3, k, 3)) for
+            Wear.stage, and ``refresh()`` takes the body's new numbers after the wear.
+    """
+
+    def __init__(self, run):
+        self.run = run
+        self.lib, (self.points, self.moment), self.gauss = kernel()
+        self.law = np.ascontiguousarray(tg._law_numbers(run.law), dtype=float)
+        self.out = np.zeros(STEP_COUNT)
+        k = len(run.body.r0)
+        self.stages = np.zeros((4, 3, k, 3)) if run.wear is not None else None
+        self.refresh()
+
+    def refresh(self) -> None:
+        """Read the run's body again: its points, mass, inertia, tip (after the wear changed them)."""
+        run = self.run
+        self.const = point_arrays(run)
+        self.sp = np.ascontiguousarray(shot_numbers(run), dtype=float)
+        self.xi = np.ascontiguousarray(run.pts["X"][:, 1], dtype=float)
+
+    def __call__(self, y: np.ndarray) -> np.ndarray:
+        """Advance the state y (Y_ layout, float64, contiguous) by one step in place.
+
+        Returns:
+            The step's numbers (STEP: the force at its start, the work, the angular impulse about O, the last
+            stage's loaded points and area), a buffer the next call overwrites.
+        """
+        run = self.run
+        t = run.tunnel
+        check = self.lib.rigid_step(len(self.const[2]), *[a.ctypes.data for a in self.const], self.gauss.ctypes.data,
+                                    len(self.gauss) // 2, self.points, self.moment, self.sp.ctypes.data,
+                                    self.law.ctypes.data, y.ctypes.data, self.xi.ctypes.data,
+                                    None if t is None else t.buf.ctypes.data, self.out.ctypes.data,
+                                    None if self.stages is None else self.stages.ctypes.data)
+        if check < 0:
+            raise MemoryError("rigid_step: no memory for its scratch arrays")
+        assert check == len(SHOT_NUMBERS) * 100 + len(self.out), "rigid_batch.c and fepen.runs.rigid disagree"
+        return self.out
+
+    def stop_back(self, run) -> float | None:
+        """RigidRun.stop_back by rigid_batch.c's rigid_stop_back, the batch's: the run's state taken back along
+        its last step to where V·a vanishes, when V·a ≤ 0.
+
+        Returns:
+            The fraction of the step kept, or None when the state stays."""
+        prev, y, lam = run.prev.as_array(), run.state.as_array(), np.zeros(1)
+        if not self.lib.rigid_stop_back(prev.ctypes.data, y.ctypes.data, lam.ctypes.data):
+            return None
+        run.state = RigidState.from_array(y)
+        return float(lam[0])
+
+
+def shot_numbers(run) -> list[float]:
+    """A shot's numbers in the kernel's order (_SHOT_LAYOUT: rigid_batch.h's S_ enum), by member."""
+    body, crater, law, t = run.body, run.crater, run.law, run.tunnel
+    at = {"S_MASS": body.mass, "S_DT": run.dt, "S_HARD_END": run.end,
+          "S_THICKNESS": -1.0 if law.thickness is None else law.thickness,
+          "S_UNTIL_STOPPED": float(run.rules.until_stopped), "S_HISTORY": run.history.clock.interval,
+          "S_CRATER": float(crater is not None), "S_CRATER_KD": crater.kd if crater is not None else 0.0,
+          "S_CRATER_C": crater.c if crater is not None else 0.0, "S_KE0": run.ke0,
+          "S_STOP_ENERGY": events.stop_fraction(body.mass, run.ke0), "S_TIP": run.tip_arm,
+          "S_TAIL": run.tail_ref - body.centre0, "S_IINV": body.I_body_inv.ravel(),
+          "S_TUNNEL": 0.0 if t is None else 1.0,
+          "S_SPACING": 0.0 if t is None else t.buf[tunnel_zones.T_SPACING],
+          "S_XI_SH": 0.0 if t is None else t.buf[tunnel_zones.T_XI_SH],
+          "S_A0": 0.0 if t is None else t.buf[tunnel_zones.T_A0],
+          "S_RESERVED": 0.0, "S_SHOULDER": run.shoulder_arm if t is not None else np.zeros(3)}
+    out: list = []
+    for member, names in _SHOT_LAYOUT:
+        part = list(at[member]) if len(names) > 1 else [at[member]]
+        assert len(part) == len(names), f"{member}: {len(part)} numbers, not {len(names)}"
+        out.extend(part)
+    return out

@@ -1,14 +1,16 @@
-/* Many rigid shots of one projectile in one call (fepen/runs/batch.py, docs/theory.md §9): each shot's RK4
- * loop, stop rules and history maxima as fepen.runs.rigid.RigidRun advances it, with no Python per stage.
- * The load points and the force sums are the single path's own compiled functions (rigid_kernel.c's
- * rigid_points and force_moment, passed in as function pointers and called on all the points: they are
+/* The rigid run's RK4 step, single or batched (docs/theory.md §9): rigid_step advances one shot by one step for
+ * fepen.runs.rigid.RigidRun.step (the single path) and rigid_stop_back takes an embedded stop back to V.a = 0 for
+ * its stop rules, and rigid_batch runs many shots of one projectile in one call
+ * (fepen/runs/batch.py), each shot's loop (one_shot: the same step, rk4, then the stop rules and the history maxima
+ * as RigidRun advances it) with no Python per stage. The load points and the force sums are rigid_kernel.c's
+ * rigid_points and force_moment (passed in as function pointers and called on all the points: they are
  * vectorised, so a point's rounding depends on its place in the array); the target law is target_kernel.c's
  * law_at_point and the stop rules events_kernel.c's penetration_rule, both included (the law built as that
  * file is built, a * b + c contracted alike). The glue between them (quaternions, omega, the crater scale, the
- * stage states, the work, the history rows' depth and energy error) repeats the single path's numpy
- * and Python expressions operation by operation, in their order, built without contracting a * b + c into
- * one rounding (-ffp-contract=off, fepen.runs.batch), so that a shot's trajectory is bitwise the single
- * path's. tests/unit/runs/test_batch.py holds the two together. */
+ * stage states, the work, the angular impulse, the history rows' depth and energy error) repeats the numpy
+ * oracle's expressions (fepen.laws.rigid_body.RigidBody.rk4_step) operation by operation, in their order, built
+ * without contracting a * b + c into one rounding (-ffp-contract=off, fepen.native), so that a step is bitwise
+ * the oracle's. tests/unit/runs/test_rigid_step.py and test_batch.py hold them together. */
 #include <math.h>
 #include <stdint.h>
 #include <stdlib.h>
@@ -16,59 +18,11 @@
 
 #include "rigid_batch.h"
 
-/* The law (law_constants, law_at_point), built as the single path builds
- * target_kernel.c (a * b + c contracted as there) */
+/* The law (target_kernel.c's law_points, point_forces's own driver, and law_at_point), built as the single path
+ * builds target_kernel.c (a * b + c contracted as there) */
 #pragma GCC push_options
 #pragma GCC optimize("fp-contract=fast")
 #include "../laws/target_kernel.c"
-
-
-/* The law (target_kernel.c's law_at_point, with point_forces's tunnel: a step's first stage records a station
- * and lets the wall yield) on k points with one shortcut that changes no bit: ell = sqrt(area) given. f is
- * written only at the points it loads (their indices into idx, in order; their stresses into sg), and only their
- * forces are summed (the others are zero). Returns how many. */
-__attribute__((noinline)) static int32_t law_points(int32_t k, const double *x, const double *v, const double *n,
-                                                    const double *area, const double *ell, const double *radius,
-                                                    const double *Rm, const double *sphi0, const double *axis,
-                                                    const double *p, const double *gauss, int32_t ng, double *f,
-                                                    int32_t *idx, double *sums, const double *body_xi, double *T,
-                                                    double *sgs) {
-    const LawConstants c = law_constants(p);
-    const int commit = T && T[T_COMMIT] != 0.0;
-    if (commit) tunnel_record(T);
-    TunnelEnd end;
-    if (T) tunnel_end(T, &end);
-    int32_t m = 0;
-    for (int j = 0; j < SUM_COUNT; ++j) sums[j] = 0.0;
-    for (int32_t i = 0; i < k; ++i) {
-        double sg = 0.0;
-        if (above_face(p, x + 3 * i, ell[i]) || !may_load(v + 3 * i, n + 3 * i, T, T ? body_xi[i] : 0.0)) continue;
-        WallHit hit;
-        const WallHit *wall = wall_of(T, &end, x + 3 * i, T ? body_xi[i] : 0.0, &hit);
-        if (!law_at_point(p, &c, x + 3 * i, v + 3 * i, n + 3 * i, area[i], ell[i], radius[i], Rm[i], sphi0[i], axis,
-                          wall, gauss, ng, f + 3 * i, &sg))
-            continue;
-        if (sg > 0.0) {
-            sums[SUM_LOADED] += 1.0;
-            sums[SUM_AREA] += area[i];
-        }
-        sgs[m] = sg;
-        idx[m++] = i;
-    }
-    if (commit) {
-        for (int32_t j = 0; j < m; ++j)
-            if (sgs[j] > 0.0)
-                wall_yield(T, &end, p, &c, x + 3 * idx[j], v + 3 * idx[j], radius[idx[j]], body_xi[idx[j]]);
-        T[T_COMMIT] = 0.0;
-    }
-    for (int32_t j = 0; j < m; ++j) {
-        const double *fi = f + 3 * idx[j];
-        sums[SUM_FORCE] += fi[0];
-        sums[SUM_FORCE + 1] += fi[1];
-        sums[SUM_FORCE + 2] += fi[2];
-    }
-    return m;
-}
 
 #pragma GCC pop_options
 
@@ -155,9 +109,18 @@ static void points_at(Body *b, const double *sp, const double *y, double *R, dou
     memcpy(b->w, w, sizeof b->w);
 }
 
-/* RigidBody.derivative with RigidRun.force_fn: dy (Y_COUNT), the force and moment, the power; loaded, area */
+/* a stage's point forces, velocities and normals (3 (k, 3) arrays) into out, for Python's wear (Wear.stage) */
+static void stage_points(const Body *b, double *out) {
+    const size_t size = 3 * (size_t)b->k * sizeof(double);
+    memcpy(out, b->f, size);
+    memcpy(out + 3 * (size_t)b->k, b->v, size);
+    memcpy(out + 6 * (size_t)b->k, b->n, size);
+}
+
+/* RigidBody.derivative with RigidRun.force_fn: dy (Y_COUNT), the force and moment, the power; loaded, area; stage
+ * (NULL: none): the point forces, velocities and normals (stage_points) */
 static void derivative(Body *b, const double *sp, const double *law, const double *y, double *dy, double *FM,
-                       double *power, double *loaded, double *area) {
+                       double *power, double *loaded, double *area, double *stage) {
     double R[9], w[3], tip[3], axis[3], sums[SUM_COUNT];
     points_at(b, sp, y, R, w);
     matvec(R, sp + S_TIP, tip);
@@ -172,7 +135,7 @@ static void derivative(Body *b, const double *sp, const double *law, const doubl
         }
     }
     int32_t m = law_points(b->k, b->x, b->v, b->n, b->area, b->ell, b->radius, b->Rm, b->sphi0, axis, law,
-                           b->gauss, b->ng, b->f, b->idx, sums, b->xi, b->T, b->sg);
+                           b->gauss, b->ng, b->f, b->sg, b->idx, sums, b->xi, b->T);
     if (sp[S_CRATER] != 0.0) { /* ForrestalCrater.scale(-tip[1], -(total . axis)) */
         double depth = -tip[1], axial = -dot3(sums, axis), scale = 1.0;
         if (!(depth >= sp[S_CRATER_KD] || axial <= 0.0)) scale = fmax(depth, 0.0) * sp[S_CRATER_C] / axial;
@@ -183,6 +146,7 @@ static void derivative(Body *b, const double *sp, const double *law, const doubl
     }
     *loaded = sums[SUM_LOADED];
     *area = sums[SUM_AREA];
+    if (stage) stage_points(b, stage);
     moment_points(b->moment, b->k, m, b->idx, b->arm, b->f, FM);
     double q[4] = {y[Y_QUAT], y[Y_QUAT + 1], y[Y_QUAT + 2], y[Y_QUAT + 3]};
     double w1 = 0.0, x1 = w[0], y1 = w[1], z1 = w[2], w2 = q[0], x2 = q[1], y2 = q[2], z2 = q[3];
@@ -196,9 +160,11 @@ static void derivative(Body *b, const double *sp, const double *law, const doubl
     *power = dot3(FM, y + Y_VELOCITY) + dot3(FM + 3, w);
 }
 
-/* RigidBody.rk4_step: y advanced by dt in place; the work of the step; F0: the force at its start */
-static double rk4(Body *b, const double *sp, const double *law, double *y, double dt, double *F0) {
-    double k[4][Y_COUNT], s[Y_COUNT], FM[6], P, loaded, area, work = 0.0;
+/* RigidBody.rk4_step: y advanced by dt in place, the step's numbers into out (STEP_: the force at its start, the
+ * work, the angular impulse about O, the last stage's loaded points and area); stages (NULL: none) the four stages'
+ * point forces, velocities and normals (4 x 3 (k, 3)) */
+static void rk4(Body *b, const double *sp, const double *law, double *y, double dt, double *out, double *stages) {
+    double k[4][Y_COUNT], s[Y_COUNT], FM[6], P, work = 0.0, ang[3] = {0.0, 0.0, 0.0};
     static const double c[4] = {0.0, 0.5, 0.5, 1.0}, wt[4] = {1.0, 2.0, 2.0, 1.0};
     for (int i = 0; i < 4; ++i) {
         if (i) {
@@ -208,15 +174,19 @@ static double rk4(Body *b, const double *sp, const double *law, double *y, doubl
             memcpy(s, y, sizeof s);
             if (b->T) b->T[T_COMMIT] = 1.0; /* RigidRun.step: the step's first stage records the tunnel */
         }
-        derivative(b, sp, law, s, k[i], FM, &P, &loaded, &area);
-        if (i == 0) memcpy(F0, FM, 3 * sizeof(double));
+        derivative(b, sp, law, s, k[i], FM, &P, out + STEP_LOADED, out + STEP_AREA,
+                   stages ? stages + (size_t)i * 9 * (size_t)b->k : NULL);
+        if (i == 0) memcpy(out + STEP_FORCE, FM, 3 * sizeof(double));
         work += wt[i] * P;
+        const double cr[3] = {s[1] * FM[2] - s[2] * FM[1], s[2] * FM[0] - s[0] * FM[2], s[0] * FM[1] - s[1] * FM[0]};
+        for (int j = 0; j < 3; ++j) ang[j] += wt[i] * (FM[3 + j] + cr[j]); /* the moment about O (np.cross) */
     }
     double h = dt / 6.0;
     for (int j = 0; j < Y_COUNT; ++j) y[j] = y[j] + h * (((k[0][j] + 2 * k[1][j]) + 2 * k[2][j]) + k[3][j]);
     double nq = norm4(y + Y_QUAT);
     for (int j = Y_QUAT; j < Y_QUAT + 4; ++j) y[j] /= nq;
-    return h * work;
+    out[STEP_WORK] = h * work;
+    for (int j = 0; j < 3; ++j) out[STEP_ANGULAR + j] = h * ang[j];
 }
 
 /* the axis (tail to nose) of state y: R (0, -1, 0) */
@@ -240,6 +210,25 @@ static void row_of(const double *sp, const double *y, double work, double *nose,
     if (ke > scale) scale = ke;
     if (1e-300 > scale) scale = 1e-300;
     *error = fabs((((ke + 0.0) + 0.0) - ke0 - work) - 0.0) / scale;
+}
+
+/* An embedded stop's interpolation (RigidRun.stop_rules, the batch's and the single path's): when V.a <= 0 at y,
+ * y is taken back along the step from prev (Y_COUNT each) to where the speed along the axis vanishes, V.a = 0 by
+ * linear interpolation, its quaternion normalised again; lam: the fraction of the step kept (1 when y stays).
+ * Returns 1 when it moved y, else 0. */
+int32_t rigid_stop_back(const double *prev, double *y, double *lam) {
+    double a[3], ap[3];
+    axis_of(y, a);
+    *lam = 1.0;
+    if (!(dot3(y + Y_VELOCITY, a) <= 0.0)) return 0;
+    axis_of(prev, ap);
+    const double a0 = dot3(prev + Y_VELOCITY, ap), a1 = dot3(y + Y_VELOCITY, a);
+    const double l = a0 - a1 > 0.0 ? a0 / (a0 - a1) : 1.0;
+    for (int j = 0; j < Y_COUNT; ++j) y[j] = prev[j] + l * (y[j] - prev[j]);
+    const double nq = norm4(y + Y_QUAT);
+    for (int j = Y_QUAT; j < Y_QUAT + 4; ++j) y[j] /= nq;
+    *lam = l;
+    return 1;
 }
 
 static int finite13(const double *y) {
@@ -267,7 +256,7 @@ static void one_shot(Body *b, const double *sp, const double *law, double *y, do
     double F[3] = {0.0, 0.0, 0.0}; /* a row's force: at the start of the last step (at t = 0 the initial one) */
     if (interval > 0.0) {
         double dy[Y_COUNT], FM[6], P, loaded, area;
-        derivative(b, sp, law, y, dy, FM, &P, &loaded, &area);
+        derivative(b, sp, law, y, dy, FM, &P, &loaded, &area, NULL);
         memcpy(F, FM, sizeof F);
     }
     while (outcome == 0 && t < sp[S_HARD_END]) {
@@ -287,7 +276,10 @@ static void one_shot(Body *b, const double *sp, const double *law, double *y, do
             }
         }
         memcpy(prev, y, sizeof prev);
-        work += rk4(b, sp, law, y, dt, F);
+        double out[STEP_COUNT];
+        rk4(b, sp, law, y, dt, out, NULL);
+        memcpy(F, out + STEP_FORCE, sizeof F);
+        work += out[STEP_WORK];
         t += dt;
         steps += 1;
         if (!finite13(y)) { status = 1; break; }
@@ -304,16 +296,8 @@ static void one_shot(Body *b, const double *sp, const double *law, double *y, do
         outcome = penetration_rule(ymin, ymax, y + Y_VELOCITY, a, sp[S_MASS], sp[S_KE0], thk,
                                    sp[S_UNTIL_STOPPED] != 0.0, sp[S_STOP_ENERGY], &entered);
         /* RigidRun.stop_rules: back to where V.a vanishes */
-        if (outcome == OUTCOME_EMBEDDED && dot3(y + Y_VELOCITY, a) <= 0.0) {
-            double ap[3];
-            axis_of(prev, ap);
-            double a0 = dot3(prev + Y_VELOCITY, ap), a1 = dot3(y + Y_VELOCITY, a);
-            double lam = a0 - a1 > 0.0 ? a0 / (a0 - a1) : 1.0;
-            for (int j = 0; j < Y_COUNT; ++j) y[j] = prev[j] + lam * (y[j] - prev[j]);
-            double nq = norm4(y + Y_QUAT);
-            for (int j = Y_QUAT; j < Y_QUAT + 4; ++j) y[j] /= nq;
-            t -= (1.0 - lam) * dt;
-        }
+        double lam;
+        if (outcome == OUTCOME_EMBEDDED && rigid_stop_back(prev, y, &lam)) t -= (1.0 - lam) * dt;
     }
     res[R_T] = t;
     res[R_STEPS] = (double)steps;
@@ -361,6 +345,34 @@ int32_t rigid_batch(int32_t n, int32_t k, const double *r0, const double *N0, co
     return S_COUNT * 10000 + R_COUNT * 100 + nlaw;
 }
 
+/* One shot's one RK4 step (the single path's, fepen.runs.rigid.RigidRun.step; rk4, the batch's step): the
+ * arguments as rigid_batch's for one shot, y (Y_COUNT) advanced in place, T the shot's tunnel (NULL: none; its
+ * shoulder, axis and commit flag are set here), out (STEP_COUNT) the step's numbers, stages (NULL: none) the four
+ * stages' point forces, velocities and normals (4 x 3 (k, 3)). Returns S_COUNT * 100 + STEP_COUNT (the caller
+ * checks the layouts), or -1 when the scratch is not allocated. */
+int32_t rigid_step(int32_t k, const double *r0, const double *N0, const double *area, const double *ell,
+                   const double *radius, const double *Rm, const double *sphi0, const double *gauss, int32_t ng,
+                   void *points, void *moment, const double *sp, const double *law, double *y, const double *xi,
+                   double *T, double *out, double *stages) {
+    Body b = {k, ng, r0, N0, area, ell, radius, Rm, sphi0, gauss, (points_fn)points, (moment_fn)moment, {0}, {0},
+              {0}, NULL, NULL, NULL, NULL, NULL, NULL, xi, T, T, NULL, 0, 0};
+    size_t kk = (size_t)(k > 0 ? k : 1);
+    double *scratch = calloc(16 * kk, sizeof(double));
+    int32_t *idx = malloc(sizeof(int32_t) * kk);
+    if (!scratch || !idx) {
+        free(scratch);
+        free(idx);
+        return -1;
+    }
+    b.x = scratch; b.v = b.x + 3 * k; b.n = b.v + 3 * k; b.arm = b.n + 3 * k; b.f = b.arm + 3 * k; b.idx = idx;
+    b.sg = b.f + 3 * k;
+    b.at[Y_QUAT] = 2.0; /* no state kept */
+    rk4(&b, sp, law, y, sp[S_DT], out, stages);
+    free(scratch);
+    free(idx);
+    return S_COUNT * 100 + STEP_COUNT;
+}
+
 /* The batch's law on one set of points, for the tests against point_forces: f (k, 3) (zero where not loaded)
  * and sums (5) as point_forces gives them. */
 void batch_law(int32_t k, const double *x, const double *v, const double *n, const double *area, const double *ell,
@@ -370,7 +382,7 @@ void batch_law(int32_t k, const double *x, const double *v, const double *n, con
     double *sg = malloc(sizeof(double) * (size_t)(k > 0 ? k : 1));
     if (idx && sg) {
         for (int32_t i = 0; i < 3 * k; ++i) f[i] = 0.0;
-        law_points(k, x, v, n, area, ell, radius, Rm, sphi0, axis, p, gauss, ng, f, idx, sums, NULL, NULL, sg);
+        law_points(k, x, v, n, area, ell, radius, Rm, sphi0, axis, p, gauss, ng, f, sg, idx, sums, NULL, NULL);
     }
     free(idx);
     free(sg);
