@@ -475,11 +475,12 @@ native.shares("rigid_batch", "S_", [(member, len(names)) for member, names in _S
 #: a shot's state as fepen.laws.rigid_body.RigidState.as_array lays it out (centre, quaternion, velocity, angular
 #: momentum): rigid_batch.h's Y_ enum
 native.shares("rigid_batch", "Y_", [("Y_CENTRE", 3), ("Y_QUAT", 4), ("Y_VELOCITY", 3), ("Y_MOMENTUM", 3)])
-#: one RK4 step's numbers (rigid_step's out): rigid_batch.h's STEP_ enum (checked when the kernel is loaded)
+#: one RK4 step's numbers (rigid_step's out): rigid_batch.h's STEP_ enum
 _STEP_LAYOUT = (("STEP_FORCE", 3), ("STEP_WORK", 1), ("STEP_ANGULAR", 3), ("STEP_LOADED", 1), ("STEP_AREA", 1))
 #: where each of them starts in the step's numbers, by name
 STEP = {m[5:].lower(): sum(w for _, w in _STEP_LAYOUT[:i]) for i, (m, _) in enumerate(_STEP_LAYOUT)}
 STEP_COUNT = sum(w for _, w in _STEP_LAYOUT)
+native.shares("rigid_batch", "STEP_", _STEP_LAYOUT)
 _KERNEL: dict = {}
 
 
@@ -492,7 +493,6 @@ def kernel():
         if body is None or lib is None:
             return None
         native.check_layouts("events")  # the outcome codes the batch returns
-        native.check_layout(native.PACKAGE / native.KERNELS["rigid_batch"].header, "STEP_", _STEP_LAYOUT)
         vp = ctypes.c_void_p
         _KERNEL["fn"] = (lib, [ctypes.cast(f, vp).value for f in (body.rigid_points, body.force_moment)],
                          tg.crater_gauss())

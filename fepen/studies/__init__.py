@@ -7,6 +7,7 @@ uncertainty_report), the accuracy/cost study (accuracy_cost), the calibrations (
 fepen/data's table of errors (prediction_errors); whole fepen processes (processes) and the closed forms they are
 checked against."""
 
-__all__ = ["study", "rounds", "products", "record", "spec", "shot_table", "monte_carlo", "engine", "queue", "processes", "sweep",
-           "validate", "bands", "depth", "limits", "charge_safety", "uncertainty", "resistance", "uncertainty_report",
-           "accuracy_cost", "calibration", "wear_calibration", "prediction_errors", "closed_forms"]
+__all__ = ["study", "rounds", "products", "record", "spec", "shot_table", "monte_carlo", "engine", "queue",
+           "processes", "sweep", "validate", "bands", "depth", "limits", "charge_safety", "uncertainty", "resistance",
+           "uncertainty_report", "accuracy_cost", "calibration", "wear_calibration", "prediction_errors",
+           "closed_forms"]

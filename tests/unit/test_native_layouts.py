@@ -97,7 +97,8 @@ def test_the_numba_law_is_typed_by_its_header():
 
 
 #: every layout Python shares with a kernel, by kernel: the prefixes of its header's enums
-SHARED = {"target": {"P_", "SUM_"}, "rigid_batch": {"S_", "R_", "Y_"}, "events": {"OUTCOME_"}, "cells": {"TOT_"}}
+SHARED = {"target": {"P_", "SUM_"}, "rigid_batch": {"S_", "R_", "Y_", "STEP_"}, "events": {"OUTCOME_"},
+          "cells": {"TOT_"}}
 
 
 def test_every_shared_layout_is_declared_and_agrees():
