@@ -35,7 +35,7 @@ __all__ = ["shot", "budget", "setup", "targets", "run", "rigid", "batch", "sensi
 def expected_end(scene, sh: Shot) -> float:
     """The time a deformable run is expected to end at, for the progress bar: run.end_time, else the end of
     the same shot with the rigid projectile (a fraction of a second to compute), else its hard end."""
-    if sh.end_time is not None or sh.law is None:
+    if sh.end_time is not None or not sh.target.takes_rigid():
         return sh.hard_end
     try:
         quick = RigidRun(shot.rigid_version(scene), None, MPI.COMM_SELF).run()

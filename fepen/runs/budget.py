@@ -176,7 +176,7 @@ def check_rigid_step(rigid_step: float | None, shape, shell_density: float, v0: 
     more than RIGID_STEP_FINER times finer than the shot's own step (fepen.runs.rigid.default_step, on the body's
     mass from its exact volume, a CAD body's from its enclosing cylinder); and a run.end_time that needs more than
     MAX_RIGID_STEPS steps of the step the run will take."""
-    if law is None or v0 <= 0.0:
+    if v0 <= 0.0:
         return
     mass = shell_density * meshed_volume(shape, False)
     own = default_step(mass, v0, shape.diameter, law)

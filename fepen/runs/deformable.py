@@ -99,11 +99,14 @@ class DeformableRun(Run):
                 self._after_erosion()
 
     def stop_rules(self) -> str | None:
-        """On the rigid wall every step ("rebound"); in the target Run's rules every EVENT_EVERY steps, after
-        "eroded" and the failure strain (BeyondMethod)."""
+        """The load's own rules: on the rigid wall every step ("rebound", fepen.solver.rigid_wall); in a target
+        target_rules."""
+        return self.load.stop_rule(self)
+
+    def target_rules(self) -> str | None:
+        """In a target: Run's rules every EVENT_EVERY steps, after "eroded" and the failure strain
+        (BeyondMethod)."""
         s, m = self.solver, self.model
-        if m.law is None:
-            return self.rules.rebound(s.t, self.load.contact_nodes)
         if s.step_count % self.check_every:
             return None
         if m.erosion is not None and s.total_mass < events.ERODED_FRACTION * s.initial_mass:
@@ -201,11 +204,11 @@ class DeformableRun(Run):
                 "gap_max_mm", "penetration_max_mm", "slip_max_mm", "free_fraction", "sliding_fraction")})
         self.gauges.record()
         rear = -self._y_extent(x)[1] if self.crossings is not None else np.nan
-        xc, w, M, H, vc = diagnostics.rotation(s, x, getattr(self.load, "nodal_force", None))  # a rigid wall: none
+        xc, w, M, H, vc = diagnostics.rotation(s, x, self.load.nodal_force)  # a rigid wall: None
         return Snapshot(tip, tail, vc, self.load.force, s.total_mass, en,
                         self.load.contact_nodes, s.dt, diagnostics.max_peeq(s), self.load.area, rear, extra,
                         self._removal(e) if self.removing else None, w, M, H,
-                        self.load.angular_impulse_now(self.comm) if m.law is not None else np.zeros(3), xc)
+                        self.load.angular_impulse_now(self.comm), xc)
 
     def removal(self) -> Removal:
         return self._removal(diagnostics.energies(self.solver))
@@ -224,10 +227,8 @@ class DeformableRun(Run):
 
     def _field_writer(self, times) -> FieldWriter:
         scalars = ["interface_gap_m", "interface_slip_m"] if self.contact is not None else []
-        nodal = ["displacement_m", "velocity_m_s"]
-        if self.model.law is not None:  # the target's load (a rigid wall has none)
-            nodal.append("target_force_N")
-            scalars += ["target_normal_stress_Pa", "target_friction_traction_Pa"]
+        nodal = ["displacement_m", "velocity_m_s", *self.load.field_names[0]]  # the target's load (a wall: none)
+        scalars += list(self.load.field_names[1])
         if self.model.recession is not None:
             scalars.append("wear_depth_m")
         if self.safety is not None and self.contact is not None:
@@ -247,8 +248,7 @@ class DeformableRun(Run):
                   "peeq": diagnostics.live_peeq(s), "temperature_K": s.temp, "cell_tag": s.mat + 1.0}
         stress = diagnostics.stress_fields(s)
         values.update(zip(shot.STRESS_TENSOR_FIELDS, stress.pop("stress_Pa").T), **stress)
-        if self.model.law is not None:  # the target's load (a rigid wall has none)
-            values.update(self.load.surface_fields(s))
+        values.update(self.load.surface_fields(s))  # the target's load (a rigid wall has none)
         if self.contact is not None:
             values.update(self.contact.nodal_gap_and_slip())
         if m.recession is not None:

@@ -13,7 +13,7 @@ from fepen.geometry import mesh as fmesh
 from fepen.geometry import revolution, tags
 from fepen.laws import target as tg
 from fepen.runs import outputs, setup, shot
-from fepen.solver import assembly, erosion, explicit, probes, recession, rigid_wall, shell_charge, surface, target_load
+from fepen.solver import assembly, erosion, explicit, probes, recession, shell_charge, surface
 
 
 # ---------------------------------------------------------------------------------------------------------
@@ -85,13 +85,7 @@ def build(sh, comm: MPI.Comm = MPI.COMM_WORLD) -> Model:
         s.interface = contact
     tip = probes.node_at(s, pm.shape.tip)
     tail = probes.node_at(s, pm.shape.tail)
-    surf = None
-    if sh.law is not None:
-        surf = surface.outer_surface(s.V, pm.facet_tags, pm.shape)
-        load = target_load.TargetLoad(s, surf, sh.law, tip, tail, sh.crater(s.total_mass), sh.tunnel,
-                                      sh.load_points)
-    else:
-        load = rigid_wall.RigidWall(s)
+    surf, load = sh.target.load(s, pm, sh, tip, tail)  # a target's load on its surface, or the rigid wall
     s.external = load
     eroding = receding = None
     if sh.erosion is not None:

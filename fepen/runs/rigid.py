@@ -362,12 +362,10 @@ class RigidRun(Run):
                   total_energy=total, energy_ratio=total / self.ke0)
         rear = -float(body.points(s)[0][:, 1].max())
         R, w = body.at(s)[1:3]
-        F, M, loaded, area = self.F, np.zeros(3), self.loaded, self.area
-        if self.shot.law is not None:  # the target's force and moment about the centre at the row's state
-            x, v, n, arm = body.points(s)
-            load = self._row_load(s, R, x, v, n)
-            F, M = body.force_moment(arm, load.force)
-            loaded, area = load.loaded, load.area
+        x, v, n, arm = body.points(s)  # the target's force and moment about the centre at the row's state
+        load = self._row_load(s, R, x, v, n)
+        F, M = body.force_moment(arm, load.force)
+        loaded, area = load.loaded, load.area
         return Snapshot(tip, tail, s.V, F, body.mass, en, loaded, self.dt, 0.0, area, rear,
                         omega=w.copy(), moment=M, momentum=s.L.copy(), impulse=self.angular_impulse,
                         centre=s.c.copy())
@@ -502,7 +500,7 @@ def kernel():
 def covers(run) -> bool:
     """Whether the compiled step (CompiledStep) can advance a RigidRun: the C kernels are built (FEPEN_KERNEL is not
     python or numpy), the shot has a target law and its target kind is one the batch takes (not layered)."""
-    return kernel() is not None and run.law is not None and run.shot.target.not_batched() is None
+    return kernel() is not None and run.shot.target.not_batched() is None
 
 
 def point_arrays(run) -> list:

@@ -104,7 +104,7 @@ class Run:
         self.rows: list[list[float]] = []
         self.history_text = results.history_rows()  # history.csv's rows, each formatted once
         law = shot.law
-        self.rules = events.StopRules(law.thickness if law is not None else None, shot.end_time is None)
+        self.rules = events.StopRules(shot.target.thickness(law), shot.end_time is None)
         self.crossings = shot.target.crossings(law)  # a layered target's entries and exits, else None
         self.removing = shot.wear is not None or shot.erosion is not None
         self.history = outputs.History(shot.outputs.history_interval, grid=not shot.rigid)
@@ -163,8 +163,8 @@ class Run:
 
     @property
     def splitting(self) -> bool:
-        """Whether the history has the load's split by zone (a concrete target)."""
-        return self.shot.law is not None
+        """Whether the history has the load's split by zone (the target's kind says)."""
+        return self.shot.target.splits_load()
 
     def load_split(self) -> list[float]:
         """The body's LOAD_COLUMNS at the history row's state (collective)."""

@@ -185,10 +185,7 @@ class Shot:
     def crater(self, mass: float) -> tg.ForrestalCrater | None:
         """Forrestal's linear crater for a projectile of ``mass`` (kg) when effects.crater = "linear", else None
         (the energy crater is in the law)."""
-        if self.law is None or self.law.crater != "linear":
-            return None
-        shape = self.built.shape
-        return tg.ForrestalCrater(self.law, mass, self.speed, self.crh, shape.crater_nose_factor())
+        return self.target.crater(self.law, mass, self.speed, self.crh, self.built.shape.crater_nose_factor())
 
 
 

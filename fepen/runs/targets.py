@@ -78,6 +78,39 @@ class TargetKind:
         """Why a rigid shot into this target cannot go in a batch (fepen.runs.batch), or None: it can."""
         return None
 
+    def takes_rigid(self) -> bool:
+        """Whether the rigid fidelity runs against this target (a deformable run's progress bar previews its end
+        by the rigid shot)."""
+        return True
+
+    def thickness(self, law) -> float | None:
+        """The target's depth to its last rear face (m; None: semi-infinite), for the perforation rule."""
+        return law.thickness
+
+    def splits_load(self) -> bool:
+        """Whether the history splits the target's load by zone (nose, shank, tail: fepen.io.columns.LOADS)."""
+        return True
+
+    def crater(self, law, mass: float, speed: float, crh: float, nose_factor: float):
+        """Forrestal's linear crater (fepen.laws.target.ForrestalCrater) when the law asks for it
+        (effects.crater = "linear"), else None (the energy crater is in the law)."""
+        if law.crater != "linear":
+            return None
+        return tg.ForrestalCrater(law, mass, speed, crh, nose_factor)
+
+    def load(self, solver, pm, sh, tip: int, tail: int):
+        """The deformable model's load of this target on ``solver`` (fepen.solver.target_load.TargetLoad on the
+        outer surface's load points) and that surface: (surface, load).
+
+        Args:
+            solver: the ExplicitSolver. pm: the meshed projectile. sh: the Shot. tip, tail: their nodes.
+        """
+        from fepen.solver import surface, target_load
+
+        surf = surface.outer_surface(solver.V, pm.facet_tags, pm.shape)
+        return surf, target_load.TargetLoad(solver, surf, sh.law, tip, tail, sh.crater(solver.total_mass),
+                                            sh.tunnel, sh.load_points)
+
     def no_public_errors(self, scene) -> str | None:
         """Why fepen's errors on public data (fepen.stats.interval) do not apply to this target, or None: they
         do, by its strength model."""
@@ -154,9 +187,31 @@ class RigidWall(TargetKind):
         """None: the penalty wall of the deformable model (fepen.solver.rigid_wall) stands in for a law."""
         return None
 
+    def takes_rigid(self) -> bool:
+        """No: a rigid projectile on a rigid wall has nothing to compute."""
+        return False
+
+    def thickness(self, law) -> None:
+        """A wall is not perforated."""
+        return None
+
+    def splits_load(self) -> bool:
+        """A wall's load has no zones."""
+        return False
+
+    def crater(self, law, mass: float, speed: float, crh: float, nose_factor: float) -> None:
+        """No crater in a wall."""
+        return None
+
+    def load(self, solver, pm, sh, tip: int, tail: int):
+        """The penalty wall y = 0 on the nodes (fepen.solver.rigid_wall.RigidWall), no load surface."""
+        from fepen.solver import rigid_wall
+
+        return None, rigid_wall.RigidWall(solver)
+
     def check(self, scene) -> None:
         """Refuse the rigid fidelity (a rigid projectile on a rigid wall has nothing to compute)."""
-        if scene.effects.fidelity == "rigid":
+        if scene.effects.fidelity == "rigid" and not self.takes_rigid():
             raise InputError("effects.fidelity", "'rigid' runs against target.kind = 'concrete'; a rigid "
                                                  "projectile on a rigid wall has nothing to compute")
 

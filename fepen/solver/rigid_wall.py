@@ -29,6 +29,23 @@ class RigidWall:
         self.contact_nodes = 0
         self.area = 0.0  # a wall of nodes: no loaded area
 
+    #: the wall's force on each node is not kept (its moment is not summed: diagnostics.rotation)
+    nodal_force = None
+    #: the fields it writes into fields.xdmf: none (fepen.solver.target_load.TargetLoad's: the target's load)
+    field_names: tuple = ((), ())
+
+    def surface_fields(self, solver) -> dict:
+        """No surface fields: a wall's load is its nodes' springs."""
+        return {}
+
+    def angular_impulse_now(self, comm) -> np.ndarray:
+        """The wall's angular impulse about O is not summed: zero."""
+        return np.zeros(3)
+
+    def stop_rule(self, run) -> str | None:
+        """A body on the wall stops when it rebounds, checked every step (fepen.runs.events.StopRules.rebound)."""
+        return run.rules.rebound(run.solver.t, self.contact_nodes)
+
     def __call__(self, solver, dt: float) -> None:
         n = solver.n_owned
         y = solver.X[:n, 1] + solver.U[:n, 1]

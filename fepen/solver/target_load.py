@@ -219,6 +219,13 @@ class TargetLoad:
         return {"target_force_N": self._nodes.copy(), "target_normal_stress_Pa": sig_node,
                 "target_friction_traction_Pa": tau_node}
 
+    #: the fields it writes into fields.xdmf (nodal vectors, nodal scalars; surface_fields gives them)
+    field_names: tuple = (("target_force_N",), ("target_normal_stress_Pa", "target_friction_traction_Pa"))
+
+    def stop_rule(self, run) -> str | None:
+        """The run's rules in a target (fepen.runs.deformable.DeformableRun.target_rules)."""
+        return run.target_rules()
+
     def angular_impulse_now(self, comm) -> np.ndarray:
         """The target's angular impulse about O since the run began (N m s; collective, exact: the same on any
         partition), folded into angular_impulse."""

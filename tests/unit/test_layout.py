@@ -93,10 +93,12 @@ TARGET_KIND_PENDING = ()
 def test_target_kinds_carry_their_own_behaviour():
     """No branch on the target's kind outside the kinds themselves (fepen.runs.targets, fepen.laws.layers): no
     target.kind == or !=, no layered flag read, no isinstance on TargetLaw or Layered (issue 60, item 5); a
-    caller asks the Shot's kind (law, check, plates, envelope_name, hard_end, tunnel, crossings)."""
+    caller asks the Shot's kind (law, check, plates, envelope_name, hard_end, tunnel, crossings, thickness,
+    splits_load, crater, load, takes_rigid): the rigid wall too, with no law."""
     homes = {"runs/targets.py", "laws/layers.py"}
     pattern = (r"target\.kind\s*[!=]=|\.kind\s*[!=]=\s*\"(concrete|rigid-wall)\"|\.layered\b|"
-               r"getattr\([^)]*\"layered\"|isinstance\([^)]*\b(TargetLaw|Layered)\b")
+               r"getattr\([^)]*\"layered\"|isinstance\([^)]*\b(TargetLaw|Layered)\b|"
+               r"\.law is (not )?None")  # the rigid wall, the one kind without a law, answers for itself
     found = _lines_matching(pattern, homes, TARGET_KIND_PENDING)
     assert not found, found
 

@@ -127,3 +127,19 @@ def test_every_target_law_takes_the_one_point_forces_signature():
         one = law.layers[0].law
         assert all(np.array_equal(a, b) for a, b in zip(one.point_forces(tg.point_forces, *args, None, None),
                                                         tg.point_forces(one, *args)))
+
+
+def test_the_wall_answers_for_the_law_it_lacks():
+    """What a run asked of a law (its thickness, its crater, its load's zones, a rigid preview) each kind
+    answers, the rigid wall without a law: not perforated, no crater, no zones, no rigid shot."""
+    one, lay, w = one_material("target.thickness=0.3"), layered(), wall()
+    law1, law2 = targets.of(one).law(one), targets.of(lay).law(lay)
+    assert targets.of(one).thickness(law1) == pytest.approx(0.3)
+    assert targets.of(lay).thickness(law2) == law2.thickness and targets.of(w).thickness(None) is None
+    assert targets.of(one).splits_load() and targets.of(lay).splits_load() and not targets.of(w).splits_load()
+    assert targets.of(one).takes_rigid() and targets.of(lay).takes_rigid() and not targets.of(w).takes_rigid()
+    assert targets.of(w).crater(None, 1.0, 500.0, 3.0, 1.0) is None
+    assert targets.of(one).crater(law1, 1.6, 584.0, 3.0, 1.0) is None  # the energy crater is in the law
+    lin = one_material("effects.crater=linear")
+    crater = targets.of(lin).crater(targets.of(lin).law(lin), 1.6, 584.0, 3.0, 1.0)
+    assert isinstance(crater, tg.ForrestalCrater) and crater.depth() > 0.0
