@@ -113,10 +113,6 @@ def plastic_lateral_rows(validate_dir) -> list[dict]:
     return out
 
 
-def _table(rows: list[dict], header: str, file: str = "prediction_errors.csv", copies=()) -> Table:
-    return Table(file, COLUMNS, rows, digits=None, comments=header, copies=copies)
-
-
 @dataclass
 class ErrorsPlan:
     """The sets, the plastic rows' validation folder (or None: the table's own plastic rows), the table."""
@@ -179,7 +175,8 @@ class PredictionErrors(Study):
         return None
 
     def tables(self, plan: ErrorsPlan, result: dict, info) -> list:
-        return [_table(result["_rows"], result["_header"], copies=(plan.table,) if plan.table else ())]
+        return [Table("prediction_errors.csv", COLUMNS, result["_rows"], digits=None, comments=result["_header"],
+                      copies=(plan.table,) if plan.table else ())]
 
     def pictures(self, plan: ErrorsPlan, result: dict, info) -> list:
         return []

@@ -52,11 +52,21 @@ class Inputs:
     folder.
 
     Attributes:
-        tables: the tables (Table). document: {file: JSON content} written beside them.
+        tables: the tables (Table). documents: {file: JSON content} written beside them.
     """
 
     tables: tuple = ()
     documents: dict | None = None
+
+    def write(self, out: Path, say=None) -> None:
+        """Its documents and tables into the study's folder ``out`` (rank 0)."""
+        from mpi4py import MPI
+
+        from fepen.io import files
+
+        write(out, None, "", self.tables, say=say)
+        for file, document in (self.documents or {}).items():
+            files.write_json(Path(out) / file, document, MPI.COMM_SELF)
 
 
 def _table(out: Path, t: Table, say) -> None:

@@ -98,11 +98,8 @@ def drive(study, plan, out: Path, comm, info: RunInfo, progress: bool, run) -> N
             return
         if isinstance(rnd, Inputs):  # files the next rounds read, written by rank 0; every rank gets the folder
             from fepen.io import files
-            from fepen.studies import products
 
-            files.agree(comm, str(out), lambda r=rnd: [products.write(out, None, "", r.tables, say=info.say),
-                                                       *(files.write_json(out / f, d, MPI.COMM_SELF)
-                                                         for f, d in (r.documents or {}).items())])
+            files.agree(comm, str(out), lambda r=rnd: r.write(out, info.say))
             records = out
             continue
         if isinstance(rnd, Sub):
