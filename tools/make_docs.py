@@ -7,11 +7,12 @@ A generated part of a page sits between two comments that name it,
     ...
     <!-- /make docs: NAME -->
 
-and BLOCKS says which command makes it. `python tools/make_docs.py` runs them all (about 12 minutes on 2
-cores: the plastic Table 1 takes 5); `--only NAME ...` the named ones; `--list` lists them with their cost.
-`tests/system/test_docs_figures.py` re-runs the cheap ones (the studies' limit and ricochet table, Table 1's
-rigid means) and fails when a figure printed on a page moves. A page's prose around a block says what the
-figures mean; when a regeneration changes a conclusion, the prose is the author's to change.
+and BLOCKS says which command makes it. `python tools/make_docs.py` runs them all; `--only NAME ...` the
+named ones; `--list` lists them with their cost on 2 cores and the total. Each block begins with a line naming
+the command that made its figures and the fepen that ran it. `tests/system/test_docs_figures.py` re-runs the
+cheap ones (Block.cheap) on one rank and fails when a digit printed on a page moves (wall times masked). A
+page's prose around a block says what the figures mean; when a regeneration changes a conclusion, the prose is
+the author's to change.
 
 Each generator takes a scratch directory and returns the block's text (Markdown, no trailing newline).
 """
@@ -19,14 +20,18 @@ Each generator takes a scratch directory and returns the block's text (Markdown,
 from __future__ import annotations
 
 import argparse
+import atexit
 import csv
 import json
 import os
 import re
+import shutil
 import subprocess
 import sys
 import tempfile
 import time
+from collections.abc import Callable
+from dataclasses import dataclass
 from pathlib import Path
 
 import numpy as np
@@ -36,8 +41,20 @@ PY = sys.executable
 RIGID = ["--set", "effects.fidelity=rigid"]
 
 
+#: the ranks a block's command runs on at most (MAKE_DOCS_RANKS=1: the drift test, which runs no mpirun; a
+#: study's figures are the same on any rank count, its wall time is the machine's and is masked)
+RANKS = int(os.environ.get("MAKE_DOCS_RANKS", "2"))
+
+
+def took(seconds: float, ranks: int = 2) -> str:
+    """A block's wall time as the pages print it ("12 s on 2 ranks"), on the ranks the command really ran on."""
+    r = min(ranks, RANKS)
+    return f"{seconds:.0f} s on {r} rank{'s' if r > 1 else ''}"
+
+
 def fepen(*args, ranks: int = 1) -> float:
     """Run a fepen command from the project root; its wall time (s). A failing command stops make docs."""
+    ranks = min(ranks, RANKS)
     cmd = [PY, "-m", "fepen", *args]
     if ranks > 1:
         cmd = ["mpirun", "-n", str(ranks), *cmd]
@@ -49,9 +66,35 @@ def fepen(*args, ranks: int = 1) -> float:
     return time.perf_counter() - t0
 
 
+#: the commands already run in this make docs, by their arguments: blocks quoting the same run share it
+_MADE: dict[tuple, tuple[Path, float]] = {}
+
+
+def made(*args, ranks: int = 1) -> tuple[Path, float]:
+    """A fepen command's output folder (its --out) and wall time (s), the command run once per make docs.
+
+    Args:
+        args: the command's arguments without --out.
+        ranks: the ranks it runs on (at most RANKS).
+
+    Returns:
+        (the folder, the seconds it took the first time).
+    """
+    key = (args, min(ranks, RANKS))
+    if key not in _MADE:
+        out = Path(tempfile.mkdtemp(prefix="fepen-docs-shared-"))
+        atexit.register(shutil.rmtree, out, True)
+        _MADE[key] = (out / "out", fepen(*args, "--out", str(out / "out"), ranks=ranks))
+    return _MADE[key]
+
+
+#: whether the blocks' pictures go into docs/img (the drift test, which only compares text, sets it False)
+FIGURES = True
+
+
 def figure(src: Path, name: str) -> None:
     """A study's picture into docs/img/NAME (atomically), where its page shows it."""
-    if src.is_file():
+    if FIGURES and src.is_file():
         dst = ROOT / "docs" / "img" / name
         tmp = dst.with_suffix(".png.tmp")
         tmp.write_bytes(src.read_bytes())
@@ -119,10 +162,15 @@ def table1_block(rigid: dict, plastic: dict) -> str:
     return "\n".join(lines) + "\n\n" + means_line("rigid", rigid) + "\n\n" + means_line("plastic", plastic)
 
 
+VALIDATE_RIGID = ("validate", *RIGID)
+VALIDATE_PLASTIC = ("validate", "--set", "run.fields=false")
+
+
 def table1(tmp: Path) -> str:
-    fepen("validate", *RIGID, "--out", str(tmp / "R"))
-    fepen("validate", "--set", "run.fields=false", "--out", str(tmp / "P"))
-    return table1_block(read_validation(tmp / "R" / "validation.csv"), read_validation(tmp / "P" / "validation.csv"))
+    rigid, plastic = made(*VALIDATE_RIGID)[0], made(*VALIDATE_PLASTIC)[0]
+    figure(rigid / "validation.png", "validation-rigid.png")
+    figure(plastic / "validation.png", "validation-plastic.png")
+    return table1_block(read_validation(rigid / "validation.csv"), read_validation(plastic / "validation.csv"))
 
 
 # ---- the studies (docs/studies.md) --------------------------------------------------------------------------
@@ -149,7 +197,7 @@ def limit_block(res: dict, seconds: float, ranks: int) -> str:
     if "a" in res:
         out.append(f"- **Recht–Ipson fit:** a = {res['a']:.3f}, p = {res['p']:.2f}, rms error {res['rms_m_s']:.1f} m/s "
                    f"over the {len(speeds)} shots from {min(speeds):.0f} to {max(speeds):.0f} m/s.")
-    out.append(f"- **Cost:** {shots} rigid shots, {seconds:.0f} s on {ranks} rank{'s' if ranks > 1 else ''}.")
+    out.append(f"- **Cost:** {shots} rigid shots, {took(seconds, ranks)}.")
     return "\n".join(out)
 
 
@@ -170,7 +218,7 @@ def ricochet(tmp: Path) -> str:
     s = fepen("study", "ricochet", *_sets(RICOCHET_SETS), "--out", str(tmp / "ric"), ranks=2)
     res = json.loads((tmp / "ric" / "ricochet.json").read_text())
     figure(tmp / "ric" / "ricochet.png", "ricochet.png")
-    return (ricochet_rows(res) + f"\n\nThe map and the bisections took {s:.0f} s on 2 ranks (fepen {version()}).")
+    return (ricochet_rows(res) + f"\n\nThe map and the bisections took {took(s)} (fepen {version()}).")
 
 
 def monte_carlo(tmp: Path) -> str:
@@ -196,7 +244,7 @@ def monte_carlo(tmp: Path) -> str:
     single = read_validation_row_c3(tmp)
     pct = 100.0 * np.mean(depth < 349.6)
     return "\n".join([
-        f"{embedded} of the {len(rows)} shots embed ({s:.1f} s on 2 ranks, fepen {version()}).", "",
+        f"{embedded} of the {len(rows)} shots embed ({took(s)}, fepen {version()}).", "",
         "| figure | mean | std | P5 | P50 | P95 |", "|---|---|---|---|---|---|",
         f"| depth (mm) | {stats(depth)} |", f"| nose's sideways travel Hx (mm) | {stats(hx)} |", "",
         f"The single C3 shot (rigid) goes {single:.1f} mm; the test's own depth, 349.6 mm, lies at the "
@@ -260,7 +308,7 @@ def uncertainty_c3(tmp: Path) -> str:
         f"{abs(shift):.0f} % {'below' if shift < 0 else 'above'} the nominal prediction ({nominal:.1f} mm): the "
         f"model's mean error μ = {ms['mu']:+.3f} (τ = {ms['tau']:.3f}; fepen predicts the public sets' depths "
         f"{100 * abs(np.expm1(ms['mu'])):.1f} % {'deep' if ms['mu'] < 0 else 'shallow'} on average). {shots} rigid "
-        f"shots and {len(ms['response']['resistance_factor'])} for the response: {s:.0f} s on 2 ranks "
+        f"shots and {len(ms['response']['resistance_factor'])} for the response: {took(s)} "
         f"(fepen {version()})."])
 
 
@@ -286,7 +334,7 @@ def uncertainty_slab(tmp: Path) -> str:
         f"error, {100 * (1 - both):.0f} %. The systematic band is the message: whether fepen is right for this "
         f"concrete moves the probability of perforation from {100 * band[0]:.0f} % to {100 * band[1]:.0f} %. The "
         f"shot is outside the validated envelope (a slab; the depth data are of thick targets). {shots} rigid slab "
-        f"shots took {s:.0f} s on 2 ranks (fepen {version()})."])
+        f"shots took {took(s)} (fepen {version()})."])
 
 
 # ---- a run's interval (docs/uncertainty.md) ------------------------------------------------------------------
@@ -340,8 +388,8 @@ def worked_example(tmp: Path) -> str:
     s = json.loads((tmp / "p" / "summary.json").read_text())
     lo, hi = s["depth_interval_mm"]
     return "\n".join([
-        f"plastic at the default mesh, `fepen run scenes/default.toml --set run.fields=false` ({seconds:.0f} s on "
-        f"one rank, fepen {version()}):", "", "```", *lines, "```", "",
+        f"plastic at the default mesh, `fepen run scenes/default.toml --set run.fields=false` ({took(seconds, 1)}, "
+        f"fepen {version()}):", "", "```", *lines, "```", "",
         f"The test: 349.6 mm deep, 81.4 mm sideways. How to read it: fepen's best estimate is "
         f"{s['Hy_mm']:.0f} mm; a test of this shot into a concrete that fepen has not seen would come out between "
         f"{lo:.0f} and {hi:.0f} mm four times in five."])
@@ -372,7 +420,7 @@ def charge_safety(tmp: Path) -> str:
     s = fepen("study", "charge-safety", *CHARGE_SAFETY, "--out", str(tmp / "cs"), ranks=2)
     figure(tmp / "cs" / "charge_safety.png", "charge-safety-map.png")
     text = (tmp / "cs" / "charge_safety.md").read_text().split("\n", 2)[2].strip()  # without its title
-    return (f"`mpirun -n 2 fepen study charge-safety {' '.join(CHARGE_SAFETY)}` ({s:.0f} s on 2 ranks, fepen "
+    return (f"`mpirun -n 2 fepen study charge-safety {' '.join(CHARGE_SAFETY)}` ({took(s)}, fepen "
             f"{version()}):\n\n" + text + "\n\n![the charge-safety map](img/charge-safety-map.png)")
 
 
@@ -390,47 +438,115 @@ def run_tables(tmp: Path) -> str:
     return columns.tables_markdown()
 
 
-#: name -> (page, generator, rough cost on 2 cores)
+@dataclass(frozen=True)
+class Block:
+    """One generated part of a page.
+
+    Attributes:
+        page: the page it sits on, from the project root.
+        make: the generator: a scratch directory -> the block's Markdown (without its provenance line).
+        cost_s: its rough cost on 2 cores, seconds (what `--list` prints, with the total).
+        command: the command a reader runs to make the figures themselves, named on the page.
+        cheap: re-run by tests/system/test_docs_figures.py, which fails when one of its printed digits moves.
+    """
+
+    page: str
+    make: Callable[[Path], str]
+    cost_s: float
+    command: str
+    cheap: bool = False
+
+
 BLOCKS = {
-    "history-columns": ("docs/results.md", history_columns, "0 s"),
-    "run-tables": ("docs/results.md", run_tables, "0 s"),
-    "table1": ("docs/validation.md", table1, "5 min"),
-    "ballistic-limit": ("docs/studies.md", ballistic_limit, "15 s"),
-    "ricochet": ("docs/studies.md", ricochet, "20 s"),
-    "monte-carlo": ("docs/studies.md", monte_carlo, "30 s"),
-    "uncertainty-c3": ("docs/studies.md", uncertainty_c3, "45 s"),
-    "uncertainty-slab": ("docs/studies.md", uncertainty_slab, "3 min"),
-    "depth-errors": ("docs/validation-depth.md", depth_errors, "1 min"),
-    "run-interval": ("docs/uncertainty.md", run_interval, "5 s"),
-    "worked-example": ("docs/uncertainty.md", worked_example, "40 s"),
-    "charge-safety": ("docs/charge.md", charge_safety, "2.5 min"),
+    "history-columns": Block("docs/results.md", history_columns, 0, "fepen.io.columns.markdown()", True),
+    "run-tables": Block("docs/results.md", run_tables, 0, "fepen.io.columns.tables_markdown()", True),
+    "table1": Block("docs/validation.md", table1, 120,
+                    "fepen validate --set effects.fidelity=rigid; fepen validate --set run.fields=false"),
+    "ballistic-limit": Block("docs/studies.md", ballistic_limit, 15,
+                             f"mpirun -n 2 fepen study ballistic-limit {' '.join(_sets(LIMIT_SETS))} --tol 1", True),
+    "ricochet": Block("docs/studies.md", ricochet, 20,
+                      f"mpirun -n 2 fepen study ricochet {' '.join(_sets(RICOCHET_SETS))}", True),
+    "monte-carlo": Block("docs/studies.md", monte_carlo, 30,
+                         "mpirun -n 2 fepen sweep demos/studies/c3_scatter.toml"),
+    "uncertainty-c3": Block("docs/studies.md", uncertainty_c3, 45,
+                            "mpirun -n 2 fepen study uncertainty --scatter demos/studies/c3_scatter.toml"),
+    "uncertainty-slab": Block("docs/studies.md", uncertainty_slab, 180,
+                              "mpirun -n 2 fepen study ballistic-limit, then fepen study uncertainty (below)"),
+    "depth-errors": Block("docs/validation-depth.md", depth_errors, 60, "fepen validate-depth --workers 2"),
+    "run-interval": Block("docs/uncertainty.md", run_interval, 5,
+                          "fepen run --set effects.fidelity=rigid [--set impact.shot=C7]", True),
+    "worked-example": Block("docs/uncertainty.md", worked_example, 40,
+                            "fepen run scenes/default.toml --set run.fields=false"),
+    "charge-safety": Block("docs/charge.md", charge_safety, 150,
+                           f"mpirun -n 2 fepen study charge-safety {' '.join(CHARGE_SAFETY)}"),
 }
+
+#: a block's first line: the command that made its figures and the fepen that ran it
+PROVENANCE = "<sub>Made by `{command}` with fepen {version}; `make docs ONLY={name}` makes it again.</sub>"
+#: the figures a block may print that belong to the machine, not to fepen (wall times): the drift test masks them
+MACHINE_FIGURES = re.compile(r"\d+(?:\.\d+)? s on \d+ ranks?")
+
+
+def provenance(name: str) -> str:
+    """The block's provenance line at today's version."""
+    return PROVENANCE.format(command=BLOCKS[name].command, version=version(), name=name)
 
 
 def block_text(page: str, name: str) -> str:
-    """The text now between the block's markers on its page."""
+    """The text now between the block's markers on its page, without its provenance line."""
     text = (ROOT / page).read_text()
     m = re.search(rf"<!-- make docs: {re.escape(name)} -->\n(.*?)\n<!-- /make docs: {re.escape(name)} -->", text,
                   re.S)
     if m is None:
         raise SystemExit(f"make docs: {page} has no block {name!r} (<!-- make docs: {name} --> ... "
                          f"<!-- /make docs: {name} -->)")
-    return m.group(1)
+    body = m.group(1)
+    return body.split("\n", 1)[1] if body.startswith("<sub>Made by ") else body
+
+
+def stated_provenance(page: str, name: str) -> str | None:
+    """The provenance line the block carries on its page (None: none)."""
+    text = (ROOT / page).read_text()
+    m = re.search(rf"<!-- make docs: {re.escape(name)} -->\n(<sub>Made by .*</sub>)\n", text)
+    return m.group(1) if m else None
 
 
 def replace_block(page: str, name: str, body: str) -> bool:
-    """Write body between the block's markers (the page atomically); whether it changed."""
+    """Write the provenance line and body between the block's markers (the page atomically); whether it changed."""
     path = ROOT / page
     text = path.read_text()
-    old = block_text(page, name)
-    if old == body:
+    m = re.search(rf"(<!-- make docs: {re.escape(name)} -->\n)(.*?)(\n<!-- /make docs: {re.escape(name)} -->)", text,
+                  re.S)
+    if m is None:
+        block_text(page, name)  # says which block is missing
+    new_body = provenance(name) + "\n" + body
+    if m.group(2) == new_body:
         return False
-    new = text.replace(f"<!-- make docs: {name} -->\n{old}\n<!-- /make docs: {name} -->",
-                       f"<!-- make docs: {name} -->\n{body}\n<!-- /make docs: {name} -->")
+    new = text[:m.start(2)] + new_body + text[m.end(2):]
     tmp = path.with_suffix(".md.tmp")
     tmp.write_text(new)
     os.replace(tmp, path)
     return True
+
+
+def remade(name: str, tmp: Path) -> tuple[str, str]:
+    """A block as its page states it and as its command makes it today, both with wall times masked.
+
+    Args:
+        name: the block.
+        tmp: a scratch directory.
+
+    Returns:
+        (stated, made), each the provenance line and the body.
+    """
+    b = BLOCKS[name]
+    stated = f"{stated_provenance(b.page, name)}\n{block_text(b.page, name)}"
+    return masked(stated), masked(f"{provenance(name)}\n{b.make(tmp)}")
+
+
+def masked(text: str) -> str:
+    """A block's text with the machine's figures (wall times) masked: what the drift test compares."""
+    return MACHINE_FIGURES.sub("… s on N ranks", text)
 
 
 def main(argv=None) -> int:
@@ -439,11 +555,12 @@ def main(argv=None) -> int:
     ap.add_argument("--list", action="store_true", help="list the blocks, their pages and costs")
     args = ap.parse_args(argv)
     if args.list:
-        for name, (page, _, cost) in BLOCKS.items():
-            print(f"{name:16s} {page:28s} {cost}")
+        for name, b in BLOCKS.items():
+            print(f"{name:18s} {b.page:28s} {b.cost_s:6.0f} s  {'drift-tested' if b.cheap else ''}")
+        print(f"{'all':18s} {'':28s} {sum(b.cost_s for b in BLOCKS.values()) / 60:6.1f} min")
         return 0
     for name in args.only or BLOCKS:
-        page, make, _ = BLOCKS[name]
+        page, make = BLOCKS[name].page, BLOCKS[name].make
         block_text(page, name)  # the markers exist before anything runs
         with tempfile.TemporaryDirectory(prefix=f"fepen-docs-{name}-") as tmp:
             t0 = time.perf_counter()
