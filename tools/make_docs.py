@@ -481,6 +481,19 @@ BLOCKS = {
                            f"mpirun -n 2 fepen study charge-safety {' '.join(CHARGE_SAFETY)}"),
 }
 
+#: the pages' blocks kept in modules of their own (tools/docs_*.py, each with BLOCKS: name -> Block), which use
+#: this module's fepen/made/figure/took
+EXTRA_MODULES = ("docs_cost", "docs_pages")
+
+
+def _extra_blocks() -> None:
+    import importlib
+
+    sys.modules.setdefault("make_docs", sys.modules[__name__])  # one module, also when run as a script
+    for name in EXTRA_MODULES:
+        BLOCKS.update(importlib.import_module(name).BLOCKS)
+
+
 #: a block's first line: the command that made its figures and the fepen that ran it
 PROVENANCE = "<sub>Made by `{command}` with fepen {version}; `make docs ONLY={name}` makes it again.</sub>"
 #: the figures a block may print that belong to the machine, not to fepen (wall times): the drift test masks them
@@ -550,6 +563,7 @@ def masked(text: str) -> str:
 
 
 def main(argv=None) -> int:
+    """`make docs`: make the blocks named (all by default) and write them into their pages."""
     ap = argparse.ArgumentParser(description=__doc__.split("\n\n")[0])
     ap.add_argument("--only", nargs="+", choices=sorted(BLOCKS), help="the blocks to make (default: all)")
     ap.add_argument("--list", action="store_true", help="list the blocks, their pages and costs")
@@ -569,6 +583,9 @@ def main(argv=None) -> int:
         print(f"{name}: {page} {'changed' if changed else 'unchanged'} ({time.perf_counter() - t0:.0f} s)")
     return 0
 
+
+sys.path.insert(0, str(Path(__file__).resolve().parent))
+_extra_blocks()
 
 if __name__ == "__main__":
     sys.exit(main())
