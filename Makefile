@@ -73,7 +73,8 @@ notebook: setup
 	@echo "JupyterLab installed: .venv/bin/jupyter lab demos/   (right-click a .py demo: Open With > Notebook)"
 
 # Every figure the docs quote, made again by the command that makes it and written back into its page
-# (tools/make_docs.py: the blocks between <!-- make docs: NAME --> markers; about 8 minutes on 2 cores).
+# (tools/make_docs.py: the blocks between <!-- make docs: NAME --> markers; `tools/make_docs.py --list` gives each
+# block's cost on 2 cores and the total).
 # `make docs ONLY="ricochet ballistic-limit"` makes the named ones.
 docs: setup
 	$(PY) tools/make_docs.py $(if $(ONLY),--only $(ONLY))

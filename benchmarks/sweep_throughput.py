@@ -5,12 +5,14 @@ kernels kept, as a sweep keeps them) and by the batched path (``fepen.runs.batch
 run of shots), wall and CPU time per shot, and whether their summaries are the same to the last bit; then a
 Monte Carlo sweep of SHOTS rigid shots (v0 ± 20 m/s, obliquity ± 1°, yaw ± 0.5°, f_c ± 10 %), which runs
 them in batches, serially and on 2 workers (two MPI ranks taking runs of shots from the queue). Prints ms per
-shot per core and the projection for 10,000 shots on 2 cores; writes benchmarks/sweep_throughput_results.md.
+shot per core and the projection for 10,000 shots on 2 cores; writes benchmarks/sweep_throughput_results.md
+(or $SWEEP_THROUGHPUT_RESULTS: make docs' throughput block).
 
     .venv/bin/python benchmarks/sweep_throughput.py [SHOTS [DIR]]   (default 2000; serially, it starts mpirun;
                                                                       DIR: keep the two sweeps in DIR/w1, DIR/w2)
 """
 
+import os
 import sys
 import tempfile
 import time
@@ -81,7 +83,7 @@ def main():
         same = (tmp / "w1" / "sweep.csv").read_text() == (tmp / "w2" / "sweep.csv").read_text()
         say(f"tables of 1 and 2 workers identical: {same}")
         say(f"projected 10,000 rigid shots on 2 cores: {walls[2] / n * 10000 / 60:.1f} min")
-    out = Path(__file__).with_name("sweep_throughput_results.md")
+    out = Path(os.environ.get("SWEEP_THROUGHPUT_RESULTS", Path(__file__).with_name("sweep_throughput_results.md")))
     out.write_text("# Rigid shots in a sweep\n\n`benchmarks/sweep_throughput.py " + str(n) + "`, 2 cores.\n\n"
                    + "\n".join(f"- {ln}" for ln in lines) + "\n")
 

@@ -173,6 +173,151 @@ def table1(tmp: Path) -> str:
     return table1_block(read_validation(rigid / "validation.csv"), read_validation(plastic / "validation.csv"))
 
 
+def table1_bands(tmp: Path) -> str:
+    """Table 1 as distributions: each shot as 200 rigid members over what the test did not record."""
+    out, seconds = made("validate", "--samples", "200", "--workers", "2")
+    table = [ln for ln in (out / "bands.md").read_text().splitlines() if ln.startswith("|")]
+    return "\n".join([f"`fepen validate --samples 200 --workers 2` ({took(seconds)}, fepen {version()}):", "",
+                      *table])
+
+
+#: C8's speed and obliquity with a 2° striking yaw in the plane of fire (its test's other inputs the defaults)
+C8_YAWED = ["impact.velocity=893", "impact.obliquity_deg=0.58", "impact.attack_deg=2"]
+
+
+def tunnel_reload(tmp: Path) -> str:
+    """C8's speed and obliquity with a 2° striking yaw, rigid, against the tunnel wall's reload strength."""
+    lines = ["| tunnel_reload | final axis (°) | nose offset (mm) | Hy (mm) |", "|---|---|---|---|"]
+    for label, sets in (("0.3", ["target.tunnel_reload=0.3"]), ("0.52 (default)", []),
+                        ("1.0 (the intact wall)", ["target.tunnel_reload=1.0"]), ("tunnel off", ["effects.tunnel=false"])):
+        out = tmp / label.split()[0]
+        fepen("run", *RIGID, *_sets([*C8_YAWED, *sets]), "--out", str(out))
+        s = json.loads((out / "summary.json").read_text())
+        lines.append(f"| {label} | {s['final_axis_angle_deg']:.1f} | {s['nose_offset_mm']:.0f} | {s['Hy_mm']:.0f} |")
+    return "\n".join(lines)
+
+
+def _elastic(shot: str) -> dict:
+    out, _ = made("run", *_sets([f"impact.shot={shot}", "effects.fidelity=elastic", "run.fields=false"]))
+    return json.loads((out / "summary.json").read_text())
+
+
+def _mesh_facets(shot: str, tmp: Path) -> dict:
+    """A rigid run on the volume mesh's facets (RigidRun(points="mesh")), in a process of its own."""
+    code = ("import json; from mpi4py import MPI; import fepen; from fepen.runs.rigid import RigidRun; "
+            f"sc = fepen.Scene(sets=['impact.shot={shot}', 'effects.fidelity=rigid']); "
+            "s = RigidRun(sc, None, MPI.COMM_SELF, points='mesh').run(); "
+            "print(json.dumps({k: s[k] for k in ('Hy_mm', 'final_axis_angle_deg')}))")
+    r = subprocess.run([PY, "-c", code], cwd=ROOT, capture_output=True, text=True)
+    if r.returncode != 0:
+        raise SystemExit(f"make docs: the rigid run on the mesh's facets failed:\n{r.stderr[-2000:]}")
+    return json.loads(r.stdout.strip().splitlines()[-1])
+
+
+def fidelity_steps(tmp: Path) -> str:
+    """What a switch of fidelity changes on C2, C7 and C8, step by step (depth mm / final axis °)."""
+    rigid = read_validation(made(*VALIDATE_RIGID)[0] / "validation.csv")
+    plastic = read_validation(made(*VALIDATE_PLASTIC)[0] / "validation.csv")
+    lines = ["| shot | rigid, rings on the exact surface | rigid, the mesh's facets (`RigidRun(points=\"mesh\")`) | "
+             "elastic | plastic |", "|---|---|---|---|---|"]
+    for shot in ("C2", "C7", "C8"):
+        m, e = _mesh_facets(shot, tmp), _elastic(shot)
+        cols = [f"{float(rigid[shot]['Hy_mm']):.1f} / {float(rigid[shot]['axis_deg']):.2f}",
+                f"{m['Hy_mm']:.1f} / {m['final_axis_angle_deg']:.2f}",
+                f"{e['Hy_mm']:.1f} / {e['final_axis_angle_deg']:.2f}",
+                f"{float(plastic[shot]['Hy_mm']):.1f} / {float(plastic[shot]['axis_deg']):.2f}"]
+        lines.append(f"| {shot} | " + " | ".join(cols) + " |")
+    return "\n".join(lines)
+
+
+def _impulses(history: Path) -> tuple[list[float], float, float]:
+    """Each zone's share of the impulse (%), and the tail's peak force (kN) and its time (µs)."""
+    with open(history, newline="") as f:
+        rows = list(csv.DictReader(f))
+    t = np.array([float(r["t_s"]) for r in rows])
+    zones = [np.array([float(r[f"{z}_force_N"]) for r in rows]) for z in ("nose", "shank", "tail")]
+    imp = [float(np.sum(0.5 * (f[1:] + f[:-1]) * np.diff(t))) for f in zones]
+    k = int(np.argmax(zones[2]))
+    return [100 * i / sum(imp) for i in imp], zones[2][k] / 1e3, t[k] * 1e6
+
+
+def structural_response(tmp: Path) -> str:
+    """The paper's Figs. 19-23 in numbers: per shot of the plastic Table 1, its yield, stress and load split."""
+    plastic = made(*VALIDATE_PLASTIC)[0]
+    lines = ["| shot | V (m/s), α | max PEEQ | first yield (µs, mm behind the tip) | largest von Mises, where (MPa, mm) "
+             "| impulse nose / shank / tail | tail's peak force (kN, µs) |", "|---|---|---|---|---|---|---|"]
+    for shot, r in read_validation(plastic / "validation.csv").items():
+        s = json.loads((plastic / shot / "summary.json").read_text())
+        with open(plastic / shot / "hazard.csv", newline="") as f:
+            hz = list(csv.DictReader(f))
+        top = max(hz, key=lambda h: float(h["peak_von_mises_Pa"]))
+        fy = s.get("first_yield")
+        share, peak, when = _impulses(plastic / shot / "history.csv")
+        lines.append(f"| {shot} | {float(r['v0_m_s']):.0f}, {_t(r['obliquity_deg'])}° | {s['max_peeq']:.2g} | "
+                     + (f"{fy['t_s'] * 1e6:.0f}, {fy['axial_from_nose_mm']:.1f}" if fy else "–")
+                     + f" | {float(top['peak_von_mises_Pa']) / 1e6:.0f} at {float(top['axial_from_nose_mm']):.0f} | "
+                     f"{share[0]:.0f} / {share[1]:.0f} / {share[2]:.0f} % | {peak:.0f} at {when:.0f} |")
+    return "\n".join(lines)
+
+
+# ---- the README's headline figures and pictures ---------------------------------------------------------------
+DEFAULT_RUN = ("run", "scenes/default.toml")
+
+
+def _mean_errors(rows: dict) -> tuple[float, float]:
+    """A Table 1's mean nose and tail errors (%)."""
+    return (100 * np.mean([float(r["nose_error"]) for r in rows.values()]),
+            100 * np.mean([float(r["tail_error"]) for r in rows.values()]))
+
+
+def readme_headline(tmp: Path) -> str:
+    """Table 1's means and C3 in both fidelities, and what the plastic validation costs."""
+    rigid_dir, _ = made(*VALIDATE_RIGID)
+    plastic_dir, seconds = made(*VALIDATE_PLASTIC)
+    rigid, plastic = read_validation(rigid_dir / "validation.csv"), read_validation(plastic_dir / "validation.csv")
+    (rn, rt), (pn, pt) = _mean_errors(rigid), _mean_errors(plastic)
+    c3r, c3p = (100 * float(t["C3"]["nose_error"]) for t in (rigid, plastic))
+    return (f"Table 1, all eight shots (docs/validation.md): mean nose error {rn:.1f} % rigid and {pn:.1f} % "
+            f"plastic, mean tail error {rt:.1f} % and {pt:.1f} %; C3's nose within {c3r:.1f} % rigid and {c3p:.1f} % "
+            f"plastic. The plastic validation took {took(seconds)}.")
+
+
+def _hazard_words(summary: dict) -> str:
+    """How far the C3 shot yields, in the words of the hazard map's title."""
+    peeq = float(summary.get("max_peeq", 0.0))
+    if peeq <= 0.0:
+        return ("C3 stays elastic (its largest plastic strain is 0): the map shows the largest von Mises stress "
+                "each part reached against the steel's yield stress")
+    return (f"C3 barely yields (largest plastic strain {peeq:.2g}): the map shows the plastic strain of the "
+            f"surface and the largest von Mises stress each part reached against the steel's yield stress")
+
+
+def readme_pictures(tmp: Path) -> str:
+    """The C3 pictures `make run` draws, Table 1's plastic picture and hazard maps, and ParaView's view of C3."""
+    run, _ = made(*DEFAULT_RUN)
+    plastic_dir, _ = made(*VALIDATE_PLASTIC)
+    summary = json.loads((run / "summary.json").read_text())
+    figure(run / "history.png", "c3-history.png")
+    figure(run / "hazard.png", "c3-hazard.png")
+    figure(plastic_dir / "validation.png", "validation-plastic.png")
+    figure(plastic_dir / "hazard_maps.png", "hazard-maps.png")
+    fepen("view", str(run), "--png", str(tmp / "paraview-c3.png"), "--time", "3e-4")
+    figure(tmp / "paraview-c3.png", "paraview-c3.png")
+    return "\n".join([
+        f"C3 on the default mesh, plastic, one rank (fepen {version()}): the nose ends {summary['Hy_mm']:.1f} mm deep "
+        f"and {summary['Hx_mm']:.1f} mm sideways (the test: 349.6 and 81.4 mm).", "",
+        "![C3 in ParaView](docs/img/paraview-c3.png)", "",
+        "![C3 history](docs/img/c3-history.png)", "",
+        "`history.png`: nose and tail depth against time with the test's final depths (dashed), the deceleration, "
+        "the path in the plane of incidence against the test's final nose and tail, and the energies.", "",
+        "![C3 hazard map](docs/img/c3-hazard.png)", "",
+        f"`hazard.png`: along the projectile, {_hazard_words(summary)} (A = 950 MPa), and the eight strain gauges. "
+        "A shot that stays elastic says so in the title.", "",
+        "The eight Table 1 shots, plastic, and their hazard maps side by side, from `fepen validate --set "
+        "run.fields=false` (not from `make run`):", "",
+        "![plastic Table 1](docs/img/validation-plastic.png)", "", "![hazard maps](docs/img/hazard-maps.png)"])
+
+
 # ---- the studies (docs/studies.md) --------------------------------------------------------------------------
 LIMIT_SETS = ["effects.fidelity=rigid", "target.thickness=0.15", "impact.obliquity_deg=0", "impact.attack_deg=0"]
 RICOCHET_SETS = ["effects.fidelity=rigid", "impact.attack_deg=0"]
@@ -337,6 +482,43 @@ def uncertainty_slab(tmp: Path) -> str:
         f"shots took {took(s)} (fepen {version()})."])
 
 
+# ---- the sweep's throughput (docs/studies.md) ----------------------------------------------------------------
+def _number(pattern: str, text: str) -> float:
+    m = re.search(pattern, text)
+    if m is None:
+        raise SystemExit(f"make docs: the throughput benchmark printed no {pattern!r}:\n{text[-2000:]}")
+    return float(m.group(1))
+
+
+def throughput(tmp: Path) -> str:
+    """benchmarks/sweep_throughput.py 2000: a rigid shot as a process, in-process and in a sweep on 1 and 2 cores."""
+    env = dict(os.environ, SWEEP_THROUGHPUT_RESULTS=str(tmp / "results.md"))
+    r = subprocess.run([PY, "benchmarks/sweep_throughput.py", "2000", str(tmp / "sweeps")], cwd=ROOT,
+                       capture_output=True, text=True, env=env)
+    if r.returncode != 0:
+        raise SystemExit(f"make docs: benchmarks/sweep_throughput.py failed:\n{r.stderr[-2000:]}")
+    out = r.stdout
+    process = _number(r"one `fepen run` process: ([\d.]+) s", out)
+    single = _number(r"single path \(\d+ shots\): ([\d.]+) ms wall", out)
+    batched = _number(r"batched \(\d+ shots\): ([\d.]+) ms wall", out)
+    w1 = _number(r"1 worker\(s\): ([\d.]+) s wall", out)
+    w2 = _number(r"2 worker\(s\): ([\d.]+) s wall", out)
+    same = "tables of 1 and 2 workers identical: True" in out
+    bitwise = "summaries bitwise the same: True" in out
+    return "\n".join([
+        f"`benchmarks/sweep_throughput.py 2000` on the 2-core machine with nothing else running (fepen {version()}):",
+        "", "| how the shot runs | cost |", "|---|---|",
+        f"| one whole `fepen run` process (what a hand-written loop pays) | {process:.2f} s |",
+        f"| in-process, one shot at a time (warm) | {single:.1f} ms |",
+        f"| in-process, batched (`fepen.runs.batch`) | {batched:.1f} ms |",
+        f"| `fepen sweep`, 2000 shots, 1 worker | {w1:.1f} s, {1e3 * w1 / 2000:.1f} ms per shot |",
+        f"| `fepen sweep`, 2000 shots, 2 workers (mpirun -n 2) | {w2:.1f} s, {1e3 * w2 / 1000:.1f} ms per shot per "
+        f"core |", "",
+        f"The batched summaries are the single path's {'to the last bit' if bitwise else 'NOT to the last bit'}, "
+        f"and the tables of 1 and 2 workers are {'identical' if same else 'NOT identical'}. At this rate 10,000 "
+        f"rigid shots take {w2 / 2000 * 10000 / 60:.1f} minutes on 2 cores."])
+
+
 # ---- a run's interval (docs/uncertainty.md) ------------------------------------------------------------------
 def _run_lines(tmp: Path, name: str, *sets: str) -> tuple[list[str], dict]:
     """A rigid run's printed interval and envelope lines, and its summary."""
@@ -460,8 +642,24 @@ class Block:
 BLOCKS = {
     "history-columns": Block("docs/results.md", history_columns, 0, "fepen.io.columns.markdown()", True),
     "run-tables": Block("docs/results.md", run_tables, 0, "fepen.io.columns.tables_markdown()", True),
+    "readme-headline": Block("README.md", readme_headline, 120,
+                             "fepen validate --set effects.fidelity=rigid; fepen validate --set run.fields=false"),
+    "readme-pictures": Block("README.md", readme_pictures, 60,
+                             "fepen run scenes/default.toml; fepen view DIR --png --time 3e-4; fepen validate --set "
+                             "run.fields=false"),
     "table1": Block("docs/validation.md", table1, 120,
                     "fepen validate --set effects.fidelity=rigid; fepen validate --set run.fields=false"),
+    "table1-bands": Block("docs/validation.md", table1_bands, 150, "fepen validate --samples 200 --workers 2"),
+    "tunnel-reload": Block("docs/validation.md", tunnel_reload, 10,
+                           "fepen run --set effects.fidelity=rigid --set impact.velocity=893 --set impact.obliquity_deg=0.58 "
+                           "--set impact.attack_deg=2 "
+                           "[--set target.tunnel_reload=F | --set effects.tunnel=false]", True),
+    "fidelity-steps": Block("docs/validation.md", fidelity_steps, 150,
+                            "fepen validate (both fidelities); RigidRun(points=\"mesh\"); fepen run --set "
+                            "effects.fidelity=elastic --set impact.shot=C2|C7|C8"),
+    "structural-response": Block("docs/validation.md", structural_response, 120,
+                                 "fepen validate --set run.fields=false (each shot's summary.json, hazard.csv, "
+                                 "history.csv)"),
     "ballistic-limit": Block("docs/studies.md", ballistic_limit, 15,
                              f"mpirun -n 2 fepen study ballistic-limit {' '.join(_sets(LIMIT_SETS))} --tol 1", True),
     "ricochet": Block("docs/studies.md", ricochet, 20,
@@ -472,6 +670,7 @@ BLOCKS = {
                             "mpirun -n 2 fepen study uncertainty --scatter demos/studies/c3_scatter.toml"),
     "uncertainty-slab": Block("docs/studies.md", uncertainty_slab, 180,
                               "mpirun -n 2 fepen study ballistic-limit, then fepen study uncertainty (below)"),
+    "throughput": Block("docs/studies.md", throughput, 150, "python benchmarks/sweep_throughput.py 2000"),
     "depth-errors": Block("docs/validation-depth.md", depth_errors, 60, "fepen validate-depth --workers 2"),
     "run-interval": Block("docs/uncertainty.md", run_interval, 5,
                           "fepen run --set effects.fidelity=rigid [--set impact.shot=C7]", True),
