@@ -66,7 +66,7 @@ def test_a_rigid_runs_wall_s_is_its_whole_process(c3):
     r, s, wall = c3
     split = s["time_split_s"]
     assert s["wall_s"] >= sum(split.values()) - 1e-9
-    assert s["wall_s"] <= wall
+    assert s["wall_s"] <= wall + 0.02  # /proc counts in 10 ms ticks
     assert s["wall_s"] >= 0.85 * wall, (s["wall_s"], wall, split)
 
 
