@@ -302,6 +302,8 @@ class Run:
         extra.update(self.removal_summary())
         extra.update(self.summary_blocks)
         summary = results.summary(self.shot.scene, self.shot.experiment, self.rows, outcome, extra)
+        if summary["experiment"] is not None:  # a run cut at its end time is not the test's finished shot
+            summary["experiment"]["compared"] = outcome != "ended"
         if self.crossings is not None:
             summary.update(self.crossings.summary(self.shot.law, 1e-3 * summary["depth_mm"]))
         summary.update(prediction(self.shot.envelope, outcome, summary))
