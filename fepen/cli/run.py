@@ -46,10 +46,16 @@ def run(args) -> int:
 
 
 def experiment_lines(summary: dict) -> list[str]:
-    """A Table 1 shot's errors against its test, one line (none for another shot)."""
+    """A Table 1 shot's errors against its test, one line (none for another shot); a run cut at its end time
+    (outcome "ended") is not compared: the line says so."""
     e = summary.get("experiment")
     if not e:
         return []
+    if not e.get("compared", True):
+        end = summary["scene"].get("run", {}).get("end_time")
+        cut = f"run.end_time = {end:g} s" if end is not None else "its longest time (run.end_time unset)"
+        return [f"against Table 1 {e['shot']}: not compared: {cut} cut the run at t = {summary['end_time_s']:.6g} s, "
+                "before it stopped, perforated or ricocheted (its nose and tail are not the test's final ones)"]
     return [f"against Table 1 {e['shot']}: nose error {100 * e['nose_error']:.1f} %, tail error "
             f"{100 * e['tail_error']:.1f} %, final axis {summary['final_axis_angle_deg']:.1f} deg (test "
             f"{e['final_axis_angle_deg']:.1f}), nose offset {summary['nose_offset_mm']:.0f} mm (test "

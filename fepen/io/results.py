@@ -133,8 +133,8 @@ def summary(scene: dict, experiment: str | None, rows, outcome: str, extra: dict
             None. rows: the history rows. outcome: fepen.errors.OUTCOMES' name. extra: further keys.
     """
     last = rows[-1]
-    out = {"Hx_mm": abs(last[COL["nose_x_mm"]]), "Hy_mm": abs(last[COL["nose_y_mm"]]),
-           "Tx_mm": last[COL["tail_x_mm"]], "Ty_mm": last[COL["tail_y_mm"]],  # signed: above the face < 0
+    out = {"Hx_mm": last[COL["nose_x_mm"]], "Hy_mm": last[COL["nose_y_mm"]],  # signed: above the face < 0
+           "Tx_mm": last[COL["tail_x_mm"]], "Ty_mm": last[COL["tail_y_mm"]],
            "depth_mm": max(r[COL["nose_y_mm"]] for r in rows), "length_mm": last[COL["length_mm"]],
            "residual_speed_m_s": last[COL["speed_m_s"]], "outcome": outcome,
            "energy_error": max(r[COL["energy_error"]] for r in rows), "max_peeq": last[COL["max_peeq"]]}

@@ -288,24 +288,28 @@ class Run:
     history_drawn: bool = False
 
     def write_summary(self, outcome: str, loop_s: float) -> dict:
-        """The summary (summary.json when the run has a directory)."""
-        extra = {"steps": self.step_count, "end_time_s": self.t, "wall_s": self.wall_s,
+        """The summary (summary.json when the run has a directory). The figure first (summary.json is the last
+        file of a run that ended well), and wall_s read last, just before summary.json: it covers the figure."""
+        if self.out is not None and self.shot.outputs.figures and not self.history_drawn:  # a closing drew it
+            from fepen.post import figures  # (closing.shared)
+
+            files.agree(self.comm, "history.png",
+                        lambda: figures.history_figure(self.out, self.shot.experiment, MPI.COMM_SELF))
+        extra = {"steps": self.step_count, "end_time_s": self.t, "wall_s": None,  # read below, last
                  "ranks": self.comm.size, "fidelity": self.fidelity,
                  "peak_memory_bytes": files.peak_memory_bytes(self.comm)}
         extra.update(self.summary_extra(loop_s))
-        _whole_process(extra, self.wall_before)
         extra.update(self.removal_summary())
         extra.update(self.summary_blocks)
         summary = results.summary(self.shot.scene, self.shot.experiment, self.rows, outcome, extra)
+        if summary["experiment"] is not None:  # a run cut at its end time is not the test's finished shot
+            summary["experiment"]["compared"] = outcome != "ended"
         if self.crossings is not None:
             summary.update(self.crossings.summary(self.shot.law, 1e-3 * summary["depth_mm"]))
         summary.update(prediction(self.shot.envelope, outcome, summary))
-        if self.out is not None:  # the figure first: summary.json is the last file of a run that ended well
-            from fepen.post import figures
-
-            if self.shot.outputs.figures and not self.history_drawn:  # a closing that drew it (closing.shared)
-                files.agree(self.comm, "history.png",
-                            lambda: figures.history_figure(self.out, self.shot.experiment, MPI.COMM_SELF))
+        summary["wall_s"] = self.wall_s
+        _whole_process(summary, self.wall_before)
+        if self.out is not None:
             results.write_summary(self.out, summary, self.comm)
         return summary
 
