@@ -386,8 +386,9 @@ STRAINS = Group(
 #: accelerations.csv (deformable runs): raw and filtered
 ACCELERATION_TABLE = Group(
     'accelerations.csv', '',
-    ('`accelerations.csv` (deformable runs): the history\'s accelerations, raw and low-pass filtered '
-     '(zero-phase Butterworth at `run.acceleration_filter_hz`, [theory.md §13](theory.md)).'),
+    ('`accelerations.csv` (deformable runs): the history\'s accelerations, raw and low-pass filtered by '
+     '`run.acceleration_filter` (zero-phase Butterworth at `run.acceleration_filter_hz`, or an SAE J211-1 '
+     'channel frequency class; summary.json\'s `acceleration_filter` names it, [theory.md §13](theory.md)).'),
     (
         Quantity(('t_s',), 's', 'the history row\'s time'),
         Quantity(('decel_g', 'decel_filtered_g'), 'g', 'history.csv\'s `decel_g`, raw and filtered'),

@@ -117,16 +117,16 @@ def shared(comm, out, jobs: list) -> None:
 
 def accelerations(run) -> dict:
     """accelerations.csv: the target deceleration (and with a charge each body's axial acceleration), raw and
-    low-pass filtered (run.acceleration_filter_hz). Returns the peaks."""
+    low-pass filtered (run.acceleration_filter, fepen.post.signals.acceleration_filter). Returns the peaks."""
     rows = np.array(run.rows)
     t = rows[:, 0]
     columns = run.columns
     names = ["decel_g"] + (results.CHARGE_COLUMNS if run.pm.charge else [])
-    cut = run.shot.outputs.acceleration_filter_hz
+    cut, kind = run.shot.outputs.acceleration_filter_hz, run.shot.outputs.acceleration_filter
     cols, header, peaks = [t], ["t_s"], {}
     for name in names:
         raw = rows[:, columns.index(name)]
-        filt = signals.lowpass(t, raw, cut)
+        filt = signals.acceleration_filter(t, raw, kind, cut)
         cols += [raw, filt]
         header += [name, name.replace("_g", "_filtered_g")]
         k = int(np.argmax(np.abs(filt)))

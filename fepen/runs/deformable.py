@@ -15,7 +15,7 @@ from fepen.errors import BeyondMethod, InputError, Interrupted, SimulationError
 from fepen.geometry.frames import unit_axis
 from fepen.io import results
 from fepen.io.fields import FieldWriter
-from fepen.post import analyses, paraview
+from fepen.post import analyses, paraview, signals
 from fepen.runs import checkpoint, closing, events, model, outputs, shot
 from fepen.runs import probes as run_probes
 from fepen.runs.charge_safety import ChargeSafety
@@ -263,13 +263,14 @@ class DeformableRun(Run):
         self.closing.write(self)
 
     def summary_extra(self, loop_s: float) -> dict:
-        s, m = self.solver, self.model
+        s, m, o = self.solver, self.model, self.shot.outputs
         return {"dt_s": s.clock.dt_min,
                 "time_split_s": {"mesh": m.mesh_s, "setup_jit": m.setup_s,
                                  "time_loop": loop_s - self.output_s, "output": self.output_s},
                 "mass_kg": s.total_mass, "cells": self.pm.mesh.topology.index_map(3).size_global,
                 "stress_kernel": s.kernel, "step_gain": s.clock.step_gain, **self.closing.summary(),
-                "acceleration_filter_hz": self.shot.outputs.acceleration_filter_hz}
+                "acceleration_filter": o.acceleration_filter,
+                "acceleration_filter_hz": signals.corner_hz(o.acceleration_filter, o.acceleration_filter_hz)}
 
     def stop_extra(self) -> dict:
         return {"mass_kg": self.solver.total_mass}

@@ -107,10 +107,10 @@ class Probes:
         """Append the row of the run's time (collective)."""
         self.rows.append([run.t, *self.values(run)])
 
-    def write(self, out, comm, cutoff_hz: float = 0.0) -> None:
-        """probes.csv of the rows so far (collective); cutoff_hz: the accelerometers' low-pass
-        (run.acceleration_filter_hz)."""
-        rows = filtered(self.rows, self.header, cutoff_hz) if any(h.endswith("_g_raw") for h in self.header) \
+    def write(self, out, comm, cutoff_hz: float = 0.0, kind: str = "butterworth") -> None:
+        """probes.csv of the rows so far (collective); kind, cutoff_hz: the accelerometers' filter
+        (run.acceleration_filter, run.acceleration_filter_hz)."""
+        rows = filtered(self.rows, self.header, cutoff_hz, kind) if any(h.endswith("_g_raw") for h in self.header) \
             else self.rows
         probes_io.write(rows, out, self.header, comm)
 
@@ -198,19 +198,23 @@ class RigidProbes(Probes):
         return _in_order(self.specs, np.concatenate([u, v, a], axis=1), np.zeros((0, 0)), axis)
 
 
-def filtered(rows, header: list[str], cutoff_hz: float) -> list[list[float]]:
+def filtered(rows, header: list[str], cutoff_hz: float, kind: str = "butterworth") -> list[list[float]]:
     """The rows with every accelerometer's filtered columns filled from its raw ones (zero-phase low-pass over
-    the whole record, fepen.post.signals.lowpass; the rows as given are left alone).
+    the whole record, fepen.post.signals.acceleration_filter; the rows as given are left alone).
 
     Args:
         rows: the rows, t then the values in the header's order (the filtered columns' values are ignored).
-        header: columns(probes). cutoff_hz: run.acceleration_filter_hz.
+        header: columns(probes). cutoff_hz: run.acceleration_filter_hz. kind: run.acceleration_filter.
+
+    Returns:
+        The rows, filtered columns filled.
     """
     table = np.array(rows, dtype=float).reshape(len(rows), len(header))
     for j, name in enumerate(header):
         if name + "_raw" in header:  # an accelerometer's filtered channel
             raw = header.index(name + "_raw")
-            table[:, j] = signals.lowpass(table[:, 0], table[:, raw], cutoff_hz) if len(rows) else []
+            table[:, j] = signals.acceleration_filter(table[:, 0], table[:, raw], kind, cutoff_hz) if len(rows) \
+                else []
     return table.tolist()
 
 

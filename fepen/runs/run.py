@@ -263,7 +263,8 @@ class Run:
         if self.out is not None:
             results.write_history(self.rows, self.out, self.comm, self.columns, self.history_text)
             if self.probes is not None:
-                self.probes.write(self.out, self.comm, self.shot.outputs.acceleration_filter_hz)
+                o = self.shot.outputs
+                self.probes.write(self.out, self.comm, o.acceleration_filter_hz, o.acceleration_filter)
 
     # ---- the summary --------------------------------------------------------------------------------------
     def removal_summary(self) -> dict:

@@ -55,6 +55,7 @@ class OutputSettings:
     checkpoint_interval: float
     acceleration_filter_hz: float
     figures: bool = True  #: run.figures: the PNG figures drawn
+    acceleration_filter: str = "butterworth"  #: run.acceleration_filter: fepen.post.signals.FILTERS
 
 
 @dataclass(frozen=True)
@@ -224,7 +225,7 @@ def _outputs(scene) -> OutputSettings:
             names.append("temperature_K")
     names.append("cell_tag")  # 1 shell, 2 charge, 0 eroded: for ParaView's Threshold
     return OutputSettings(min(r.output_interval / 10.0, 1e-6), r.output_interval, bool(r.fields), tuple(names),
-                          r.checkpoint_interval, r.acceleration_filter_hz, bool(r.figures))
+                          r.checkpoint_interval, r.acceleration_filter_hz, bool(r.figures), r.acceleration_filter)
 
 
 def resolve(scene, toml: bool = True, built: Built | None = None) -> Shot:

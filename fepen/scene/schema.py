@@ -448,8 +448,14 @@ SCHEMA: dict[str, Key] = {
                                                 "(stress_xx_Pa ... stress_xz_Pa) in fields.xdmf: 60 % more field "
                                                 "data (the default C3's fields.h5: 30 -> 48 MB)"),
     "run.acceleration_filter_hz": number(1.0e4, "Hz", 0.0, 1.0e7,
-                                         doc="low-pass cut-off of the filtered accelerations (accelerations.csv); "
-                                             "0: none"),
+                                         doc="low-pass cut-off of the filtered accelerations (accelerations.csv) "
+                                             "under run.acceleration_filter = 'butterworth', and of the charge-"
+                                             "safety stress; 0: none"),
+    "run.acceleration_filter": choice("butterworth", "butterworth", "CFC60", "CFC180", "CFC600", "CFC1000",
+                                      doc="the filter of the filtered accelerations (accelerations.csv, "
+                                          "accelerometer probes), zero-phase: 'butterworth' order 4 each way at "
+                                          "run.acceleration_filter_hz; 'CFC<n>' SAE J211-1's channel frequency "
+                                          "class n (4-pole phaseless, -3 dB at 1.667 n Hz; docs/theory.md §13)"),
     "run.checkpoint_interval": number(1.0e-4, "s", 0.0, 1.0,
                                       doc="simulated time between checkpoints (fepen run --resume DIR); 0: none"),
     "run.rigid_step": positive(ABSENT, "s", 1e-3,
@@ -465,7 +471,7 @@ SCHEMA: dict[str, Key] = {
                                            "axial stress, pressure (Pa), PEEQ and temperature (K), meshed "
                                            "fidelities only; 'accelerometer': the nearest node's acceleration "
                                            "on the body's axes (axial, lateral, out of plane; g), raw and "
-                                           "low-pass filtered (run.acceleration_filter_hz). Columns "
+                                           "low-pass filtered (run.acceleration_filter). Columns "
                                            "<name>_<quantity>_<unit> (docs/results.md)",
                          form="a list of tables {name, point = [x, y, z], kind = 'node', 'cell' or 'accelerometer'}",
                          rows=_probes),
