@@ -231,6 +231,8 @@ def sweep(spec, out=None, comm=None, sets=(), fresh: bool = False, ranks_per_sho
     Raises:
         InputError: bad input (naming the sweep or scene key), before any shot runs.
     """
+    import logging
+
     import pandas as pd
 
     from fepen.studies import engine
@@ -242,7 +244,8 @@ def sweep(spec, out=None, comm=None, sets=(), fresh: bool = False, ranks_per_sho
     if out is None:
         out = comm.bcast(tempfile.mkdtemp(prefix="fepen-sweep-") if comm.rank == 0 else None, root=0)
     out = Path(out)
-    say = (lambda *lines: print(*lines, sep="\n")) if progress and comm.rank == 0 else (lambda *lines: None)
+    log = logging.getLogger("fepen")  # its lines go to the fepen logger (INFO), not into a notebook's cell
+    say = (lambda *lines: log.info("\n".join(lines))) if comm.rank == 0 else (lambda *lines: None)
     fsweep.run(spec, out, comm, ranks_per_shot, sets, fresh, say=say, progress=progress)
     comm.barrier()
     table = pd.read_csv(out / "sweep.csv", keep_default_na=False, na_values=[""])

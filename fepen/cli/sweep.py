@@ -25,7 +25,6 @@ def add_arguments(parser) -> None:
 def run(args) -> int:
     """The sweep here, or under mpirun -n W when started on one rank with W > 1 workers and mpirun at hand."""
     import os
-    import sys
 
     from mpi4py import MPI
 
@@ -38,8 +37,6 @@ def run(args) -> int:
     if world.size == 1 and workers > 1 and processes.launcher():
         engine.check_ranks_per_shot(args.ranks_per_shot, workers)
         sweep.read(args.sweep, args.sets)  # bad input here, in one line, before mpirun starts
-        # the bar of rank 0 under mpirun writes into a pipe: shown there when this process is on a terminal
-        os.environ.setdefault("FEPEN_PROGRESS", "1" if sys.stderr.isatty() else "0")
         return processes.relaunch_sweep(args.sweep, args.out, args.ranks_per_shot, workers, args.sets, args.fresh)
     engine.check_ranks_per_shot(args.ranks_per_shot, world.size)
     res = sweep.run(args.sweep, args.out, world, args.ranks_per_shot, args.sets, args.fresh, say=say)

@@ -25,9 +25,6 @@ def add_arguments(parser) -> None:
 
 def run(args) -> int:
     """The eight Table 1 shots."""
-    import os
-    import sys
-
     from mpi4py import MPI
 
     from fepen.cli.common import written_line
@@ -42,7 +39,6 @@ def run(args) -> int:
         shots = [s.strip() for s in args.shots.split(",")] if args.shots else None
         plan = st.plan(args.scene, args.sets, args.samples, args.seed, shots=shots)  # bad input here
         if MPI.COMM_WORLD.size == 1 and workers > 1 and processes.launcher():
-            os.environ.setdefault("FEPEN_PROGRESS", "1" if sys.stderr.isatty() else "0")
             argv = ["validate", *([args.scene] if args.scene else []), "--out", out,
                     *[f"--set={s}" for s in args.sets], *(["--fresh"] if args.fresh else []),
                     "--samples", str(args.samples), "--seed", str(args.seed),
@@ -59,7 +55,6 @@ def run(args) -> int:
     plan = st.plan(args.scene, args.sets)  # bad input here, before anything is written
     deformable = next(iter(plan.scenes.values())).effects.fidelity != "rigid"
     if MPI.COMM_WORLD.size == 1 and deformable and workers > 1 and processes.launcher():
-        os.environ.setdefault("FEPEN_PROGRESS", "1" if sys.stderr.isatty() else "0")
         argv = ["validate", *([args.scene] if args.scene else []), "--out", args.out,
                 *[f"--set={s}" for s in args.sets], *(["--fresh"] if args.fresh else [])]
         return processes.relaunch(argv, min(workers, len(plan.scenes)))

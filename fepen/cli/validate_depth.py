@@ -21,9 +21,6 @@ def add_arguments(parser) -> None:
 
 def run(args) -> int:
     """Depth data sets: the table per set and the predicted-against-measured figure."""
-    import os
-    import sys
-
     from mpi4py import MPI
 
     from fepen.cli.common import written_line
@@ -34,7 +31,6 @@ def run(args) -> int:
     plan = st.plan(args.data, args.sets, shipped=not args.only)  # bad input here, before anything is written
     workers = workers_count(args)
     if MPI.COMM_WORLD.size == 1 and workers > 1 and processes.launcher():
-        os.environ.setdefault("FEPEN_PROGRESS", "1" if sys.stderr.isatty() else "0")
         argv = ["validate-depth", *[a for d in args.data for a in ("--data", d)], *(["--only"] if args.only else []),
                 "--out", args.out, *[f"--set={s}" for s in args.sets], *(["--fresh"] if args.fresh else [])]
         return processes.relaunch(argv, workers)

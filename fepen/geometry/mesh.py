@@ -9,7 +9,6 @@ from __future__ import annotations
 import contextlib
 import logging
 import math
-import os
 import threading
 import time
 from dataclasses import dataclass
@@ -32,9 +31,8 @@ _PROGRESS = {"on": False}
 @contextlib.contextmanager
 def progress(on: bool):
     """Within it, a mesh that gmsh builds (not one read from the cache) shows a bar on rank 0's stderr: the
-    stage (building, meshing, optimising, and the try when a seed is retried) and the elapsed time. Quiet when
-    stderr is not a terminal, unless FEPEN_PROGRESS=1 (a run under mpirun started from one); FEPEN_PROGRESS=0
-    keeps it quiet.
+    stage (building, meshing, optimising, and the try when a seed is retried) and the elapsed time, where
+    fepen.progress shows a bar (a terminal, mpirun's terminal, a notebook; FEPEN_PROGRESS=1 or 0).
 
     Args:
         on: the switch (the run's progress switch).
@@ -49,8 +47,8 @@ def progress(on: bool):
 @contextlib.contextmanager
 def phase(desc: str, rank: int = 0):
     """A phase without steps to count (a deformable run's set-up: ffcx, numba and the C kernels compiled on a
-    first run), shown as its name and the elapsed time, on rank 0 within ``progress(True)`` and on a terminal
-    (as the mesh's bar).
+    first run), shown as its name and the elapsed time, on rank 0 within ``progress(True)`` and where
+    fepen.progress shows a bar (as the mesh's bar).
 
     Args:
         desc: what is being done ("setup: compiling the kernels"). rank: this process's rank.
@@ -63,24 +61,14 @@ def phase(desc: str, rank: int = 0):
             bar.close()
 
 
-def bar_disabled() -> bool | None:
-    """tqdm's ``disable`` for a bar that is wanted: FEPEN_PROGRESS=1 shows it, 0 hides it, unset: None (shown
-    only on a terminal)."""
-    env = os.environ.get("FEPEN_PROGRESS")
-    return None if env not in ("0", "1") else env == "0"
-
-
 class _MeshBar:
     """The stages of gmsh and the elapsed time, refreshed every second by a thread (gmsh's calls release the
     interpreter lock). ``desc``: the first stage's words."""
 
     def __init__(self, desc: str = "mesh: building"):
-        import sys
+        from fepen import progress
 
-        from tqdm import tqdm
-
-        self.bar = tqdm(desc=desc, bar_format="{desc} [{elapsed}]", file=sys.stderr, leave=False,
-                        disable=bar_disabled())
+        self.bar = progress.bar(desc=desc, bar_format="{desc} [{elapsed}]", leave=False)
         self.tries, self.done = 0, threading.Event()
         self.thread = threading.Thread(target=self._tick, daemon=True)
         self.thread.start()

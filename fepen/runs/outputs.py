@@ -185,13 +185,11 @@ class Progress:
     EVERY = 200
 
     def __init__(self, end: float, t: float):
-        from tqdm import tqdm
+        from fepen import progress
 
-        from fepen.geometry.mesh import bar_disabled
-
-        # on a terminal only (a Slurm .err file or a pipe gets none; FEPEN_PROGRESS=1 asks for it anyway)
-        self.bar = tqdm(total=round(end * 1e6), initial=round(t * 1e6), unit="µs", desc="fepen", leave=False,
-                        disable=bar_disabled())
+        # where the user sees it (fepen.progress: a terminal, mpirun's terminal, a notebook; FEPEN_PROGRESS)
+        self.bar = progress.bar(total=round(end * 1e6), initial=round(t * 1e6), unit="µs", desc="fepen",
+                                leave=False)
 
     def due(self, run) -> bool:
         return run.step_count % self.EVERY == 0

@@ -216,16 +216,6 @@ def chunks(pending: list, batch: int, groups: int) -> list[list]:
     return [pending[j:j + size] for j in range(0, len(pending), size)]
 
 
-def bar_disabled(progress: bool = True) -> bool | None:
-    """tqdm's ``disable`` of a study's bar: hidden when ``progress`` is False or FEPEN_PROGRESS=0, shown with
-    FEPEN_PROGRESS=1 (fepen sweep sets it for the mpirun it starts: rank 0's stderr there is a pipe), else
-    None: shown only when stderr is a terminal."""
-    env = os.environ.get("FEPEN_PROGRESS")
-    if not progress or env == "0":
-        return True
-    return False if env == "1" else None
-
-
 def process_shot(i: int, scene, out: Path, ranks: int) -> dict:
     """Shot i as a whole ``fepen run`` process on ``ranks`` ranks into ``out`` (its scene handed over as a
     TOML file of its own, outside the folder); its record, with the process's wall time as wall_s."""
@@ -258,8 +248,8 @@ def execute(n: int, scene_of, out, comm=None, ranks_per_shot: int = 1, keep=None
         comm: the communicator (None: COMM_WORLD). ranks_per_shot: ranks per group; divides comm.size.
         keep: Scene -> whether the shot writes its results directory OUT/shots/NNNNN (None: never for rigid
             shots). say: prints a line (rank 0). desc: the progress bar's label.
-        batch: the most rigid shots of one batch. progress: the bar of shots done over the total on rank 0's
-            stderr (bar_disabled: on a terminal, or FEPEN_PROGRESS=1).
+        batch: the most rigid shots of one batch. progress: the bar of shots done over the total on rank 0,
+            where fepen.progress shows one (a terminal, mpirun's terminal, a notebook; FEPEN_PROGRESS).
         folder: (out, index) -> the folder of a shot that keeps its results (None: OUT/shots/NNNNN).
         process: 0, or each shot a whole ``fepen run`` process on this many ranks (How).
         stop: the study's fepen.runs.interrupts.Interrupts, or None: a signal it catches (or a shot stopped by one)
@@ -286,10 +276,9 @@ def execute(n: int, scene_of, out, comm=None, ranks_per_shot: int = 1, keep=None
             + f"; {groups} group{'s' if groups > 1 else ''} of {k} rank{'s' if k > 1 else ''}")
     log = None
     if comm.rank == 0:
-        from tqdm import tqdm
+        from fepen import progress as fprogress
 
-        bar = tqdm(total=len(pending), unit="shot", desc=desc, leave=False, file=sys.stderr,
-                   disable=bar_disabled(progress)) if pending else None
+        bar = fprogress.bar(progress, total=len(pending), unit="shot", desc=desc, leave=False) if pending else None
         log = _Log(out, records, bar)
     quiet = logging.getLogger("fepen")
     level = quiet.level

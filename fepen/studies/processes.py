@@ -117,7 +117,8 @@ FORWARDED = (signal.SIGTERM, signal.SIGINT, signal.SIGHUP)
 def relaunch(argv: list, workers: int) -> int:
     """A study command started without mpirun on a machine that has it (``fepen sweep``, ``fepen validate``,
     ``fepen validate-depth``): the same command again as ``mpirun -n WORKERS python -m fepen ARGV --workers 1``,
-    whose ranks share the shots (the caller checked its input first, and sets FEPEN_PROGRESS for the bar).
+    whose ranks share the shots (the caller checked its input first; rank 0's bar shows where the launcher's
+    stderr, this process's, is a terminal: fepen.progress).
 
     The launcher runs in a session of its own, so that Ctrl-C and a scheduler's signal reach this process only,
     which passes SIGTERM, SIGINT and SIGHUP on as SIGUSR1: Open MPI's mpirun and MPICH's mpiexec forward SIGUSR1

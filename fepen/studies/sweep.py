@@ -194,7 +194,7 @@ def run(path, out, comm=None, ranks_per_shot: int = 1, sets=(), fresh: bool = Fa
         ranks_per_shot: ranks of each shot's group. sets: --set overrides of the base scene.
         fresh: run every shot again (what the sweep wrote in OUT is removed first, by its manifest).
         say: prints one line (rank 0).
-        progress: the bar of shots done over the total (rank 0, stderr; fepen.studies.engine.bar_disabled).
+        progress: the bar of shots done over the total (rank 0, where fepen.progress shows one).
 
     Returns:
         {"shots", "ran", "skipped", "wall_s", "statuses"} (every rank).

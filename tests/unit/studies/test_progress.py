@@ -1,22 +1,49 @@
-"""The progress bars' switch (rank 0, stderr): off when asked, FEPEN_PROGRESS=1 on (a run under an mpirun started
-from a terminal), 0 off, else tqdm's own test of a terminal; the mesh's bar only within fepen.geometry.mesh.progress."""
+"""The progress bars of a run, of the mesh and of a study are fepen.progress's (its one decision: rank 0, the
+terminal, mpirun's terminal, a notebook, FEPEN_PROGRESS; tests/unit/test_progress_switch.py); the mesh's bar only
+within fepen.geometry.mesh.progress."""
 
-import pytest
+import io
+import sys
 
+from fepen import progress
 from fepen.geometry import mesh
+from fepen.runs import outputs
+from fepen.scene import Scene
 from fepen.studies import engine
 
 
-@pytest.mark.parametrize("env,progress,disabled", [(None, True, None), ("1", True, False), ("0", True, True),
-                                                   ("1", False, True), (None, False, True)])
-def test_the_bars_follow_the_switch_and_the_environment(monkeypatch, env, progress, disabled):
-    if env is None:
-        monkeypatch.delenv("FEPEN_PROGRESS", raising=False)
-    else:
-        monkeypatch.setenv("FEPEN_PROGRESS", env)
-    assert engine.bar_disabled(progress) is disabled
-    if progress:
-        assert mesh.bar_disabled() is disabled
+class Tty(io.StringIO):
+    def isatty(self) -> bool:
+        return True
+
+
+def test_every_bar_is_drawn_by_fepen_progress(monkeypatch):
+    made = []
+    real = progress.bar
+
+    def bar(on=True, rank=0, **kwargs):
+        made.append((on, kwargs.get("desc")))
+        return real(on, rank, **kwargs)
+
+    monkeypatch.setattr(progress, "bar", bar)
+    monkeypatch.setenv(progress.ENV, "0")
+    outputs.Progress(5e-5, 0.0).close(None, True)
+    mesh._MeshBar("mesh: building").close()
+    scene = Scene(sets=["effects.fidelity=rigid", "run.figures=false"])
+    records, ran, _ = engine.execute(1, lambda i: scene, None, desc="shots", progress=False)
+    assert ran == 1 and records[0]["status"] == "ok"
+    assert made == [(True, "fepen"), (True, "mesh: building"), (False, "shots")]
+
+
+def test_a_study_s_bar_is_off_when_its_caller_says_so(monkeypatch):
+    monkeypatch.delenv(progress.ENV, raising=False)
+    tty = Tty()
+    monkeypatch.setattr(sys, "stderr", tty)
+    for on in (False, True):
+        bar = progress.bar(on, total=3, unit="shot", desc="shots", leave=False)
+        bar.update(1)
+        bar.close()
+        assert ("shots:" in tty.getvalue()) is on
 
 
 def test_the_mesh_bar_is_on_only_within_its_switch():
