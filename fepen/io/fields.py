@@ -2,7 +2,8 @@
 one HDF5 file per output time while the run goes on, one self-contained file at its end (docs/theory.md §12,
 docs/results.md). fields.xdmf is one temporal collection with one grid per output time carrying the mesh
 and every field of that time, all data items declared with their precision, so that ParaView (Xdmf3 and
-legacy XDMF readers), pyvista and meshio's TimeSeriesReader read it as one dataset per time.
+legacy XDMF readers), pyvista and meshio's TimeSeriesReader read it as one dataset per time. The Cauchy stress,
+when its six components are written, is also one tensor attribute (``stress_Pa``, a "Tensor": full_tensor).
 """
 
 from __future__ import annotations
@@ -16,6 +17,7 @@ from mpi4py import MPI
 
 from fepen.atomic import make_dir, replacing
 from fepen.io import layout
+from fepen.io.vtu import SYMMETRIC_TENSORS
 
 #: what fields.xdmf says of its own frame and units (an Information element of its Domain)
 #: what fepen writes in fields.d/ (fepen.io.layout)
@@ -28,6 +30,25 @@ FRAME = ("fepen field output. Frame: the target's, in metres; the target face is
 
 
 INT32, FLOAT64 = 'NumberType="Int" Precision="4"', 'NumberType="Float" Precision="8"'
+
+# A tensor of fields.xdmf is an attribute of AttributeType "Tensor" (nine components: the 3 x 3 matrix row by row,
+# xx, xy, xz, yx, yy, yz, zx, zy, zz), not "Tensor6" (docs/results.md, "The stress tensor"): a Tensor6 (XDMF's
+# order xx, xy, xz, yy, yz, zz) is expanded to nine components by ParaView's legacy XDMF reader, but handed to VTK
+# as its six values by the Xdmf3 reader (ParaView's and pyvista's), and VTK's tensor filters take six components
+# in VTK's order xx, yy, zz, xy, yz, xz: two readers, two tensors, other principal stresses (seen in ParaView
+# 5.11; VTK's current Xdmf3 reader has no conversion either). Nine components are one tensor to every reader.
+
+
+def full_tensor(components: np.ndarray) -> np.ndarray:
+    """The nine components of symmetric tensors, row by row (xx, xy, xz, yx, yy, yz, zx, zy, zz).
+
+    Args:
+        components: (n, 6) in fepen.io.vtu.VTK_SYMMETRIC_ORDER (xx, yy, zz, xy, yz, xz).
+
+    Returns:
+        (n, 9) float64.
+    """
+    return np.asarray(components, dtype=np.float64)[:, [0, 3, 5, 3, 1, 4, 5, 4, 2]]
 
 
 def _time_name(t: float) -> str:
@@ -46,6 +67,9 @@ class FieldWriter:
         nodal_scalar: names of nodal scalar fields, written after the cell fields.
         times: output times already written (when resuming a run; later step files are deleted).
         integer: the names (of any kind) whose values are integers (written as int32).
+
+    A symmetric tensor whose six components are all among ``cell`` (fepen.io.vtu.SYMMETRIC_TENSORS) is written
+    beside them as one more cell field of nine components (full_tensor), a "Tensor" attribute of fields.xdmf.
     """
 
     def __init__(self, out: Path, solver, nodal: list[str], cell: list[str], times: list[float] = (),
@@ -53,6 +77,7 @@ class FieldWriter:
         self.out, self.comm = Path(out), solver.comm
         self.nodal, self.cell, self.nodal_scalar = list(nodal), list(cell), list(nodal_scalar)
         self.integer = set(integer)
+        self.tensors = {name: parts for name, parts in SYMMETRIC_TENSORS.items() if set(parts) <= set(self.cell)}
         self.times = list(times)
         self.dir = self.out / "fields.d"
         imap = solver.V.dofmap.index_map
@@ -82,6 +107,11 @@ class FieldWriter:
     def names(self) -> list[str]:
         """Every field name, in writing order."""
         return self.nodal + self.cell + self.nodal_scalar
+
+    @property
+    def datasets(self) -> list[str]:
+        """Every field's dataset of an output time: the fields, then the tensors made of them."""
+        return self.names + list(self.tensors)
 
     # ------------------------------------------------------------------------------------------------
     def _gather(self, local: np.ndarray):
@@ -126,6 +156,8 @@ class FieldWriter:
             files.inject("fields")
             arrays = {k: (v.reshape(-1, 1) if v.ndim == 1 else v) for k, v in data.items()}
             arrays = {k: (np.rint(v).astype(np.int32) if k in self.integer else v) for k, v in arrays.items()}
+            for name, parts in self.tensors.items():
+                arrays[name] = full_tensor(np.column_stack([data[p] for p in parts]))
             self._write_h5(self._step_file(len(self.times)), arrays)
             self.times.append(float(t))
             try:
@@ -149,7 +181,7 @@ class FieldWriter:
             for name in ("geometry", "topology"):
                 h5[f"/Mesh/mesh/{name}"] = h5py.ExternalLink("fields.d/mesh.h5", f"/{name}")
             for k, t in enumerate(self.times):
-                for name in self.names:
+                for name in self.datasets:
                     h5[f"/Function/{name}/{_time_name(t)}"] = h5py.ExternalLink(
                         f"fields.d/{self._step_file(k).name}", f"/{name}")
         with replacing(self.out / "fields.h5") as tmp:
@@ -176,11 +208,13 @@ class FieldWriter:
                       f'{mesh["topology"]}</DataItem>', "        </Topology>", '        <Geometry GeometryType="XYZ">',
                       f'          <DataItem Dimensions="{nn} 3" NumberType="Float" Precision="8" Format="HDF">'
                       f'{mesh["geometry"]}</DataItem>', "        </Geometry>"]
-            for name in self.names:
+            for name in self.datasets:
                 if name in self.nodal:
                     dims, kind, centre = f"{nn} 3", "Vector", "Node"
                 elif name in self.cell:
                     dims, kind, centre = f"{nc} 1", "Scalar", "Cell"
+                elif name in self.tensors:
+                    dims, kind, centre = f"{nc} 9", "Tensor", "Cell"  # not Tensor6: see full_tensor
                 else:
                     dims, kind, centre = f"{nn} 1", "Scalar", "Node"
                 number = INT32 if name in self.integer else FLOAT64
@@ -214,7 +248,7 @@ class FieldWriter:
                         dst.create_dataset(f"/Mesh/mesh/{name}", data=src[name][()])
                 for k, t in enumerate(self.times):
                     with h5py.File(self._step_file(k), "r") as src:
-                        for name in self.names:
+                        for name in self.datasets:
                             dst.create_dataset(f"/Function/{name}/{_time_name(t)}", data=src[name][()])
             self._write_xdmf(consolidated=True)
             layout.remove_entry(self.dir, _TIMES)  # what fepen wrote there (a user's file stays, and the folder)

@@ -445,8 +445,9 @@ SCHEMA: dict[str, Key] = {
                                   "run's report pictures from its fields are drawn regardless: they carry "
                                   "its summary's numbers)"),
     "run.stress_tensor_fields": flag(False, doc="also write the Cauchy stress tensor's six components "
-                                                "(stress_xx_Pa ... stress_xz_Pa) in fields.xdmf: 60 % more field "
-                                                "data (the default C3's fields.h5: 30 -> 48 MB)"),
+                                                "(stress_xx_Pa ... stress_xz_Pa) and the tensor as one attribute "
+                                                "(stress_Pa) in fields.xdmf: 2.5 times the field data (the "
+                                                "default C3's fields.h5: 30 -> about 75 MB)"),
     "run.acceleration_filter_hz": number(1.0e4, "Hz", 0.0, 1.0e7,
                                          doc="low-pass cut-off of the filtered accelerations (accelerations.csv) "
                                              "under run.acceleration_filter = 'butterworth', and of the charge-"

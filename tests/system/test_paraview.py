@@ -1,7 +1,9 @@
 """The fields as a user meets them (issue 15; docs/results.md): ParaView's Xdmf3 and legacy XDMF readers
 (pvpython), pyvista and meshio each open fields.xdmf of a finished run (serial and 2 ranks), a charged run,
 and a run while it is running and after it was killed; every reader runs in a subprocess, so a crash is a
-failure, not a dead test run. ParaView also renders the run's view.py to a PNG.
+failure, not a dead test run. ParaView also renders the run's view.py to a PNG, and its tensor filter finds the
+principal stresses of the six stress scalars in the one stress tensor of fields.xdmf and of the stress maps' .vtu
+(issue 61).
 
 ParaView comes from Debian (`apt-get install paraview xvfb`, done by tools/bootstrap.sh); where it is not
 installed the ParaView tests are skipped and say so, the pyvista and meshio ones still run.
@@ -34,6 +36,10 @@ SMALL = ["--set", "mesh.size=0.006", "--set", "run.end_time=6e-5", "--set", "run
 POINT_FIELDS = {"displacement_m", "velocity_m_s", "target_force_N", "target_normal_stress_Pa",
                 "target_friction_traction_Pa"}
 CELL_FIELDS = {"von_mises_Pa", "axial_stress_Pa", "peeq", "temperature_K", "cell_tag", "pressure_Pa", "triaxiality"}
+#: the finished serial and 2-rank runs write the stress tensor: its six scalars and the one tensor made of them
+TENSOR = ["--set", "run.stress_tensor_fields=true"]
+STRESS_COMPONENTS = ("xx", "yy", "zz", "xy", "yz", "xz")
+TENSOR_FIELDS = {f"stress_{c}_Pa" for c in STRESS_COMPONENTS} | {"stress_Pa"}
 
 
 @pytest.fixture(scope="module")
@@ -41,7 +47,7 @@ def runs(tmp_path_factory):
     """Finished runs: serial, 2 ranks, charged (serial), each made when first asked for (conftest.Runs: the
     2-rank run only in the system lane's two_ranks phase)."""
     base = tmp_path_factory.mktemp("pv")
-    how = {"serial": (1, []), "ranks2": (2, []), "charged": (1, ["--set", "effects.charge=true"])}
+    how = {"serial": (1, TENSOR), "ranks2": (2, TENSOR), "charged": (1, ["--set", "effects.charge=true"])}
 
     def make(name):
         ranks, extra = how[name]
@@ -163,7 +169,7 @@ def test_every_reader_opens_a_finished_run_as_one_dataset_per_time(runs, name):
     import h5py
 
     out = runs[name]
-    found = check_all_readers(out)
+    found = check_all_readers(out, cell_fields=CELL_FIELDS | TENSOR_FIELDS)
     if not found:
         pytest.skip("ParaView's pvpython is not installed (the pyvista and meshio checks passed)")
     last = found["xdmf3"]["rows"][-1]
@@ -177,6 +183,55 @@ def test_every_reader_opens_a_finished_run_as_one_dataset_per_time(runs, name):
     tip_mm = 1e3 * np.array(last["tip"])
     assert tip_mm[0] == pytest.approx(h["nose_x_mm"], abs=1e-6)
     assert -tip_mm[1] == pytest.approx(h["nose_y_mm"], abs=1e-6)
+
+
+def principal_stresses(components: dict) -> np.ndarray:
+    """Each cell's principal stresses (ascending, Pa) by numpy.linalg.eigvalsh of its six stress scalars."""
+    m = np.zeros((len(components["xx"]), 3, 3))
+    for c, v in components.items():
+        i, j = "xyz".index(c[0]), "xyz".index(c[1])
+        m[:, i, j] = m[:, j, i] = np.ravel(v)
+    return np.linalg.eigvalsh(m)
+
+
+def same_principal_stresses(found: list, components: dict) -> None:
+    """ParaView's principal stresses are numpy's of the six scalars to float32's round-off (Tensor Glyph's
+    eigenvalues are float32): 1e-6 of the largest; swapped components are off by a good part of it."""
+    expected = principal_stresses(components)
+    scale = np.abs(expected).max()
+    assert scale > 1e8  # the nose is loaded
+    got = np.array(found)
+    assert got.shape == expected.shape
+    np.testing.assert_allclose(got, expected, rtol=0, atol=1e-6 * scale)
+
+
+@needs_paraview
+@pytest.mark.parametrize("name", ["serial", "ranks2"])
+def test_paraviews_tensor_filter_finds_the_principal_stresses_of_the_six_scalars(runs, name):
+    """Issue 61: ParaView's own tensor filter (Cell Centers, then Tensor Glyph extracting the eigenvalues; no
+    Calculator) on fields.xdmf's one stress attribute, stress_Pa, with both XDMF readers, at the last time, and on
+    the stress maps' cut planes (stress_maps_end.vtu, six components XX YY ZZ XY YZ XZ): each cell's principal
+    stresses are numpy.linalg.eigvalsh's of its six stress scalars."""
+    import h5py
+    import meshio
+
+    out = runs[name]
+    vtu = out / "stress_maps_end.vtu"
+    *xdmf, cuts = run_readers([paraview_cmd(out, "xdmf3"), paraview_cmd(out, "legacy"),
+                               [PVPYTHON, str(HERE / "paraview_inspect.py"), str(vtu), "vtu"]])
+    for which, found in zip(("xdmf3", "legacy"), xdmf):
+        row = found["rows"][-1]
+        assert row["stress_components"] == 9, which  # the attribute is a Tensor of nine components
+        with h5py.File(out / "fields.h5", "r") as h5:
+            group = h5["/Function/stress_Pa"]
+            key = min(group.keys(), key=lambda k: abs(float(k.replace("_", ".")) - row["t"]))
+            components = {c: h5[f"/Function/stress_{c}_Pa/{key}"][()] for c in STRESS_COMPONENTS}
+        same_principal_stresses(row["principal_stress_Pa"], components)
+    assert cuts["stress_components"] == ["XX", "YY", "ZZ", "XY", "YZ", "XZ"]
+    m = meshio.read(vtu)
+    components = {c: np.concatenate(m.cell_data[f"stress_{c}_Pa"]) for c in STRESS_COMPONENTS}
+    assert cuts["cells"] == len(components["xx"]) > 100
+    same_principal_stresses(cuts["principal_stress_Pa"], components)
 
 
 def test_a_charged_run_carries_both_cell_tags_and_the_interface_fields(runs):

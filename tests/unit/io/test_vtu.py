@@ -44,3 +44,31 @@ def test_cell_data_of_the_wrong_length_is_refused(tmp_path):
     with pytest.raises(ValueError, match="3 values for 2 cells"):
         write_vtu(tmp_path / "x.vtu", np.zeros((3, 3)), [("triangle", np.array([[0, 1, 2], [0, 2, 1]]))],
                   {"s": [np.zeros(3)]})
+
+
+def test_the_six_stress_components_make_one_symmetric_tensor_array(tmp_path):
+    """stress_xx_Pa ... stress_xz_Pa: also ``stress_Pa``, six components in VTK's order XX, YY, ZZ, XY, YZ, XZ,
+    named so; meshio and pyvista read it back; a generic (k, c) array is written with its c components."""
+    meshio = pytest.importorskip("meshio")
+    rng = np.random.default_rng(61)
+    points = rng.standard_normal((20, 3))
+    tri, quad = rng.integers(0, 20, (4, 3)), rng.integers(0, 20, (3, 4))
+    order = ("xx", "yy", "zz", "xy", "yz", "xz")
+    comps = {f"stress_{c}_Pa": [rng.standard_normal(4), rng.standard_normal(3)] for c in order}
+    vec = [rng.standard_normal((4, 3)), rng.standard_normal((3, 3))]
+    path = tmp_path / "s.vtu"
+    write_vtu(path, points, [("triangle", tri), ("quad", quad)], {**comps, "v": vec})
+    expected = np.column_stack([np.concatenate(comps[f"stress_{c}_Pa"]) for c in order])
+    m = meshio.read(path)
+    assert np.array_equal(np.concatenate(m.cell_data["stress_Pa"]), expected)
+    assert np.array_equal(np.concatenate(m.cell_data["v"]), np.concatenate(vec))
+    assert np.array_equal(np.concatenate(m.cell_data["stress_xy_Pa"]), expected[:, 3])  # the scalars stay
+    head = path.read_bytes().split(b"<AppendedData")[0].decode()
+    assert ('Name="stress_Pa" NumberOfComponents="6" ComponentName0="XX" ComponentName1="YY" ComponentName2="ZZ" '
+            'ComponentName3="XY" ComponentName4="YZ" ComponentName5="XZ"') in head
+    pv = pytest.importorskip("pyvista")
+    g = pv.read(path)
+    assert np.array_equal(np.asarray(g.cell_data["stress_Pa"]), expected)
+    write_vtu(tmp_path / "five.vtu", points, [("triangle", tri), ("quad", quad)],
+              {k: v for k, v in comps.items() if k != "stress_xz_Pa"})
+    assert "stress_Pa" not in meshio.read(tmp_path / "five.vtu").cell_data
