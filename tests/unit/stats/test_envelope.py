@@ -65,12 +65,14 @@ def test_a_rigid_run_of_another_steel_is_inside():
 
 
 def test_docs_show_the_tables_fepen_envelope_prints():
-    """docs/uncertainty.md holds, between its markers, exactly what `fepen envelope` prints."""
+    """docs/uncertainty.md holds, in its make docs block envelope-tables, exactly what `fepen envelope` prints."""
     out = subprocess.run([sys.executable, "-m", "fepen", "envelope"], capture_output=True, text=True, check=True).stdout
     doc = (ROOT / "docs" / "uncertainty.md").read_text()
-    begin, end = "<!-- fepen envelope -->\n", "<!-- end fepen envelope -->"
+    begin, end = "<!-- make docs: envelope-tables -->\n", "<!-- /make docs: envelope-tables -->"
     assert begin in doc and end in doc
-    assert doc.split(begin, 1)[1].split(end, 1)[0].strip() == out.strip()
+    body = doc.split(begin, 1)[1].split(end, 1)[0]
+    assert body.startswith("<sub>Made by `fepen envelope` with fepen ")
+    assert body.split("\n", 1)[1].strip() == out.strip()
 
 
 def test_fepen_envelope_judges_a_scene_without_running_it():
