@@ -346,6 +346,23 @@ def layered_structure(tmp: Path) -> str:
                                "![The layered structure](img/layered-structure.png)"])
 
 
+# ---- docs/charge.md ------------------------------------------------------------------------------------------
+def carried_charge(tmp: Path) -> str:
+    """The contact checked without a target: the demo's table and what its columns say in a sentence."""
+    out, _ = output(["demos/charge/carried_charge.py"])
+    lines = out.strip().splitlines()
+    start = next(i for i, ln in enumerate(lines) if ln.startswith("case"))
+    table = lines[start:start + 4]
+    rows = {ln[:24].strip(): [float(x) for x in ln[24:].split()] for ln in table[1:]}
+    mu0 = rows["decelerating, mu = 0"]
+    fr = [r for k, r in rows.items() if not k.endswith("mu = 0")]
+    gaps = [r[3] for r in rows.values()]
+    return "\n".join(["```", *table, "```", "",
+                      f"Without friction the cylindrical walls carry {100 * mu0[1]:.2g} % of the load; with μ = 0.1 "
+                      f"their friction carries {100 * min(r[1] for r in fr):.0f}–{100 * max(r[1] for r in fr):.0f} %. "
+                      f"The end away from the load opens ({min(gaps):.3f}–{max(gaps):.3f} mm)."])
+
+
 B = md.Block
 #: name -> make_docs.Block
 BLOCKS: dict = {
@@ -364,6 +381,7 @@ BLOCKS: dict = {
                      f"python demos/targets/metal_plate.py --speeds {METAL_SPEEDS}", True),
     "layered-structure": B("docs/projectiles-and-targets.md", layered_structure, 5,
                            "python demos/targets/layered_structure.py", True),
+    "carried-charge": B("docs/charge.md", carried_charge, 40, "python demos/charge/carried_charge.py"),
     "depth-ci-subset": B("docs/validation-depth.md", depth_subset, 10, "python tests/system/test_depth_subset.py",
                          True),
 }
