@@ -26,7 +26,7 @@ def run(args) -> int:
     from fepen.stats import envelope, interval
 
     sc = fscene.load(args.scene, args.sets)
-    built = setup.check_supported(sc)
+    built = setup.check_supported(sc, meshes=False)  # judges the scene, meshes nothing: no mesh budget
     facts = setup.envelope_facts(sc, built)
     v = envelope.verdict(facts)
     lines = [envelope.line(v)]

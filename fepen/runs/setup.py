@@ -219,21 +219,24 @@ def placement(scene) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
     return R, v, w
 
 
-def check_supported(scene, built: Built | None = None) -> Built:
+def check_supported(scene, built: Built | None = None, meshes: bool = True) -> Built:
     """Raise InputError for settings this version cannot simulate, before anything is meshed.
 
     Args:
         built: the projectile, when already built; default: projectile(scene) (InputError on its geometry).
+        meshes: whether the caller goes on to mesh and run the scene; False (``fepen envelope``, which judges a
+            scene and runs nothing) skips the dolfinx release and the mesh's cost, which only a mesh needs.
 
     Returns:
         The built projectile.
     """
     built = built or projectile(scene)
-    if scene.effects.fidelity != "rigid" or scene.get("mesh.rigid_panel") is not None:
+    mesh = meshes and (scene.effects.fidelity != "rigid" or scene.get("mesh.rigid_panel") is not None)
+    if mesh:
         from fepen import dolfinx_api
 
         dolfinx_api.check_version()  # a mesh is made: only on the dolfinx releases fepen supports
-    if built.shape.needs_volume_mesh(scene.effects.fidelity):
+    if meshes and built.shape.needs_volume_mesh(scene.effects.fidelity):
         check_mesh_cost(scene, MPI.COMM_WORLD, built)
     targets.of(scene).check(scene)  # the friction's strength; a rigid wall refuses the rigid fidelity
     return built

@@ -65,12 +65,14 @@ def test_a_rigid_run_of_another_steel_is_inside():
 
 
 def test_docs_show_the_tables_fepen_envelope_prints():
-    """docs/uncertainty.md holds, between its markers, exactly what `fepen envelope` prints."""
+    """docs/uncertainty.md holds, in its make docs block envelope-tables, exactly what `fepen envelope` prints."""
     out = subprocess.run([sys.executable, "-m", "fepen", "envelope"], capture_output=True, text=True, check=True).stdout
     doc = (ROOT / "docs" / "uncertainty.md").read_text()
-    begin, end = "<!-- fepen envelope -->\n", "<!-- end fepen envelope -->"
+    begin, end = "<!-- make docs: envelope-tables -->\n", "<!-- /make docs: envelope-tables -->"
     assert begin in doc and end in doc
-    assert doc.split(begin, 1)[1].split(end, 1)[0].strip() == out.strip()
+    body = doc.split(begin, 1)[1].split(end, 1)[0]
+    assert body.startswith("<sub>Made by `fepen envelope` with fepen ")
+    assert body.split("\n", 1)[1].strip() == out.strip()
 
 
 def test_fepen_envelope_judges_a_scene_without_running_it():
@@ -82,3 +84,26 @@ def test_fepen_envelope_judges_a_scene_without_running_it():
     bad = subprocess.run([sys.executable, "-m", "fepen", "envelope", "--set", "impact.velocity=-1"],
                          capture_output=True, text=True)
     assert bad.returncode == 2 and bad.stderr.count("\n") == 1 and "impact.velocity" in bad.stderr
+
+
+#: the scene docs/uncertainty.md judges with `fepen envelope`: a 300 mm, 900 kg body, whose deformable mesh at the
+#: default size would be past mesh.max_cells
+BIG = ["--set", "projectile.diameter=0.3", "--set", "projectile.length=2.4", "--set", "projectile.mass=900", "--set",
+       "impact.velocity=300"]
+
+
+def test_fepen_envelope_judges_a_scene_too_big_to_mesh():
+    """Issue 61: `fepen envelope` runs nothing, so the deformable mesh's budget is not its business. Before the fix
+    the page's own command exited 2 ('mesh.size: 0.0025 m makes about 4.04e+07 cells')."""
+    p = subprocess.run([sys.executable, "-m", "fepen", "envelope", *BIG], capture_output=True, text=True, cwd=ROOT)
+    assert p.returncode == 0, p.stderr
+    assert p.stdout.startswith("outside the validated envelope: calibre 300 mm is 47.8 % above")
+    assert "projectile mass 900 kg is 320 % above" in p.stdout
+    assert "depth interval (10-90 %): the predicted depth -28 % to +22 %" in p.stdout
+
+
+def test_fepen_run_still_refuses_the_mesh_it_cannot_afford():
+    """The same scene run deformable is refused before gmsh starts: one line naming mesh.size, exit 2."""
+    p = subprocess.run([sys.executable, "-m", "fepen", "run", *BIG, "--out", "/nonexistent/never-written"],
+                       capture_output=True, text=True, cwd=ROOT)
+    assert p.returncode == 2 and p.stderr.count("\n") == 1 and "mesh.size" in p.stderr and "cells" in p.stderr
