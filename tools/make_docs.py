@@ -215,6 +215,12 @@ def _mesh_facets(shot: str, tmp: Path) -> dict:
     return json.loads(r.stdout.strip().splitlines()[-1])
 
 
+def _span(a: np.ndarray, digits: int) -> str:
+    """A range of figures as a page prints it: "0.77–0.93", or one figure where both ends print alike."""
+    lo, hi = f"{a.min():.{digits}f}", f"{a.max():.{digits}f}"
+    return lo if lo == hi else f"{lo}–{hi}"
+
+
 def fidelity_steps(tmp: Path) -> str:
     """What a switch of fidelity changes on C2, C7 and C8, step by step (depth mm / final axis °)."""
     rigid = read_validation(made(*VALIDATE_RIGID)[0] / "validation.csv")
@@ -237,9 +243,9 @@ def fidelity_steps(tmp: Path) -> str:
     axes = max(max(s[4]) - min(s[4]) for s in steps)
     return "\n".join(lines) + "\n\n" + (
         f"The load's sampling (rings to the mesh's facets, the same rigid body) shortens each path by "
-        f"{sampling.min():.1f}–{sampling.max():.1f} %; the body's elasticity (the mesh's rigid body to the elastic "
-        f"one: its compression and the nose's ringing, whose velocities add to the points' inertial term) by "
-        f"{elasticity.min():.2f}–{elasticity.max():.2f} %; plasticity by at most {np.abs(plasticity).max():.2f} %. "
+        f"{_span(sampling, 1)} %; the body's elasticity (the mesh's rigid body to the elastic one: its compression "
+        f"and the nose's ringing, whose velocities add to the points' inertial term) by {_span(elasticity, 2)} %; "
+        f"plasticity by at most {np.abs(plasticity).max():.2g} %. "
         f"The final axes agree to {axes:.2f}°.")
 
 
