@@ -1,7 +1,8 @@
 """fepen: deformable projectile penetrating concrete by the projectile-target separation method.
 
-Only the projectile is meshed (FEniCSx/dolfinx 0.5); the concrete acts through a cavity-expansion
-resistance law applied node by node on the deformed projectile surface.
+Only the projectile is meshed (FEniCSx: dolfinx 0.5.2, Debian bookworm's, or 0.11, the current release;
+docs/install.md); the concrete acts through a cavity-expansion resistance law applied node by node on the
+deformed projectile surface.
 
 The API (docs/api.md): ``fepen.Scene``, ``fepen.run(scene, out=None, comm=None) -> Result``,
 ``fepen.load(results_dir) -> Result``, ``fepen.resume(results_dir)``, ``fepen.mesh(scene, out) -> dict``,

@@ -37,6 +37,10 @@ class Result:
         scene: the resolved Scene of the run.
         fields: fields.xdmf when the run wrote fields, else None.
         figures: the pictures the run wrote, by name ("history", "hazard", "deformed", ...).
+
+    The run's tables, read on first use: ``history`` (numpy structured array), and as pandas DataFrames
+    ``history_frame``, ``probes``, ``accelerations`` and ``strains``, their columns named as in the files (units in
+    the names; docs/results.md). A table the run did not write raises FileNotFoundError saying why.
     """
 
     out: Path
@@ -45,6 +49,7 @@ class Result:
     fields: Path | None = None
     figures: dict = field(default_factory=dict)
     _history: np.ndarray | None = field(default=None, repr=False)
+    _tables: dict = field(default_factory=dict, repr=False)
 
     @property
     def history(self) -> np.ndarray:
@@ -57,13 +62,36 @@ class Result:
 
     @property
     def history_frame(self):
-        """history.csv as a pandas DataFrame (needs pandas)."""
-        try:
-            import pandas as pd
-        except ImportError as err:  # pragma: no cover - depends on the machine
-            raise ImportError("Result.history_frame needs pandas; Result.history is the same as a numpy "
-                              "structured array") from err
-        return pd.DataFrame(self.history)
+        """history.csv as a pandas DataFrame (the same numbers as ``history``)."""
+        from fepen.io.results import pandas
+
+        return pandas("Result.history_frame").DataFrame(self.history)
+
+    @property
+    def probes(self):
+        """probes.csv as a pandas DataFrame: ``t_s`` and the ``[[output.probes]]``' columns (``tip_uy_m``,
+        ``tail_vy_m_s``, ...; docs/results.md). Raises FileNotFoundError, saying why, for a run without probes."""
+        return self._table("probes.csv")
+
+    @property
+    def accelerations(self):
+        """accelerations.csv as a pandas DataFrame: ``t_s``, ``decel_g``, ``decel_filtered_g`` (and the shell's
+        and charge's with a charge). Raises FileNotFoundError, saying why, for a rigid run (it writes none)."""
+        return self._table("accelerations.csv")
+
+    @property
+    def strains(self):
+        """strains.csv as a pandas DataFrame: ``t_s`` and the eight gauges' axial log strains (``top_33pctL``,
+        ...). Raises FileNotFoundError, saying why, for a rigid run (it writes none)."""
+        return self._table("strains.csv")
+
+    def _table(self, name: str):
+        """One of the run's CSV tables as a DataFrame, read on first use (fepen.io.results.RunFiles.table)."""
+        if name not in self._tables:
+            from fepen.io import results
+
+            self._tables[name] = results.read(self.out).table(name)
+        return self._tables[name]
 
     def plot(self, field: str = "von_mises_Pa", time: float | None = None, png=None):
         """The projectile at an output time (the last by default) warped by its displacement, coloured by
@@ -233,10 +261,11 @@ def sweep(spec, out=None, comm=None, sets=(), fresh: bool = False, ranks_per_sho
     """
     import logging
 
-    import pandas as pd
-
+    from fepen.io.results import pandas
     from fepen.studies import engine
     from fepen.studies import sweep as fsweep
+
+    pd = pandas("fepen.sweep")
 
     comm = _comm(comm)
     _record_call("sweep", spec, out=None if out is None else str(out))

@@ -625,10 +625,10 @@ def depth_errors(tmp: Path) -> str:
     table = [ln for ln in text.splitlines() if ln.startswith("|")]
     with open(tmp / "depth" / "depth.csv", newline="") as f:
         rows = [r for r in csv.DictReader(f) if r["set"] not in CALIBRATION_SETS and r["set"] != "table1"]
-    err = {k: 100 * np.mean([abs(float(r[k]) / float(r["depth"]) - 1) for r in rows]) for k in ("default",
-                                                                                               "closed form")}
+    err = {k: 100 * np.mean([abs(float(r[f"{k}_depth_m"]) / float(r["depth_m"]) - 1) for r in rows])
+           for k in ("default", "closed_form")}
     return ("\n".join(table) + f"\n\nPooled over the {len(rows)} shots of the sets not used for any choice, mean "
-            f"|error|: default law {err['default']:.1f} %, closed form {err['closed form']:.1f} % (fepen {version()}).")
+            f"|error|: default law {err['default']:.1f} %, closed form {err['closed_form']:.1f} % (fepen {version()}).")
 
 
 # ---- the charge-safety map (docs/charge.md) ------------------------------------------------------------------

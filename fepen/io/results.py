@@ -199,6 +199,43 @@ class RunFiles:
             rows = list(csv.reader(f))
         return rows[0], rows[1:]
 
+    def table(self, name: str):
+        """One of the run's CSV tables (RUN_TABLES: probes.csv, accelerations.csv, strains.csv, hazard.csv,
+        charge_sections.csv; history.csv too) as a pandas DataFrame, its columns named as in the file (units in
+        the names, docs/results.md), every number the double the file holds (read back to the bit).
+
+        Raises:
+            ImportError: pandas is missing (one line). FileNotFoundError: the run wrote no such table; the
+                message says why (a rigid run writes no strains.csv, a run without [[output.probes]] no
+                probes.csv, a stopped run none of the closing tables).
+        """
+        pd = pandas(f"the table {name}")
+        path = self.out / name
+        if not path.is_file():
+            raise FileNotFoundError(f"{path} is not there: {self.absent_why(name)}")
+        return pd.read_csv(path, float_precision="round_trip")
+
+    def absent_why(self, name: str) -> str:
+        """Why a run's directory holds no ``name`` (one of RUN_TABLES), from its scene and summary."""
+        keys, summary = self.scene_keys(), self.summary() or {}
+        outcome = summary.get("outcome")
+        if name == "probes.csv" and not any(k.startswith("output.probes") for k in keys) \
+                and "[[output.probes]]" not in self._scene_text():
+            return "the run has no [[output.probes]] (docs/scenes.md)"
+        if name != "probes.csv" and keys.get("effects.fidelity") == "rigid":
+            return f"{name} is written by deformable runs only (this run's effects.fidelity is 'rigid')"
+        if name == "charge_sections.csv" and keys.get("effects.charge") is False:
+            return "charge_sections.csv is written by charged runs only (this run's effects.charge is false)"
+        if "Hx_mm" not in summary:
+            return f"the run did not finish (outcome {outcome!r}): {summary.get('stop_reason') or 'no summary.json'}"
+        return f"the run wrote none (outcome {outcome!r}; docs/results.md says which runs write it)"
+
+    def _scene_text(self) -> str:
+        try:
+            return (self.out / "scene.toml").read_text()
+        except (OSError, UnicodeDecodeError):
+            return ""
+
     def given_scene(self) -> dict:
         """The keys the user gave, as the scene.toml in the directory holds them (nested TOML tables), or {}."""
         import tomllib
@@ -235,6 +272,21 @@ class RunFiles:
     def figures(self) -> dict[str, Path]:
         """The run's pictures, by name: {"history": .../history.png, ...}."""
         return {p.stem: p for p in sorted(self.out.glob("*.png"))}
+
+
+#: the run's CSV tables a Result reads by name (fepen.io.columns.TABLES' files and probes.csv)
+RUN_TABLES = ("probes.csv", *columns.TABLES)
+
+
+def pandas(what: str):
+    """pandas, or ImportError with one line naming what needed it and how to get it (no traceback from deep in
+    pandas' callers)."""
+    try:
+        import pandas as pd
+    except ImportError:
+        raise ImportError(f"{what} needs pandas, a dependency of fepen that is not installed here: "
+                          "pip install 'pandas>=1.5'") from None
+    return pd
 
 
 def read(out) -> RunFiles:

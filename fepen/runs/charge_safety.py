@@ -17,7 +17,7 @@ import numpy as np
 
 from fepen.laws import explosive
 
-__all__ = ["ChargeSafety", "CELL_FIELDS", "line"]
+__all__ = ["ChargeSafety", "CELL_FIELDS", "line", "settled", "FINISHED", "VERDICTS"]
 
 #: the criteria read in the charge's cells (their margins are fields.xdmf's cell fields)
 CELL_CRITERIA = ("strength", "tension")
@@ -229,6 +229,50 @@ def _largest(values: np.ndarray, points: np.ndarray) -> np.ndarray:
     p = points[at]
     j = at[np.lexsort((p[:, 2], p[:, 1], p[:, 0]))[0]]
     return np.array([top, *points[j]])
+
+
+#: the outcomes of a shot that ended by its own physics (fepen.errors.OUTCOMES): its demands are whole. "ended"
+#: (run.end_time reached first) is not one: the projectile still moved, and a demand could still grow
+FINISHED = ("embedded", "perforated", "ricochet", "rebound", "eroded")
+#: a shot's verdict on its charge: "safe" (finished, every threshold's margin at least 1), "unsafe" (a demand
+#: past its threshold, finished or not: it stays past it), "undecided" (not finished and nothing past a
+#: threshold yet, or no result: a margin so far is only an upper bound of the shot's), "no threshold" (finished,
+#: but no criterion has one)
+VERDICTS = ("safe", "unsafe", "undecided", "no threshold")
+
+
+def settled(summary: dict | None, status: str = "ok", message: str = "") -> dict:
+    """A shot's outcome, whether it finished and its verdict on the charge (VERDICTS), from its own end state.
+
+    Args:
+        summary: its summary.json (None: no result). status: the study's record of it ("ok", "stopped",
+            "bad-input", "failed", "missing"). message: the record's message (why it stopped).
+
+    Returns:
+        {"outcome": the summary's outcome (OUTCOMES' name) or, without a result, the status; "finished": bool;
+        "verdict": one of VERDICTS; "reason": why a shot that did not finish has no verdict ("" else)}.
+    """
+    s = summary or {}
+    outcome = s.get("outcome") or status
+    finished = status == "ok" and outcome in FINISHED and "Hx_mm" in s
+    margin = (s.get("charge_safety") or {}).get("margin")
+    if margin is not None and margin < 1.0:
+        verdict = "unsafe"
+    elif finished:
+        verdict = "safe" if margin is not None else "no threshold"
+    else:
+        verdict = "undecided"
+    reason = ""
+    if not finished:
+        from fepen.errors import OUTCOMES
+
+        if outcome == "ended":
+            reason = (f"reached run.end_time = {s.get('end_time_s', float('nan')):.4g} s with the projectile still "
+                      f"at {s.get('residual_speed_m_s', float('nan')):.4g} m/s: its demands so far are lower bounds")
+        else:
+            reason = message or s.get("stop_reason") or (OUTCOMES[outcome].meaning if outcome in OUTCOMES else
+                                                         f"no result ({outcome})")
+    return {"outcome": outcome, "finished": finished, "verdict": verdict, "reason": reason}
 
 
 def line(block: dict) -> str:

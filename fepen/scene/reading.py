@@ -18,6 +18,8 @@ from fepen.scene.schema import REMOVED, SCHEMA, SECTIONS
 #: the largest scene file read (bytes): a scene is a page of text; a larger file is refused before it is parsed
 #: (the scene fepen writes into its results is held within it too: written_scene_fits)
 SCENE_MAX = 1 << 20
+#: the top-level keys of a sweep file (docs/studies.md) that no scene has: its base scene, overrides and kinds
+SWEEP_ONLY = ("scene", "base", "grid", "monte_carlo", "table")
 
 
 # ---------------------------------------------------------------------------------------------------------
@@ -199,4 +201,6 @@ def read_toml(path: str | Path, key: str = "SCENE") -> dict[str, Any]:
     except (ValueError, RecursionError) as err:
         raise toml_error(err, key, name) from None
     check_nesting(tree, key, name, level=0)
+    if any(k in tree for k in SWEEP_ONLY):  # before any of its keys is called unknown
+        raise InputError(key, f"{name} is a sweep file: run it with `fepen sweep {name}`")
     return flatten(tree)

@@ -15,11 +15,12 @@ from dataclasses import dataclass
 from fepen import scene as fscene
 from fepen.errors import InputError
 from fepen.laws.explosive import CRITERIA
+from fepen.runs.charge_safety import VERDICTS
 from fepen.studies.limits import base_keys, envelope_of, scene_line
 from fepen.studies.products import Picture, Table
 from fepen.studies.study import Round, Study, numbers, register, set_option
 
-__all__ = ["ChargeSafetyStudy", "SafetyPlan", "boundary", "table"]
+__all__ = ["ChargeSafetyStudy", "SafetyPlan", "boundary", "table", "undecided_lines"]
 
 #: the criteria's names, in the summary's order
 NAMES = tuple(c for c, _, _ in CRITERIA)
@@ -94,17 +95,22 @@ def boundary(speeds, margins) -> float | None:
 
 
 def table(plan: SafetyPlan, records: dict) -> list[dict]:
-    """One row per point: its speed, angles, status (ok, or why it has no verdict: bad-input, stopped, missing),
-    the shot's outcome and the message of a shot that did not finish, governing criterion and margin, every
-    criterion's margin, the depth and final axis angle, whether it lies inside the validated envelope."""
+    """One row per point: its speed, angles, status (ok, or why it has no result: bad-input, stopped, missing),
+    the shot's outcome (its summary's, else the status), whether it finished, its verdict
+    (fepen.runs.charge_safety.settled: an unfinished shot is never "safe") and why it has none, governing
+    criterion and margin, every criterion's margin, the depth and final axis angle, whether it lies inside the
+    validated envelope."""
+    from fepen.runs.charge_safety import settled
+
     rows = []
     for i, (v, o, a) in enumerate(plan.points):
         r = records.get(i, {"status": "missing", "summary": None, "message": ""})
         s = r.get("summary") or {}
         cs = s.get("charge_safety") or {}
+        end = settled(r.get("summary"), r["status"], r.get("message") or "")
         row = {"point": i, "velocity_m_s": v, "obliquity_deg": o, "attack_deg": a, "status": r["status"],
-               "outcome": s.get("outcome"), "message": r.get("message") or None,
-               "governing": cs.get("governing"), "margin": cs.get("margin")}
+               "outcome": end["outcome"], "finished": end["finished"], "verdict": end["verdict"],
+               "message": end["reason"] or None, "governing": cs.get("governing"), "margin": cs.get("margin")}
         for name in NAMES:
             c = cs.get(name) or {}
             row[f"{name}_margin"] = c.get("margin")
@@ -114,6 +120,12 @@ def table(plan: SafetyPlan, records: dict) -> list[dict]:
         row["inside_envelope"] = plan.envelopes[i]["inside"]
         rows.append(row)
     return rows
+
+
+def undecided_lines(rows: list[dict]) -> list[str]:
+    """One line per point whose shot did not finish and has nothing past a threshold: where, and why."""
+    return [f"{r['velocity_m_s']:g} m/s, {r['obliquity_deg']:g} deg, attack {r['attack_deg']:g} deg: undecided "
+            f"({r['outcome']}): {r['message']}" for r in rows if r["verdict"] == "undecided"]
 
 
 @register
@@ -158,15 +170,17 @@ class ChargeSafetyStudy(Study):
         bounds = []
         for a in sorted({p[2] for p in plan.points}):
             for o in sorted({p[1] for p in plan.points}):
-                ms = [next(r["margin"] for r in rows if (r["velocity_m_s"], r["obliquity_deg"], r["attack_deg"])
-                           == (v, o, a)) for v in speeds]
+                ms = [next(r["margin"] if r["verdict"] != "undecided" else None for r in rows  # a lower bound
+                           if (r["velocity_m_s"], r["obliquity_deg"], r["attack_deg"]) == (v, o, a)) for v in speeds]
                 bounds.append({"obliquity_deg": o, "attack_deg": a, "boundary_speed_m_s": boundary(speeds, ms),
                                "margins": ms})
         govs = sorted({r["governing"] for r in rows if r["governing"]})
         return {"points": len(rows), "rows": rows, "boundary": bounds, "governing": govs,
                 "explosive": plan.probe.charge.explosive, "scene": scene_line(plan.probe),
                 "mesh_size_m": plan.probe.mesh.size,
-                "statuses": {s: sum(r["status"] == s for r in rows) for s in sorted({r["status"] for r in rows})}}
+                "statuses": {s: sum(r["status"] == s for r in rows) for s in sorted({r["status"] for r in rows})},
+                "verdicts": {v: sum(r["verdict"] == v for r in rows) for v in VERDICTS if any(r["verdict"] == v
+                                                                                            for r in rows)}}
 
     def tables(self, plan: SafetyPlan, result: dict, info) -> list:
         rows = result["rows"]
@@ -186,13 +200,17 @@ class ChargeSafetyStudy(Study):
         for r in result["rows"]:
             def f(x):
                 return "–" if x is None else f"{x:.3g}"
+            bound = "≤ " if r["verdict"] == "undecided" and r["margin"] is not None else ""  # the shot's is lower
             lines.append(f"| {r['velocity_m_s']:g} | {r['obliquity_deg']:g} | {r['attack_deg']:g} | "
-                         f"{r['governing'] or r['status']} | {f(r['margin'])} | "
+                         f"{r['governing'] or r['status']} | {bound}{f(r['margin'])} | "
                          + " | ".join(f(r[f'{n}_margin']) for n in NAMES)
                          + f" | {'–' if r['depth_mm'] is None else format(r['depth_mm'], '.0f')} | "
                          + f"{'inside' if r['inside_envelope'] else 'outside'} |")
+        undecided = [f"- {u}" for u in undecided_lines(result["rows"])]
+        lines += [""] + undecided if undecided else []
         lines += ["", "Margin: threshold over demand (1 at the threshold, below 1 beyond it); – where the criterion "
-                  "has no threshold. The boundary: the speed at which the governing margin crosses 1.", "",
+                  "has no threshold; ≤: a shot that did not finish (undecided: its demands could still grow). The "
+                  "boundary: the speed at which the governing margin crosses 1, of the finished shots.", "",
                   "Every criterion's demand (the largest over the shot; units: "
                   + ", ".join(f"{n} {u}" for n, u, _ in CRITERIA) + "):", "",
                   "| speed (m/s) | obliquity (deg) | attack (deg) | " + " | ".join(NAMES) + " |",
@@ -215,6 +233,7 @@ class ChargeSafetyStudy(Study):
             ms = ", ".join("–" if m is None else f"{m:.3g}" for m in b["margins"])
             out.append(f"obliquity {b['obliquity_deg']:g} deg, attack {b['attack_deg']:g} deg: governing margins "
                        f"{ms}; " + (f"margin 1 at {v:.0f} m/s" if v is not None else "no crossing"))
+        out += undecided_lines(result["rows"])
         outside = [r for r in result["rows"] if not r["inside_envelope"]]
         out.append(f"governing: {', '.join(result['governing']) or 'none'}; {len(outside)} of {result['points']} "
                    "points outside the validated envelope")

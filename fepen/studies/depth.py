@@ -32,7 +32,7 @@ from fepen.studies.study import Round, Study, register
 __all__ = ["Row", "read_set", "table1_set", "shipped_sets", "scene_sets", "rigid_depth", "closed_form_depth",
            "errors", "shot_scenes", "predictions", "predict_sets", "gather_sets", "summary_table",
            "interval_coverage", "markdown", "ValidateDepth", "validate_depth",
-           "COLUMNS", "STRENGTH_BASES", "METHODS"]
+           "COLUMNS", "STRENGTH_BASES", "METHODS", "DEPTH_CSV"]
 
 COLUMNS = ("shot", "d_mm", "m_kg", "crh", "L_mm", "v_ms", "fc_mpa", "rho_kgm3", "depth_m")
 #: what a set's f_c can have been measured on (column ``strength_basis``; absent or empty: the first)
@@ -309,6 +309,13 @@ def markdown(table: list[dict], header: str = "") -> str:
 #: what fepen validate-depth writes into its folder
 DEPTH_NAMES = ("shots.jsonl", "depth.csv", "depth.md", "depth.png")
 
+#: depth.csv's columns: (name, unit: "text" not a number, "–" dimensionless; predictions()' key or METHODS name)
+DEPTH_CSV = (("set", "text", "set"), ("shot", "text", "name"), ("diameter_m", "m", "D"), ("length_m", "m", "L"),
+             ("mass_kg", "kg", "mass"), ("crh", "–", "crh"), ("velocity_m_s", "m/s", "V"), ("fc_Pa", "Pa", "fc"),
+             ("density_kg_m3", "kg/m^3", "rho"), ("depth_m", "m", "depth"), ("obliquity_deg", "deg", "obliquity_deg"),
+             ("attack_deg", "deg", "attack_deg"), ("strength_basis", "text", "strength_basis"), ("default_depth_m",
+             "m", "default"), ("forrestal_S_depth_m", "m", "forrestal-S"), ("closed_form_depth_m", "m", "closed form"))
+
 
 @dataclass
 class DepthPlan:
@@ -370,8 +377,8 @@ class ValidateDepth(Study):
         return None
 
     def tables(self, plan: DepthPlan, result: dict, info) -> list:
-        rows = [{"set": name, **s} for name, shots in result["_results"].items() for s in shots]
-        return [Table("depth.csv", ["set", *Row.__dataclass_fields__, *METHODS], rows, digits=None)]
+        rows = [{c: s.get(k, name) for c, _, k in DEPTH_CSV} for name, ss in result["_results"].items() for s in ss]
+        return [Table("depth.csv", [c for c, _, _ in DEPTH_CSV], rows, digits=None)]  # the set: its name
 
     def texts(self, plan: DepthPlan, result: dict, info) -> dict:
         note = (f"Rigid fidelity, default scene but for each shot's projectile, target strength and density"

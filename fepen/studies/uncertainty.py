@@ -254,6 +254,14 @@ class Uncertainty(Study):
                 "seed": args.seed, "model_scatter": args.model_scatter, "striking": args.striking,
                 "axis_beyond": args.axis_beyond}
 
+    @classmethod
+    def argv(cls, args) -> list[str]:
+        """Its own options as command-line words (``fepen study uncertainty --workers W``'s relaunch under mpirun)."""
+        return [*([args.scene] if args.scene else []), *[f"--set={s}" for s in args.sets],
+                *[f"{o}={v}" for o, v in (("--scatter", args.scatter), ("--samples", args.samples),
+                                          ("--seed", args.seed), ("--axis-beyond", args.axis_beyond)) if v is not None],
+                *([] if args.model_scatter else ["--no-model-scatter"]), *(["--striking"] if args.striking else [])]
+
     def plan(self, **options) -> Plan:
         return plan(**options)
 

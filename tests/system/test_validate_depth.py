@@ -25,15 +25,15 @@ def test_validate_depth_writes_table_and_figure(fepen_cli, tmp_path):
     for name in ("depth.csv", "depth.md", "depth.png"):
         assert (out / name).stat().st_size > 0
     rows = list(csv.DictReader(open(out / "depth.csv")))
-    assert [row["name"] for row in rows] == ["a", "b"]
+    assert [row["shot"] for row in rows] == ["a", "b"]
     for row in rows:
-        P = float(row["depth"])
+        P = float(row["depth_m"])
         # Forrestal-S in the rigid fidelity with the closed form's linear crater (k = 2), no separation angle and
         # no free face is the closed form's law: within 3 % (the nose entering and the onset angle differ)
         rel = 0.03
-        assert float(row["forrestal-S"]) == pytest.approx(float(row["closed form"]), rel=rel)
-        assert P > 0 and math.isfinite(float(row["default"]))
-    e = depth.errors([float(x["default"]) for x in rows], [float(x["depth"]) for x in rows])
+        assert float(row["forrestal_S_depth_m"]) == pytest.approx(float(row["closed_form_depth_m"]), rel=rel)
+        assert P > 0 and math.isfinite(float(row["default_depth_m"]))
+    e = depth.errors([float(x["default_depth_m"]) for x in rows], [float(x["depth_m"]) for x in rows])
     assert f"{100 * e['mean_abs']:.1f} %" in (out / "depth.md").read_text()
 
 
@@ -55,3 +55,42 @@ def test_validate_depth_bad_input_exits_2(fepen_cli, tmp_path):
     assert r.returncode == 2 and "--data" in r.stderr and "Traceback" not in r.stderr
     r = fepen_cli("validate-depth", "--set", "target.strength_model=magic", "--out", tmp_path / "o")
     assert r.returncode == 2 and "target.strength_model" in r.stderr
+
+
+#: the unit suffix of each unit depth.csv declares (fepen.studies.depth.DEPTH_CSV)
+SUFFIX = {"m": "_m", "mm": "_mm", "m/s": "_m_s", "kg": "_kg", "deg": "_deg", "Pa": "_Pa", "s": "_s", "J": "_J",
+          "kg/m^3": "_kg_m3"}
+
+
+def test_every_number_of_depth_csv_carries_its_unit(tmp_path):
+    """depth.csv's header is DEPTH_CSV's; a column with a number in it is declared with a unit its name ends in,
+    or declared dimensionless ("–"), and holds the shot's SI value (the data set's mm, MPa read as m, Pa)."""
+    data = tmp_path / "mine.csv"
+    data.write_text(HEADER + ROWS)
+    depth.validate_depth([data], out=tmp_path / "out", shipped=False)
+    with open(tmp_path / "out" / "depth.csv", newline="") as f:
+        rows = list(csv.DictReader(f))
+    header = list(rows[0])
+    assert header == [c for c, _, _ in depth.DEPTH_CSV]
+    unit = {c: u for c, u, _ in depth.DEPTH_CSV}
+    for c in header:
+        numeric = all(_number(r[c]) for r in rows)
+        assert numeric == (unit[c] != "text"), c
+        if numeric and unit[c] != "–":
+            assert c.endswith(SUFFIX[unit[c]]), (c, unit[c])
+    assert [c for c in header if unit[c] == "–"] == ["crh"]
+    a = rows[0]
+    assert (a["set"], a["shot"], a["strength_basis"]) == ("mine", "a", "cylinder")
+    for c, want in (("diameter_m", 0.0269), ("length_m", 0.2424), ("mass_kg", 0.906), ("crh", 2.0),
+                    ("velocity_m_s", 277.0), ("fc_Pa", 35.2e6), ("density_kg_m3", 2370.0), ("depth_m", 0.173),
+                    ("obliquity_deg", 0.0)):
+        assert float(a[c]) == pytest.approx(want, rel=1e-12), c
+    assert 0.05 < float(a["default_depth_m"]) < 0.5 and 0.05 < float(a["closed_form_depth_m"]) < 0.5
+
+
+def _number(text: str) -> bool:
+    try:
+        float(text)
+    except ValueError:
+        return False
+    return True
