@@ -15,8 +15,9 @@ from pathlib import Path
 
 from fepen.errors import InputError, MachineFault
 
-__all__ = ["VIEW_SCRIPT", "write_view_script", "plot", "show", "render_png", "has_display", "missing_fields",
-           "NoDisplay", "ViewerFailed", "field_centres", "field_centre", "field_unit", "run_name", "view_title"]
+__all__ = ["VIEW_SCRIPT", "view_script", "write_view_script", "plot", "show", "render_png", "has_display",
+           "missing_fields", "NoDisplay", "ViewerFailed", "field_centres", "field_centre", "field_unit", "run_name",
+           "view_title"]
 
 #: what ``fepen view`` without a display says (exit code 2)
 NO_DISPLAY = "no display: use --png FILE (an offscreen picture)"
@@ -132,7 +133,8 @@ def field_centre(out: Path, field: str, key: str = "--field") -> str:
     """
     centres = field_centres(out)
     if field not in centres:
-        raise InputError(key, f"{field!r} is not a field of this run; its fields: {', '.join(centres)}")
+        fields = f"its fields: {', '.join(centres)}" if centres else "its fields.xdmf holds none"
+        raise InputError(key, f"{field!r} is not a field of this run; {fields}")
     return centres[field]
 
 
@@ -275,14 +277,19 @@ def write_view_script(out: Path) -> Path:
 
     path = Path(out) / "view.py"
     with replacing(path) as tmp:
-        tmp.write_text(VIEW_SCRIPT.replace("{here!r}", repr(str(Path(out).resolve())))
-                       .replace("{shot!r}", repr(run_name(out))).replace("{units!r}", repr(UNITS)))
+        tmp.write_text(view_script(out))
     return path
+
+
+def view_script(out: Path) -> str:
+    """The text of ``view.py`` for the results directory ``out`` (VIEW_SCRIPT filled in)."""
+    return (VIEW_SCRIPT.replace("{here!r}", repr(str(Path(out).resolve()))).replace("{shot!r}", repr(run_name(out)))
+            .replace("{units!r}", repr(UNITS)))
 
 
 def show(out: Path, field: str = "von_mises_Pa", time: float | None = None, png: str | Path | None = None) -> None:
     """``fepen view``: the run in ``out`` in ParaView on its view.py (written first for a run from before
-    view.py), or by pyvista (plot) where ParaView is not installed.
+    view.py, and rewritten when an older fepen wrote it), or by pyvista (plot) where ParaView is not installed.
 
     Args:
         out: results directory with fields.xdmf. field: the field to colour by. time: output time (s); None:
@@ -302,7 +309,7 @@ def show(out: Path, field: str = "von_mises_Pa", time: float | None = None, png:
     if not png and not has_display():
         raise NoDisplay()
     script = out / "view.py"
-    if not script.is_file():  # a run from before view.py was written
+    if not script.is_file() or script.read_text(errors="replace") != view_script(out):  # a run of an older fepen
         write_view_script(out)
     if png and shutil.which("pvpython"):
         render_png(script, png, [*(["--time", repr(time)] if time is not None else []), "--field", field,

@@ -71,6 +71,23 @@ def test_paraview_colours_a_point_field_and_a_cell_field(run, tmp_path, field):
     assert coloured_fraction(png) > 0.002
 
 
+@needs_paraview
+def test_a_view_py_of_an_older_fepen_is_rewritten(run, tmp_path):
+    """A run's view.py written by an older fepen (one that drew the nodal scalars as cell fields) is replaced
+    by today's before `fepen view` renders with it: the point field coloured, the file today's."""
+    from fepen.post import paraview
+
+    today = paraview.view_script(run)
+    stale = today.replace('["POINTS" if field in points else "CELLS", field]', '["CELLS", field]')
+    assert stale != today
+    (run / "view.py").write_text(stale)
+    png = tmp_path / "view.png"
+    r = run_fepen("view", str(run), "--png", str(png), "--field", "target_normal_stress_Pa")
+    assert r.returncode == 0, r.stderr[-2000:]
+    assert coloured_fraction(png) > 0.002
+    assert (run / "view.py").read_text() == today
+
+
 @pytest.mark.parametrize("field", ["target_normal_stress_Pa", "von_mises_Pa"])
 def test_pyvista_colours_a_point_field_and_a_cell_field(run, tmp_path, field):
     """The pyvista picture (Result.plot, fepen view without ParaView) colours by either kind of field, and
