@@ -13,7 +13,9 @@ def add_arguments(parser) -> None:
     parser.add_argument("dir", help="results directory of a run with fields (finished, running or killed)")
     parser.add_argument("--png", help="render one picture to this file, offscreen, and exit")
     parser.add_argument("--time", type=float, help="output time (s); default the last")
-    parser.add_argument("--field", default="von_mises_Pa", help="the field to colour by (default von_mises_Pa)")
+    parser.add_argument("--field", default="von_mises_Pa",
+                        help="the field to colour by (default von_mises_Pa): any field of the run's fields.xdmf, "
+                             "drawn on the points or the cells as the file holds it")
 
 
 def run(args) -> int:
@@ -21,7 +23,12 @@ def run(args) -> int:
 
     Returns:
         0 when shown or written; 2 without a display (and no --png), 4 when the ParaView GUI failed: each with
-        one line ``fepen view: ...`` on stderr.
+        one line ``fepen view: ...`` on stderr. The picture is titled with the field, its unit, the frame's
+        time and the shot (fepen.post.paraview.view_title).
+
+    Raises:
+        InputError: ("dir") no fields.xdmf; ("--field") a field the run does not have (the line names those it
+            has): exit 2, before any window or picture.
     """
     from pathlib import Path
 
@@ -30,6 +37,7 @@ def run(args) -> int:
     out = Path(args.dir)
     if not (out / "fields.xdmf").is_file():
         raise InputError("dir", paraview.missing_fields(out))
+    paraview.field_centre(out, args.field)
     try:
         paraview.show(out, args.field, args.time, args.png)
     except (paraview.NoDisplay, paraview.ViewerFailed) as err:

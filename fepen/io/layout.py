@@ -50,7 +50,7 @@ RUN_NAMES = frozenset({
     "hazard.png", "strains.csv", "nose_profile.csv", "nose_profile.png", "stress_maps_peak.png",
     "stress_maps_peak.vtu", "stress_maps_end.png", "stress_maps_end.vtu", "trajectory.png", "deformed.png",
     "charge_sections.csv", "charge_histories.png", "stress_maps.png", "stress_maps.vtu", "cross_sections.png",
-    "cross_sections.vtu", "interface.png"})
+    "cross_sections.vtu", "interface.png", "attitude.png"})
 #: what ``fepen mesh`` writes
 MESH_NAMES = frozenset({"run.json", "fepen.log", RESERVE, "mesh.json", "scene.toml", "mesh.xdmf", "mesh.h5",
                         "mesh.vtu", "mesh_facets.xdmf", "mesh_facets.vtu", "mesh.png"})

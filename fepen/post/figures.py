@@ -160,19 +160,128 @@ def run_title(out, what: str = "", shot: str | None = None) -> str:
     return f"{name}: {what}" if what else name
 
 
+def depth_interval(out, summary: dict | None = None) -> dict | None:
+    """The run's predicted depth interval, as its summary reports it (docs/uncertainty.md).
+
+    Args:
+        out: the results directory. summary: the run's summary when the caller has it (a run draws its figures
+            before it writes summary.json); None: the directory's summary.json.
+
+    Returns:
+        {"low_mm", "high_mm", "levels": (the lower and upper probabilities)}, or None when the directory has no
+        summary.json or the summary has no interval (a shot that did not stop, a target without public data).
+    """
+    summary = (summary if summary is not None else results.read(out).summary()) or {}
+    bounds = summary.get("depth_interval_mm")
+    if not bounds:
+        return None
+    levels = (summary.get("interval") or {}).get("levels") or (0.1, 0.9)
+    return {"low_mm": float(bounds[0]), "high_mm": float(bounds[1]), "levels": tuple(levels)}
+
+
+def interval_band(ax, interval: dict | None, label: bool = True):
+    """The depth interval drawn across an axes whose y is the depth (mm): a shaded band from its low to its high
+    end, with its probabilities in the legend's label.
+
+    Args:
+        ax: the axes. interval: depth_interval's dict, or None (nothing drawn). label: give the band a legend
+            label.
+
+    Returns:
+        The band (matplotlib Polygon), or None.
+    """
+    if interval is None:
+        return None
+    lo, hi = interval["low_mm"], interval["high_mm"]
+    p0, p1 = (round(100 * p) for p in interval["levels"])
+    text = f"predicted depth, {p0}–{p1} %: {lo:.0f}–{hi:.0f} mm" if label else None
+    return ax.axhspan(lo, hi, color="tab:purple", alpha=0.15, lw=0, zorder=0.5, label=text)
+
+
+#: the attitude figure's history columns (fepen.io.columns.ATTITUDE): the axis in the plane of fire, the yaw
+ATTITUDE_COLUMNS = ("axis_angle_deg", "yaw_deg")
+
+
+def attitude_figure(out: Path, experiment: str | None = None, path: Path | None = None) -> Path | None:
+    """attitude.png: the body's attitude over the time after impact (µs), from history.csv's attitude columns:
+    the axis's angle from the target's normal in the plane of fire (``axis_angle_deg``, positive toward +x;
+    the Table 1 test's final axis dashed) and the yaw, the angle between the axis and the velocity
+    (``yaw_deg``). Drawn by whoever draws history.png (history_figure).
+
+    Args:
+        out: the results directory (history.csv, scene.toml). experiment: the Table 1 shot's name, or None
+            (then the scene's impact.shot). path: where to write (default out/attitude.png).
+
+    Returns:
+        The PNG's path, or None when history.csv has no attitude columns (a run of an older fepen).
+    """
+    from fepen.io.columns import final_axis_deg
+
+    out = Path(out)
+    data = results.read(out).history()
+    if not set(ATTITUDE_COLUMNS) <= set(data.dtype.names or ()):
+        return None
+    name = experiment or run_info(out)["shot"]
+    s = shot(name) if name else None
+    fig = new_figure((8.0, 6.4))
+    axis, yaw = fig.subplots(2, 1, sharex=True)
+    t = data["t_s"] * 1e6
+    axis.plot(t, data["axis_angle_deg"], color="C0", label="simulated axis")
+    if s is not None:
+        final = float(final_axis_deg(s.Hx_mm, s.Hy_mm, s.Tx_mm, s.Ty_mm))
+        axis.axhline(final, color="C0", ls="--", lw=1, label=f"{name} test: final axis {final:.1f}°")
+    axis.set(ylabel="axis from the target's normal (°)", title="pitch: the axis in the plane of fire (+ toward +x)")
+    axis.legend(fontsize=8, loc="best")
+    yaw.plot(t, data["yaw_deg"], color="C3", label="yaw")
+    yaw.set(xlabel="time after impact (µs)", ylabel="yaw (°)", title="yaw: the axis against the velocity (3-D)")
+    for a in (axis, yaw):
+        a.grid(alpha=0.3)
+    line = f"final axis {data['axis_angle_deg'][-1]:.1f}°, final yaw {data['yaw_deg'][-1]:.1f}°"
+    fig.suptitle(run_title(out, "attitude", name) + "\n" + line, fontsize=11)
+    fig.tight_layout()
+    return save_figure(fig, path or out / "attitude.png")
+
+
 def _nonzero(values) -> bool:
     return bool(np.any(np.abs(np.nan_to_num(np.asarray(values, float))) > 0.0))
 
 
-def history_figure(out: Path, experiment: str | None = None, comm=MPI.COMM_WORLD) -> None:
+def _energies_panel(ax, data, t, tlabel: str) -> None:
+    """history.png's energies: kinetic and given to the target (kJ), and on a right axis (J) the stored elastic
+    energy and the plastic dissipation when not zero throughout (else named in the legend's title)."""
+    ax.plot(t, data["kinetic_J"] / 1e3, label="kinetic")
+    ax.plot(t, -data["external_work_J"] / 1e3, label="given to the target (−external work)")
+    names = data.dtype.names
+    zero, small = [], None
+    for key, label, colour in (("elastic_J", "stored elastic", "C2"), ("plastic_J", "plastic dissipation", "C3")):
+        if key in names and _nonzero(data[key]):
+            small = small or ax.twinx()  # joules, beside the tens of kilojoules
+            small.plot(t, data[key], "--", color=colour, lw=1, label=f"{label} (J, right axis)")
+        elif key in names:
+            zero.append(label)
+    ax.set(xlabel=tlabel, ylabel="energy (kJ)", title="energies")
+    handles, labels = ax.get_legend_handles_labels()
+    if small is not None:
+        small.set_ylabel("energy (J)")
+        more = small.get_legend_handles_labels()
+        handles, labels = handles + more[0], labels + more[1]
+    (small or ax).legend(handles, labels, fontsize=7, loc="center right", framealpha=0.9,
+                         title=("zero throughout: " + ", ".join(zero)) if zero else None, title_fontsize=7)
+
+
+def history_figure(out: Path, experiment: str | None = None, comm=MPI.COMM_WORLD, summary: dict | None = None) -> None:
     """history.png (rank 0), four panels over the time after impact (µs): the nose and tail depths with the
     Table 1 test's final depths as horizontal lines; the target's deceleration; the path in the plane of
     incidence with the test's final nose and tail; the energies (kinetic, the energy given to the target,
-    and the stored elastic energy and plastic dissipation when not zero throughout).
+    and the stored elastic energy and plastic dissipation when not zero throughout). The depth panels carry
+    the predicted depth interval when summary.json reports one (interval_band). Then attitude.png
+    (attitude_figure), so that every run that draws history.png draws its attitude too.
 
     Args:
         out: the results directory (history.csv, scene.toml). experiment: the Table 1 shot's name, or None
-            (then the scene's impact.shot). comm: the run's communicator (only rank 0 draws).
+            (then the scene's impact.shot). comm: the run's communicator (only rank 0 draws). summary: the run's
+            summary, for its depth interval, when the caller has it before summary.json is written (None: read
+            summary.json, if any).
     """
     if comm.rank != 0:
         return
@@ -190,6 +299,8 @@ def history_figure(out: Path, experiment: str | None = None, comm=MPI.COMM_WORLD
     if s is not None:
         ax[0].axhline(s.Hy_mm, color="C3", ls="--", lw=1, label=f"{name} test: final nose depth {s.Hy_mm:g} mm")
         ax[0].axhline(s.Ty_mm, color="C0", ls="--", lw=1, label=f"{name} test: final tail depth {s.Ty_mm:g} mm")
+    band = depth_interval(out, summary)
+    interval_band(ax[0], band)
     ax[0].invert_yaxis()
     ax[0].set(xlabel=tlabel, ylabel="depth below the target face (mm)", title="depth")
     ax[0].legend(fontsize=7, loc="best")
@@ -206,30 +317,13 @@ def history_figure(out: Path, experiment: str | None = None, comm=MPI.COMM_WORLD
         ax[2].plot([s.Hx_mm], [s.Hy_mm], "o", color="C3", mec="k", label=f"{name} test: nose")
         ax[2].plot([s.Tx_mm], [s.Ty_mm], "s", color="C0", mec="k", label=f"{name} test: tail")
     ax[2].axhline(0.0, color="saddlebrown", lw=1)
+    interval_band(ax[2], band)
     ax[2].invert_yaxis()
     ax[2].set(xlabel="x along the target face (mm)", ylabel="depth below the target face (mm)",
               title="path in the plane of incidence (equal scales)")
     ax[2].set_aspect("equal", adjustable="datalim")
     ax[2].legend(fontsize=7, loc="best")
-    # energies
-    ax[3].plot(t, data["kinetic_J"] / 1e3, label="kinetic")
-    ax[3].plot(t, -data["external_work_J"] / 1e3, label="given to the target (−external work)")
-    names = data.dtype.names
-    zero, small = [], None
-    for key, label, colour in (("elastic_J", "stored elastic", "C2"), ("plastic_J", "plastic dissipation", "C3")):
-        if key in names and _nonzero(data[key]):
-            small = small or ax[3].twinx()  # joules, beside the tens of kilojoules
-            small.plot(t, data[key], "--", color=colour, lw=1, label=f"{label} (J, right axis)")
-        elif key in names:
-            zero.append(label)
-    ax[3].set(xlabel=tlabel, ylabel="energy (kJ)", title="energies")
-    handles, labels = ax[3].get_legend_handles_labels()
-    if small is not None:
-        small.set_ylabel("energy (J)")
-        more = small.get_legend_handles_labels()
-        handles, labels = handles + more[0], labels + more[1]
-    (small or ax[3]).legend(handles, labels, fontsize=7, loc="center right", framealpha=0.9,
-                 title=("zero throughout: " + ", ".join(zero)) if zero else None, title_fontsize=7)
+    _energies_panel(ax[3], data, t, tlabel)
     for a in ax:
         a.grid(alpha=0.3)
     depth = float(np.nanmax(data["nose_y_mm"]))
@@ -239,3 +333,4 @@ def history_figure(out: Path, experiment: str | None = None, comm=MPI.COMM_WORLD
     fig.suptitle(run_title(out, "history", name) + "\n" + line, fontsize=11)
     fig.tight_layout()
     save_figure(fig, out / "history.png")
+    attitude_figure(out, name)

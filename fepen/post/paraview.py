@@ -15,8 +15,9 @@ from pathlib import Path
 
 from fepen.errors import InputError, MachineFault
 
-__all__ = ["VIEW_SCRIPT", "write_view_script", "plot", "show", "render_png", "has_display", "missing_fields",
-           "NoDisplay", "ViewerFailed"]
+__all__ = ["VIEW_SCRIPT", "view_script", "write_view_script", "plot", "show", "render_png", "has_display",
+           "missing_fields", "NoDisplay", "ViewerFailed", "field_centres", "field_centre", "field_unit", "run_name",
+           "view_title"]
 
 #: what ``fepen view`` without a display says (exit code 2)
 NO_DISPLAY = "no display: use --png FILE (an offscreen picture)"
@@ -87,6 +88,87 @@ def missing_fields(out: Path) -> str:
         return f"{out} holds no fields.xdmf: the run had run.fields = false"
     return f"{out} holds no fields.xdmf yet: the run wrote no output time (run.output_interval) before it stopped"
 
+#: where an XDMF Attribute's Center puts a field, as ParaView and pyvista name it
+CENTRES = {"Node": "POINTS", "Cell": "CELLS"}
+#: a field's unit from the end of its name (every field of fepen carries its unit in its name); none: dimensionless
+UNITS = (("_m_s", "m/s"), ("_Pa", "Pa"), ("_N", "N"), ("_K", "K"), ("_J", "J"), ("_m", "m"), ("_s", "s"))
+
+
+def field_centres(out: Path) -> dict[str, str]:
+    """The fields of a run's fields.xdmf and where each lives, as the file says (its Attribute elements' Center),
+    never from a list of names: a field added to the run is drawn where it is written.
+
+    Args:
+        out: the results directory.
+
+    Returns:
+        {field name: "POINTS" (Center="Node") or "CELLS" (Center="Cell")}, in the file's order.
+
+    Raises:
+        InputError: ("dir") fields.xdmf is not XML (not a file fepen wrote).
+    """
+    import xml.etree.ElementTree as ET
+
+    path = Path(out) / "fields.xdmf"
+    try:
+        root = ET.parse(path).getroot()
+    except ET.ParseError as err:
+        raise InputError("dir", f"{path} is not an XDMF file: {err}") from None
+    found: dict[str, str] = {}
+    for attribute in root.iter("Attribute"):
+        centre = CENTRES.get(attribute.get("Center", "Node"))
+        if centre is not None:
+            found.setdefault(attribute.get("Name"), centre)
+    return found
+
+
+def field_centre(out: Path, field: str, key: str = "--field") -> str:
+    """Where ``field`` lives in the run's fields ("POINTS" or "CELLS", field_centres).
+
+    Args:
+        out: the results directory. field: the field's name. key: the argument the user gave it by.
+
+    Raises:
+        InputError: (key) the run has no such field: one line naming the fields it has.
+    """
+    centres = field_centres(out)
+    if field not in centres:
+        fields = f"its fields: {', '.join(centres)}" if centres else "its fields.xdmf holds none"
+        raise InputError(key, f"{field!r} is not a field of this run; {fields}")
+    return centres[field]
+
+
+def field_unit(field: str) -> str:
+    """A field's unit from the end of its name ("Pa", "m/s", ...; "dimensionless" for peeq, triaxiality, tags)."""
+    return next((unit for end, unit in UNITS if field.endswith(end)), "dimensionless")
+
+
+def run_name(out: Path) -> str:
+    """The run's shot and fidelity as the figures' titles name it (fepen.post.figures.run_title), or "" when the
+    directory holds no readable scene."""
+    from fepen.post.figures import run_title
+
+    try:
+        return run_title(out)
+    except Exception:  # noqa: BLE001 - a title is not worth failing a picture for
+        return ""
+
+
+def view_title(out: Path, field: str, t: float) -> str:
+    """The title of a picture of the run (view.py's ``title``, which ParaView runs without fepen): "FIELD (UNIT) at
+    t = T µs — SHOT".
+
+    Args:
+        out: the results directory. field: the field drawn. t: the frame's output time (s).
+
+    Returns:
+        The title.
+    """
+    text = f"{field} ({field_unit(field)}) at t = {t * 1e6:.1f} µs"
+    name = run_name(out)
+    return f"{text} — {name}" if name else text
+
+
 VIEW_SCRIPT = '''"""This run in ParaView: the projectile warped by its displacement, coloured by von Mises stress, the
 target face (y = 0) drawn, the time controls on the output times (written by fepen).
 
@@ -98,14 +180,31 @@ import argparse
 import os
 
 from paraview.simple import (GetActiveViewOrCreate, GetAnimationScene, GetColorTransferFunction, Plane,
-                             Render, SaveScreenshot, Show, WarpByVector, Xdmf3ReaderS)
+                             Render, SaveScreenshot, Show, Text, WarpByVector, Xdmf3ReaderS)
 
 HERE = os.path.dirname(os.path.abspath(__file__)) if "__file__" in globals() else {here!r}
 
 
-def main(png=None, time=None, field="von_mises_Pa"):
+#: the run's shot and fidelity, for the title (fepen view passes its own with --shot)
+SHOT = {shot!r}
+#: a field's unit from the end of its name (fepen's names carry their units)
+UNITS = {units!r}
+
+
+def title(field, t, shot=SHOT):
+    """The picture's title: the field and its unit, the frame's time (microseconds), the shot."""
+    unit = next((u for end, u in UNITS if field.endswith(end)), "dimensionless")
+    text = f"{field} ({unit}) at t = {t * 1e6:.1f} \u00b5s"
+    return f"{text} \u2014 {shot}" if shot else text
+
+
+def main(png=None, time=None, field="von_mises_Pa", shot=SHOT):
     reader = Xdmf3ReaderS(registrationName="fields.xdmf", FileName=[os.path.join(HERE, "fields.xdmf")])
     reader.UpdatePipelineInformation()
+    points, cells = list(reader.PointArrays), list(reader.CellArrays)  # the reader's, from the file's Centers
+    if field not in points + cells:  # where the field lives is the file's (its Attribute's Center)
+        raise SystemExit(f"view.py: --field: {field!r} is not a field of this run; its fields: "
+                         + ", ".join(points + cells))
     times = list(reader.TimestepValues) or [0.0]
     t = times[-1] if time is None else min(times, key=lambda s: abs(s - time))
     warp = WarpByVector(registrationName="deformed", Input=reader)
@@ -121,8 +220,7 @@ def main(png=None, time=None, field="von_mises_Pa"):
     fine = reader.GetDataInformation().GetNumberOfCells() > 5000
     shown.SetRepresentationType("Surface" if fine else "Surface With Edges")
     shown.EdgeColor = [0.25, 0.25, 0.25]
-    centre = "POINTS" if field in ("displacement_m", "velocity_m_s", "wear_depth_m") else "CELLS"
-    shown.ColorArrayName = [centre, field]
+    shown.ColorArrayName = ["POINTS" if field in points else "CELLS", field]
     lut = GetColorTransferFunction(field)
     lut.ApplyPreset("Jet", True)
     shown.LookupTable = lut
@@ -150,6 +248,10 @@ def main(png=None, time=None, field="von_mises_Pa"):
     view.CameraPosition = [c[0] + 0.8 * half, c[1] + 0.6 * half, c[2] + 2.3 * half]  # the projectile is near it
     view.CameraViewUp = [0.0, 1.0, 0.0]
     view.CameraViewAngle = 30.0
+    text = Text(registrationName="title", Text=title(field, t, shot))
+    label = Show(text, view)
+    label.WindowLocation = "Upper Center"
+    label.FontSize = 16
     Render(view)
     if png:
         SaveScreenshot(png, view, ImageResolution=[1200, 800])
@@ -159,10 +261,13 @@ def main(png=None, time=None, field="von_mises_Pa"):
 if __name__ != "view":  # run, not imported
     parser = argparse.ArgumentParser(description="this run in ParaView")
     parser.add_argument("--png", help="render one picture to this file and exit")
-    parser.add_argument("--time", type=float, help="output time (s); default the last")
-    parser.add_argument("--field", default="von_mises_Pa", help="the field to colour by")
+    given = os.environ.get  # what fepen view gives the GUI, whose --script takes no arguments
+    parser.add_argument("--time", type=float, default=given("FEPEN_VIEW_TIME"),
+                        help="output time (s); default the last")
+    parser.add_argument("--field", default=given("FEPEN_VIEW_FIELD", "von_mises_Pa"), help="the field to colour by")
+    parser.add_argument("--shot", default=given("FEPEN_VIEW_SHOT", SHOT), help="the run's name in the title")
     args, _ = parser.parse_known_args()
-    main(args.png, args.time, args.field)
+    main(args.png, args.time, args.field, args.shot)
 '''
 
 
@@ -172,13 +277,19 @@ def write_view_script(out: Path) -> Path:
 
     path = Path(out) / "view.py"
     with replacing(path) as tmp:
-        tmp.write_text(VIEW_SCRIPT.replace("{here!r}", repr(str(Path(out).resolve()))))
+        tmp.write_text(view_script(out))
     return path
+
+
+def view_script(out: Path) -> str:
+    """The text of ``view.py`` for the results directory ``out`` (VIEW_SCRIPT filled in)."""
+    return (VIEW_SCRIPT.replace("{here!r}", repr(str(Path(out).resolve()))).replace("{shot!r}", repr(run_name(out)))
+            .replace("{units!r}", repr(UNITS)))
 
 
 def show(out: Path, field: str = "von_mises_Pa", time: float | None = None, png: str | Path | None = None) -> None:
     """``fepen view``: the run in ``out`` in ParaView on its view.py (written first for a run from before
-    view.py), or by pyvista (plot) where ParaView is not installed.
+    view.py, and rewritten when an older fepen wrote it), or by pyvista (plot) where ParaView is not installed.
 
     Args:
         out: results directory with fields.xdmf. field: the field to colour by. time: output time (s); None:
@@ -186,6 +297,7 @@ def show(out: Path, field: str = "von_mises_Pa", time: float | None = None, png:
             GUI.
 
     Raises:
+        InputError: ("--field") the run has no such field (field_centre), before any window or picture.
         NoDisplay: a window asked for (no ``png``) without a display (has_display).
         ViewerFailed: the ParaView GUI exited with a non-zero code or on a signal.
     """
@@ -193,15 +305,19 @@ def show(out: Path, field: str = "von_mises_Pa", time: float | None = None, png:
     import subprocess
 
     out = Path(out)
+    field_centre(out, field)
     if not png and not has_display():
         raise NoDisplay()
     script = out / "view.py"
-    if not script.is_file():  # a run from before view.py was written
+    if not script.is_file() or script.read_text(errors="replace") != view_script(out):  # a run of an older fepen
         write_view_script(out)
     if png and shutil.which("pvpython"):
-        render_png(script, png, [*(["--time", repr(time)] if time is not None else []), "--field", field])
+        render_png(script, png, [*(["--time", repr(time)] if time is not None else []), "--field", field,
+                                 "--shot", run_name(out)])
     elif not png and shutil.which("paraview"):
-        code = subprocess.run(["paraview", f"--script={script}"], check=False).returncode
+        given = {"FEPEN_VIEW_FIELD": field, "FEPEN_VIEW_SHOT": run_name(out),
+                 **({"FEPEN_VIEW_TIME": repr(time)} if time is not None else {})}
+        code = subprocess.run(["paraview", f"--script={script}"], check=False, env={**os.environ, **given}).returncode
         if code < 0:
             raise ViewerFailed(f"ParaView was killed by signal {-code}")
         if code:
@@ -242,10 +358,12 @@ def plot(out: Path, field: str = "von_mises_Pa", time: float | None = None, png:
         png: write the picture there (offscreen) instead of showing it.
 
     Returns:
-        The pyvista Plotter (closed when ``png`` is given).
-    """
-    import os
+        The pyvista Plotter (closed when ``png`` is given), titled by view_title.
 
+    Raises:
+        InputError: ("field") the run has no such field.
+    """
+    centre = field_centre(out, field, "field")
     os.environ.setdefault("VTK_DEFAULT_OPENGL_WINDOW", "vtkOSOpenGLRenderWindow")
     import numpy as np
     import pyvista as pv
@@ -263,10 +381,11 @@ def plot(out: Path, field: str = "von_mises_Pa", time: float | None = None, png:
     face = pv.Plane(center=(0.5 * (x0 + x1), 0.0, 0.0), direction=(0.0, 1.0, 0.0), i_size=x1 - x0 + 2 * half,
                     j_size=2 * half)
     plotter = pv.Plotter(off_screen=png is not None, window_size=(1200, 800))
-    plotter.add_mesh(warped, scalars=field, cmap="jet", show_edges=True, edge_color="#404040",
-                     scalar_bar_args={"title": field})
+    plotter.add_mesh(warped, scalars=field, preference="point" if centre == "POINTS" else "cell", cmap="jet",
+                     show_edges=True, edge_color="#404040",
+                     scalar_bar_args={"title": field, "position_x": 0.2, "width": 0.6})
     plotter.add_mesh(face, color="grey", opacity=0.35)
-    plotter.add_text(f"t = {times[k] * 1e6:.1f} us", font_size=10)
+    plotter.add_text(view_title(out, field, float(times[k])), position="upper_edge", font_size=10)
     plotter.view_xy()
     plotter.camera.azimuth = 20
     plotter.camera.elevation = 15

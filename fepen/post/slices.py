@@ -285,19 +285,21 @@ def _one_path(polys: list):
     return MplPath(verts, codes.astype(MplPath.code_type))
 
 
-def trajectory_figure(out: Path, path: Path, experiment=None, outlines: int = 6) -> None:
+def trajectory_figure(out: Path, path: Path, experiment=None, outlines: int = 6, summary: dict | None = None) -> None:
     """The shot in the plane of incidence (the paper's Fig. 18): the target face and the target, the
     projectile's deformed outline (its cut by the plane z = 0) at a few output times, the nose and tail paths
-    of history.csv and, for a Table 1 shot, the test's final nose and tail.
+    of history.csv and, for a Table 1 shot, the test's final nose and tail; the predicted depth interval as a
+    band when summary.json reports one (fepen.post.figures.interval_band).
 
     Args:
         experiment: fepen.data.Shot (Hx_mm, Hy_mm, Tx_mm, Ty_mm) or None.
         outlines: how many output times to draw, evenly spread from the first to the last.
+        summary: the run's summary, for its depth interval (None: summary.json, if any).
     """
     import matplotlib
     from matplotlib.patches import PathPatch
 
-    from fepen.post.figures import new_figure, run_title, save_figure
+    from fepen.post.figures import depth_interval, interval_band, new_figure, run_title, save_figure
 
     out = Path(out)
     h = np.atleast_1d(np.genfromtxt(out / "history.csv", delimiter=",", names=True))
@@ -325,6 +327,7 @@ def trajectory_figure(out: Path, path: Path, experiment=None, outlines: int = 6)
         ax.plot([experiment.Tx_mm, experiment.Hx_mm], [experiment.Ty_mm, experiment.Hy_mm], "k-", lw=2.5,
                 label=f"{name or 'test'} test: final tail to nose (Table 1)")
         ax.plot([experiment.Hx_mm], [experiment.Hy_mm], "k^", ms=8)
+    interval_band(ax, depth_interval(out, summary))  # before the limits: the band is in view
     ax.autoscale_view()
     x0, x1 = ax.get_xlim()
     y0, y1 = ax.get_ylim()

@@ -13,7 +13,7 @@ import numpy as np
 
 __all__ = ["OUTCOME_COLOURS", "SHOWN_UNITS", "column", "quantiles", "summarised", "sweep_size", "sweep_figure",
            "histogram_names", "histograms", "charge_safety", "limit", "ricochet", "uncertainty", "depth", "pareto",
-           "validation", "hazard_maps"]
+           "validation", "VALIDATION_SIZE", "place_labels", "hazard_maps"]
 
 OUTCOME_COLOURS = {"embedded": "tab:blue", "perforated": "tab:green", "ricochet": "tab:red", "ended": "tab:grey"}
 #: the figures summarised by quantiles and histograms when present
@@ -342,23 +342,94 @@ def depth(fig, results: dict[str, list[dict]], method: str = "default") -> None:
     fig.tight_layout()
 
 
+#: validation.png's size (inches): the scatter panels square enough for eight shots' names each
+VALIDATION_SIZE = (17.0, 6.4)
+#: the offsets a point's name is tried at (points), nearest first, each in eight directions
+LABEL_RINGS = (5.0, 12.0, 22.0, 34.0, 48.0, 64.0)
+
+
+def _boxes_overlap(a, b) -> bool:
+    return a.x0 < b.x1 and b.x0 < a.x1 and a.y0 < b.y1 and b.y0 < a.y1
+
+
+def _free(box, taken, marks, frame) -> bool:
+    """The box is inside the frame, clear of the boxes taken and of every marker's centre."""
+    inside = frame.x0 <= box.x0 and box.x1 <= frame.x1 and frame.y0 <= box.y0 and box.y1 <= frame.y1
+    if not inside or any(_boxes_overlap(box, t) for t in taken):
+        return False
+    return not np.any((marks[:, 0] > box.x0) & (marks[:, 0] < box.x1) & (marks[:, 1] > box.y0)
+                      & (marks[:, 1] < box.y1))
+
+
+def place_labels(ax, xy, names, taken=(), fontsize: float = 7.5, colours=None) -> list:
+    """Name points without a collision: each name is put at the nearest offset (LABEL_RINGS, eight directions)
+    where its box overlaps no name put before, none of the boxes ``taken`` (a legend) and no marker of the axes,
+    inside the axes; beyond the first ring a thin leader line joins it to its point. Call it after the figure's
+    layout is final (the boxes are measured on its canvas).
+
+    Args:
+        ax: the axes, its points and legends drawn. xy: the points (data coordinates). names: their names.
+        taken: display-coordinate boxes to keep clear (matplotlib Bbox). fontsize: the names' size (points).
+        colours: each name's colour (its marker's, so that a name beside two markers says whose it is).
+
+    Returns:
+        The annotations (matplotlib Annotation), one per point.
+    """
+    fig = ax.figure
+    renderer = fig.canvas.get_renderer()
+    frame = ax.get_window_extent(renderer)
+    marks = [ax.transData.transform(line.get_xydata()) for line in ax.lines
+             if line.get_marker() not in (None, "None", "", " ") and len(line.get_xydata())]
+    marks = np.vstack(marks) if marks else np.zeros((0, 2))
+    taken = list(taken)
+    directions = [(math.cos(a), math.sin(a)) for a in np.radians([45, 135, -45, -135, 0, 90, 180, -90])]
+    placed = []
+    for i, ((x, y), name) in enumerate(zip(xy, names)):
+        probe = ax.annotate(name, (x, y), xytext=(0, 0), textcoords="offset points", fontsize=fontsize)
+        found = None
+        for r in LABEL_RINGS:
+            for dx, dy in directions:
+                where = {"xytext": (r * dx, r * dy), "ha": "left" if dx > 0.1 else "right" if dx < -0.1 else "center",
+                         "va": "bottom" if dy > 0.1 else "top" if dy < -0.1 else "center"}
+                probe.xyann = where["xytext"]
+                probe.set(ha=where["ha"], va=where["va"])
+                if _free(probe.get_window_extent(renderer), taken, marks, frame):
+                    found = (r, where)
+                    break
+            if found is not None:
+                break
+        probe.remove()
+        r, where = found or (LABEL_RINGS[0], {"xytext": (LABEL_RINGS[0],) * 2, "ha": "left", "va": "bottom"})
+        colour = "k" if colours is None else colours[i]
+        leader = {"arrowprops": {"arrowstyle": "-", "lw": 0.6, "color": colour, "shrinkA": 1, "shrinkB": 3}} \
+            if r > LABEL_RINGS[0] else {}
+        label = ax.annotate(name, (x, y), textcoords="offset points", fontsize=fontsize, color=colour, **where,
+                            **leader)
+        taken.append(label.get_window_extent(renderer))
+        placed.append(label)
+    return placed
+
+
 def validation(fig, rows, out) -> None:
-    """validation.png: simulated against measured (Hy, Ty), (Hx, Tx), and the nose trajectories (read from
-    each shot's history.csv in OUT; fig: 15 x 4.6 in)."""
-    ax = fig.subplots(1, 3)
+    """validation.png: simulated against measured (Hy, Ty), (Hx, Tx), each point named by its shot without a
+    collision (place_labels), and the nose trajectories (read from each shot's history.csv in OUT); fig:
+    VALIDATION_SIZE."""
+    ax = fig.subplots(1, 3, gridspec_kw={"width_ratios": [1.0, 1.0, 0.8]})
+    named = []
     for k, (a, b) in enumerate((("Hy", "Ty"), ("Hx", "Tx"))):
-        for key, mark in ((a, "o"), (b, "s")):
+        for key, mark, what in ((a, "o", "nose"), (b, "s", "tail")):
             x = [r[f"{key}_exp_mm"] for r in rows]
             y = [r[f"{key}_mm"] for r in rows]
-            ax[k].plot(x, y, mark, label=f"{key}")
-            for r, xi, yi in zip(rows, x, y):
-                ax[k].annotate(r["shot"], (xi, yi), fontsize=7)
-        lim = max(max(r[f"{a}_exp_mm"], r[f"{a}_mm"]) for r in rows) * 1.1
+            line, = ax[k].plot(x, y, mark, ms=5, label=f"{key} ({what})")
+            named += [(k, (xi, yi), r["shot"], line.get_color()) for r, xi, yi in zip(rows, x, y)]
+        lim = max(max(r[f"{c}_exp_mm"], r[f"{c}_mm"]) for r in rows for c in (a, b)) * 1.1
         ax[k].plot([0, lim], [0, lim], "k:", lw=0.8)
         ax[k].plot([0, lim], [0, 1.06 * lim], "k:", lw=0.5)
         ax[k].plot([0, lim], [0, 0.94 * lim], "k:", lw=0.5)
-        ax[k].set(xlabel="test (mm)", ylabel="simulation (mm)", title=f"{a}, {b} (dotted: ±6 %)")
-        ax[k].legend(fontsize=8)
+        ax[k].set(xlabel="test (mm)", ylabel="simulation (mm)", title=f"{a}, {b} (dotted: equal and ±6 %)",
+                  xlim=(-0.04 * lim, lim), ylim=(-0.04 * lim, lim))
+        ax[k].legend(fontsize=8, loc="upper left")
+        ax[k].grid(alpha=0.25)
     for i, r in enumerate(rows):
         d = np.genfromtxt(Path(out) / r["shot"] / "history.csv", delimiter=",", names=True)
         ax[2].plot(d["nose_x_mm"], d["nose_y_mm"], color=f"C{i}", label=r["shot"])
@@ -367,8 +438,13 @@ def validation(fig, rows, out) -> None:
     ax[2].invert_yaxis()
     ax[2].set(xlabel="x (mm)", ylabel="depth (mm)", title="nose trajectories; tests: o nose, □ tail",
               aspect="equal")
-    ax[2].legend(fontsize=7, ncol=2)
+    ax[2].legend(fontsize=8, loc="upper left", bbox_to_anchor=(1.02, 1.0), title="shot", title_fontsize=8)
     fig.tight_layout()
+    fig.canvas.draw()  # the layout final: the names are placed on it
+    for k in (0, 1):
+        legend = ax[k].get_legend().get_window_extent(fig.canvas.get_renderer())
+        mine = [n for n in named if n[0] == k]
+        place_labels(ax[k], [n[1] for n in mine], [n[2] for n in mine], [legend], colours=[n[3] for n in mine])
 
 
 def hazard_maps(fig, out) -> None:

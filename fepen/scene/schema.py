@@ -439,8 +439,9 @@ SCHEMA: dict[str, Key] = {
                                   "by h/c as it deforms; altitude: min h/c (conservative)"),
     "run.fields": flag(True, doc="write fields.xdmf + fields.h5 and the pictures made from them (elastic and "
                                  "plastic fidelities; a rigid run writes no fields)"),
-    "run.figures": flag(True, doc="draw the run's PNG figures (history.png, hazard.png, nose_profile.png, "
-                                  "stress_maps_*.png, trajectory.png, deformed.png, charge_histories.png); "
+    "run.figures": flag(True, doc="draw the run's PNG figures (history.png, attitude.png, hazard.png, "
+                                  "nose_profile.png, stress_maps_*.png, trajectory.png, deformed.png, "
+                                  "charge_histories.png); "
                                   "false: their CSV, VTU and JSON only, for sweeps of many shots (a charged "
                                   "run's report pictures from its fields are drawn regardless: they carry "
                                   "its summary's numbers)"),

@@ -94,7 +94,8 @@ class Validate(Study):
 
         rows, out = result["rows"], info.out
         hazards = all((out / r["shot"] / "hazard.csv").is_file() for r in rows)
-        return [Picture("validation.png", (15, 4.6), lambda fig: study_figures.validation(fig, rows, out), 110),
+        return [Picture("validation.png", study_figures.VALIDATION_SIZE,
+                        lambda fig: study_figures.validation(fig, rows, out), 110),
                 Picture("paths.png", paths.size(),
                         lambda fig: paths.draw(fig, {plan.scenes["C1"].effects.fidelity: out})),
                 Picture("hazard_maps.png", (12, 3.8),

@@ -70,7 +70,8 @@ def run_with_fields(tmp_path):
     """A directory that looks like a run with fields (fepen view checks for fields.xdmf first)."""
     out = tmp_path / "run"
     out.mkdir()
-    (out / "fields.xdmf").write_text("<Xdmf/>\n")
+    (out / "fields.xdmf").write_text('<Xdmf><Domain><Grid><Attribute Name="von_mises_Pa" Center="Cell"/></Grid>'
+                                     "</Domain></Xdmf>\n")
     return out
 
 
