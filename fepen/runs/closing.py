@@ -43,6 +43,7 @@ class Closing:
             self.safety = run.safety.summary(self.peaks.get("charge_acc"))
         s = run.solver
         name, out = run.shot.experiment, run.out
+        band = run.predicted(run.closing_outcome) if figures else None  # the depth interval the figures show
         jobs = []  # the figures (and stress maps' .vtu), drawn by the ranks at once: (draw, names, weight)
         if run.fields is not None:  # the cut planes at peak load and at the end, and the shot (Figs. 18, 20-21)
             jobs += [(lambda stem=stem, t=t: slices.stress_maps(out, out / f"{stem}.png", t, figures),
@@ -50,13 +51,14 @@ class Closing:
                      for stem, t in (("stress_maps_peak", self.peaks["decel"]["t_s"]), ("stress_maps_end", None))]
             if figures:
                 test = table1_shot(name) if name else None
-                jobs.append((lambda: slices.trajectory_figure(out, out / "trajectory.png", test), ("trajectory.png",),
-                             1.0))
+                jobs.append((lambda: slices.trajectory_figure(out, out / "trajectory.png", test, summary=band),
+                             ("trajectory.png",), 1.0))
         if figures:  # history.csv is whole: closed before the closing analyses
             from fepen.post import figures as figs
 
             jobs += [(hazard, ("hazard.png",), 2.0),
-                     (lambda: figs.history_figure(out, name, MPI.COMM_SELF), ("history.png",), 1.5)]
+                     (lambda: figs.history_figure(out, name, MPI.COMM_SELF, band), ("history.png", "attitude.png"),
+                      1.5)]
             run.history_drawn = True
         shared(run.comm, out, jobs)
         if run.fields is None and figures:

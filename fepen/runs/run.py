@@ -193,6 +193,7 @@ class Run:
             try:
                 self.close_outputs(completed)
                 if completed:
+                    self.closing_outcome = outcome or "ended"
                     self.write_closing()
             except BaseException as err:  # a full disk at history.csv's last write: the stop is recorded too
                 if self.stop is None:
@@ -287,15 +288,19 @@ class Run:
     summary_blocks: dict = {}
     #: history.png drawn by the closing analyses (beside the other figures), not again by write_summary
     history_drawn: bool = False
+    #: the outcome of a completed run, known to its closing analyses (their figures band its depth interval)
+    closing_outcome: str = "ended"
+
+    def predicted(self, outcome: str) -> dict:
+        """The run's validated-envelope verdict and intervals from its last history row, before its summary is
+        written: what the closing's figures band (the same figures summary.json will give)."""
+        return prediction(self.shot.envelope, outcome,
+                          results.summary(self.shot.scene, self.shot.experiment, self.rows, outcome, {}))
 
     def write_summary(self, outcome: str, loop_s: float) -> dict:
-        """The summary (summary.json when the run has a directory). The figure first (summary.json is the last
-        file of a run that ended well), and wall_s read last, just before summary.json: it covers the figure."""
-        if self.out is not None and self.shot.outputs.figures and not self.history_drawn:  # a closing drew it
-            from fepen.post import figures  # (closing.shared)
-
-            files.agree(self.comm, "history.png",
-                        lambda: figures.history_figure(self.out, self.shot.experiment, MPI.COMM_SELF))
+        """The summary (summary.json when the run has a directory). The figure, with the summary's depth interval,
+        before summary.json (the last file of a run that ended well), and wall_s read last, just before
+        summary.json: it covers the figure."""
         extra = {"steps": self.step_count, "end_time_s": self.t, "wall_s": None,  # read below, last
                  "ranks": self.comm.size, "fidelity": self.fidelity,
                  "peak_memory_bytes": files.peak_memory_bytes(self.comm)}
@@ -308,6 +313,11 @@ class Run:
         if self.crossings is not None:
             summary.update(self.crossings.summary(self.shot.law, 1e-3 * summary["depth_mm"]))
         summary.update(prediction(self.shot.envelope, outcome, summary))
+        if self.out is not None and self.shot.outputs.figures and not self.history_drawn:  # a closing drew it
+            from fepen.post import figures  # (closing.shared)
+
+            files.agree(self.comm, "history.png",
+                        lambda: figures.history_figure(self.out, self.shot.experiment, MPI.COMM_SELF, summary))
         summary["wall_s"] = self.wall_s
         _whole_process(summary, self.wall_before)
         if self.out is not None:

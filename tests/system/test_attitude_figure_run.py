@@ -31,3 +31,26 @@ def test_a_run_writes_its_attitude_figure(tmp_path, monkeypatch, fidelity):
     np.testing.assert_array_equal(axis.lines[0].get_ydata(), h["axis_angle_deg"])
     np.testing.assert_array_equal(yaw.lines[0].get_ydata(), h["yaw_deg"])
     assert abs(h["axis_angle_deg"][0] - 10.6) < 0.05  # C3: obliquity 10.5° plus its 0.1° of attack
+
+
+@pytest.mark.parametrize("fidelity", ["rigid", "plastic"])
+def test_a_fresh_runs_figures_band_the_interval_its_summary_gives(tmp_path, monkeypatch, fidelity):
+    """A run draws history.png (and a deformable run trajectory.png) before summary.json exists: the depth
+    interval they band is the one the summary then gives. Before, a fresh run's figures had no band (they read a
+    summary.json not yet written), only a figure redrawn later did."""
+    import fepen
+    from fepen.post import figures, slices
+
+    given = {}
+    real_history, real_trajectory = figures.history_figure, slices.trajectory_figure
+    monkeypatch.setattr(figures, "history_figure", lambda out, exp=None, comm=None, summary=None:
+                        given.setdefault("history", summary) and real_history(out, exp, comm, summary))
+    monkeypatch.setattr(slices, "trajectory_figure", lambda out, path, exp=None, outlines=6, summary=None:
+                        given.setdefault("trajectory", summary) and real_trajectory(out, path, exp, outlines, summary))
+    sets = {"rigid": ["effects.fidelity=rigid"],
+            "plastic": ["mesh.size=0.008", "impact.velocity=150", "impact.obliquity_deg=0", "impact.attack_deg=0"]}
+    result = fepen.run(fepen.Scene(sets=sets[fidelity]), out=tmp_path / fidelity)
+    interval = result.summary["depth_interval_mm"]
+    assert interval is not None and interval[0] < result.summary["depth_mm"] < interval[1]
+    for name in ("history",) + (("trajectory",) if fidelity == "plastic" else ()):
+        assert given[name]["depth_interval_mm"] == interval, name
