@@ -37,6 +37,7 @@ from pathlib import Path
 import numpy as np
 
 ROOT = Path(__file__).resolve().parents[1]
+sys.path.insert(0, str(ROOT))  # the fepen of this checkout (a worktree's own), for the blocks that import it
 PY = sys.executable
 RIGID = ["--set", "effects.fidelity=rigid"]
 

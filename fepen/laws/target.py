@@ -272,7 +272,7 @@ def reload_fraction(Y: float, lam: float, c_over_a: float) -> float:
     (docs/theory.md §8.7): the comminuted ring the nose left (a < r < c) has lost its cohesion and keeps its
     friction, the cracked and elastic concrete beyond c unchanged; then Forrestal and Tzou's (1997) equilibrium
     in the ring with the cohesion τ0 removed gives σ_r(a) = Y (c/a)^(αλ), α = 6/(3 + 2λ), against the intact
-    σ_s (cavity_wall_stress). 0.52 for the paper's concrete (λ 0.67, c/a 5.45); 0.46–0.57 over λ 0.5–0.8, c/a 4–6.
+    σ_s (cavity_wall_stress). 0.52 for the paper's concrete (λ 0.67, c/a 5.45); 0.45–0.59 over λ 0.5–0.8, c/a 4–6.
 
     Args:
         Y: unconfined compressive strength (Pa). lam: λ. c_over_a: the plastic zone's c/a.
