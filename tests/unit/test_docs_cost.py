@@ -103,6 +103,7 @@ def test_the_end_points_and_their_changes_coarsest_first():
     assert lines[0] == "| case | 4 mm | 2.5 mm | 1.6 mm | change 4 → 2.5 | change 2.5 → 1.6 |"
     assert lines[2:] == ["| 45° obliquity, 900 m/s | 503.6, 414.2 | 530.4, 426.4 | 556.7, 427.2 | +26.8, +12.2 | "
                          "+26.3, +0.8 |"]
+    assert [docs_cost._signed(v) for v in (-0.04, -18.94)] == ["+0.0", "−18.9"]  # no "−0.0", a true minus
 
 
 def _validation(folder: Path, nose: float, tail: float, axis: float, loss=None) -> Path:
