@@ -180,12 +180,14 @@ def hard_cases(tmp: Path) -> str:
     """The full-size table (2.5 and 4 mm, 2 ranks), its cost, and the charged shell against the empty one."""
     rows = [hard_case(c, h) for c in full_size_cases() for h in HARD_SIZES]
     text = [hard_table(rows), "", _cost_line(rows, 2)]
-    c, o = hard_case("charged_oblique_900_45", 0.0025), hard_case("oblique_900_45", 0.0025)
+    h = HARD_SIZES[0]  # the default mesh
+    c, o = hard_case("charged_oblique_900_45", h), hard_case("oblique_900_45", h)
     if c["exit"] == 0 and o["exit"] == 0:
         dy, dx = c["Hy_mm"] - o["Hy_mm"], c["Hx_mm"] - o["Hx_mm"]
-        text += ["", f"At 2.5 mm the charged projectile ends {abs(dy):.0f} mm ({100 * abs(dy) / o['Hy_mm']:.0f} %) "
-                 f"{'shallower' if dy < 0 else 'deeper'} than the empty shell, {c['Hy_mm']:.1f} against "
-                 f"{o['Hy_mm']:.1f} mm, and {abs(dx):.0f} mm {'further' if dx > 0 else 'less far'} sideways."]
+        text += ["", f"At {h * 1e3:g} mm the charged projectile ends {abs(dy):.0f} mm "
+                 f"({100 * abs(dy) / o['Hy_mm']:.0f} %) {'shallower' if dy < 0 else 'deeper'} than the empty shell, "
+                 f"{c['Hy_mm']:.1f} against {o['Hy_mm']:.1f} mm, and {abs(dx):.0f} mm "
+                 f"{'further' if dx > 0 else 'less far'} sideways."]
     return "\n".join(text)
 
 
