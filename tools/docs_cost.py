@@ -140,17 +140,12 @@ def hard_case(case: str, h: float, ranks: int = 2) -> dict:
 
 def hard_table(rows: list[dict]) -> str:
     """run_all.py's table without its wall column (the machine's, not fepen's: the blocks say it once, masked)."""
-    head = ("| case | h (mm) | outcome | energy error | steps | smallest step (ns) | Hx (mm) | Hy (mm) | Tx (mm) | "
-            "Ty (mm) | residual speed (m/s) | max PEEQ |")
-    lines = [head, "|" + "---|" * (head.count("|") - 1)]
-    for r in rows:
-        if r["exit"] == 0:
-            lines.append(f"| {r['case']} | {r['h_mm']:g} | {r['outcome']} | {r['energy_error']:.1e} | {r['steps']} | "
-                         f"{r['dt_s'] * 1e9:.1f} | {r['Hx_mm']:.1f} | {r['Hy_mm']:.1f} | {r['Tx_mm']:.1f} | "
-                         f"{r['Ty_mm']:.1f} | {r['residual_speed_m_s']:.1f} | {r['max_peeq']:.3f} |")
-        else:
-            lines.append(f"| {r['case']} | {r['h_mm']:g} | exit {r['exit']}: {r['message']} |" + " |" * 9)
-    return "\n".join(lines)
+    import importlib.util
+
+    spec = importlib.util.spec_from_file_location("run_all", md.ROOT / "demos" / "hard_cases" / "run_all.py")
+    run_all = importlib.util.module_from_spec(spec)
+    spec.loader.exec_module(run_all)
+    return "\n".join(run_all.table(rows, wall=False))
 
 
 def _cost_line(rows: list[dict], ranks: int) -> str:
