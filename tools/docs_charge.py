@@ -76,6 +76,12 @@ def _at(p) -> str:
     return "(" + ", ".join(_m(c) for c in p) + ")"
 
 
+def _span(values: list[float], digits: int = 2) -> str:
+    """A range as a page prints it, "0.23–0.24", or one figure where both ends print alike."""
+    lo, hi = f"{min(values):.{digits}f}", f"{max(values):.{digits}f}"
+    return lo if lo == hi else f"{lo}–{hi}"
+
+
 def _pct(a: float, b: float) -> float:
     """|a/b − 1| in per cent."""
     return 100 * abs(a / b - 1)
@@ -395,7 +401,7 @@ def mesh_quality(tmp: Path) -> str:
     words = f"The 0.25 h altitude goal is met at {', '.join(h for h, _ in met) or 'no size'} mm"
     if short:
         words += (f"; at {', '.join(h for h, _ in short)} mm the 2 mm wide cavity step is narrower than an element and "
-                  f"the mesh reaches {min(a for _, a in short):.2f}–{max(a for _, a in short):.2f} h")
+                  f"the mesh reaches {_span([a for _, a in short])} h")
     return "\n".join(lines) + f"\n\n{words} (fepen {md.version()})."
 
 
@@ -456,20 +462,20 @@ B = md.Block
 _DEMO = f"python {CHARGE_DEMO} --ranks 2"
 #: name -> make_docs.Block
 BLOCKS: dict = {
-    "charge-contact": B("docs/charge.md", charge_contact, 250, _DEMO),
-    "charge-mesh": B("docs/charge.md", charge_mesh, 320,
+    "charge-contact": B("docs/charge.md", charge_contact, 150, _DEMO),
+    "charge-mesh": B("docs/charge.md", charge_mesh, 60,
                      f"{_DEMO}; mpirun -n 2 fepen run {CHARGE_SCENE} --set mesh.size=0.004 --set run.fields=false"),
-    "charge-console": B("docs/charge.md", console_line, 250, _DEMO),
-    "charge-quick": B("docs/charge.md", quick_verdict, 40, f"{_DEMO} --quick"),
-    "charge-angles": B("docs/charge.md", safety_angles, 500,
+    "charge-console": B("docs/charge.md", console_line, 150, _DEMO),
+    "charge-quick": B("docs/charge.md", quick_verdict, 30, f"{_DEMO} --quick"),
+    "charge-angles": B("docs/charge.md", safety_angles, 200,
                        f"{_DEMO}; mpirun -n 2 fepen run {CHARGE_SCENE} --set run.fields=false "
                        "[--set impact.obliquity_deg=20 | --set impact.velocity=1000]"),
-    "charge-safety-mesh": B("docs/charge.md", safety_mesh, 300,
+    "charge-safety-mesh": B("docs/charge.md", safety_mesh, 200,
                             f"mpirun -n 2 fepen run {CHARGE_SCENE} --set mesh.size=H --set run.end_time=3e-4 "
                             f"--set run.fields=false (H = {', '.join(SAFETY_MESHES)})"),
-    "mesh-quality": B("docs/verification.md", mesh_quality, 60,
+    "mesh-quality": B("docs/verification.md", mesh_quality, 150,
                       f"fepen mesh --set mesh.size=H (H = {', '.join(MESH_SIZES)} mm)"),
-    "taylor": B("docs/verification.md", taylor, 90, "python demos/verification/taylor.py"),
+    "taylor": B("docs/verification.md", taylor, 130, "python demos/verification/taylor.py"),
     "rigid-checks": B("docs/verification.md", rigid_checks, 4,
                       f"fepen run {' '.join(md._sets(RICOCHET))}; fepen run {' '.join(md._sets(SLAB))}", True),
 }
