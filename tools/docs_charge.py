@@ -10,6 +10,7 @@ from __future__ import annotations
 import atexit
 import csv
 import json
+import os
 import shutil
 import subprocess
 import tempfile
@@ -53,7 +54,9 @@ def script(path: str, *args: str, ranks: int = 1, ranks_flag: bool = False) -> t
         elif r > 1:
             cmd = ["mpirun", "-n", str(r), *cmd]
         t0 = time.perf_counter()
-        p = subprocess.run(cmd, cwd=ROOT, capture_output=True, text=True)
+        path_ = os.pathsep.join(p for p in (str(ROOT), os.environ.get("PYTHONPATH", "")) if p)
+        p = subprocess.run(cmd, cwd=ROOT, capture_output=True, text=True,  # this tree's fepen, as `python -m` has
+                           env=dict(os.environ, PYTHONPATH=path_))
         if p.returncode != 0:
             raise SystemExit(f"make docs: {path} {' '.join(args)} failed (exit {p.returncode}):\n{p.stdout[-2000:]}\n"
                              f"{p.stderr[-2000:]}")
