@@ -721,7 +721,7 @@ BLOCKS = {
 
 #: the pages' blocks kept in modules of their own (tools/docs_*.py, each with BLOCKS: name -> Block), which use
 #: this module's fepen/made/figure/took
-EXTRA_MODULES = ("docs_cost", "docs_pages", "docs_theory")
+EXTRA_MODULES = ("docs_cost", "docs_pages", "docs_theory", "docs_charge")
 
 
 def _extra_blocks() -> None:
