@@ -331,8 +331,8 @@ BLOCKS = {
     "hard-refinement": md.Block("docs/hard-cases.md", hard_refinement, 800,
                                 f"mpirun -n 2 fepen run {HARD}/CASE.toml --set mesh.size=0.0016 (and 0.0012) "
                                 "--set run.fields=false, the cases below"),
-    "wear-rigid": md.Block("docs/wear.md", wear_rigid, 16,
-                           "fepen validate --set effects.fidelity=rigid [--set effects.wear=true]", True),
+    "wear-rigid": md.Block("docs/wear.md", wear_rigid, 20,
+                           "fepen validate --set effects.fidelity=rigid [--set effects.wear=true]"),
     "wear-plastic": md.Block("docs/wear.md", wear_plastic, 360,
                              "fepen validate --set run.fields=false [--set effects.wear=true]"),
 }
