@@ -7,6 +7,7 @@ One small plastic run (6 mm mesh, 60 µs) serves every test; ParaView's tests ar
 xvfb-run is not installed (the pyvista ones still run).
 """
 
+import json
 import os
 import shutil
 import subprocess
@@ -125,20 +126,26 @@ def test_the_title_names_the_field_its_unit_the_time_and_the_shot(run):
     assert paraview.view_title(run, "velocity_m_s", 0.0).startswith("velocity_m_s (m/s) at t = 0.0 µs")
 
 
-def test_the_pyvista_picture_carries_the_title(run, tmp_path, monkeypatch):
+def test_the_pyvista_picture_carries_the_title(run, tmp_path):
     """paraview.plot puts view_title's text, for the frame it drew (the output time nearest the one asked), on
-    the picture."""
-    os.environ.setdefault("VTK_DEFAULT_OPENGL_WINDOW", "vtkOSOpenGLRenderWindow")
-    import pyvista as pv
-
+    the picture. It renders in a process of its own, as every reader test does (an offscreen VTK render aborted
+    a pytest-xdist worker in CI)."""
     from fepen.post import paraview
 
-    texts = []
-    add_text = pv.Plotter.add_text
-    monkeypatch.setattr(pv.Plotter, "add_text", lambda self, text, *a, **k: texts.append(text) or
-                        add_text(self, text, *a, **k))
-    paraview.plot(run, "target_normal_stress_Pa", 2.1e-5, tmp_path / "t.png")
-    assert texts == [paraview.view_title(run, "target_normal_stress_Pa", 2e-5)]
+    code = ("import json, sys\n"
+            "import pyvista as pv\n"
+            "from fepen.post import paraview\n"
+            "texts = []\n"
+            "add_text = pv.Plotter.add_text\n"
+            "pv.Plotter.add_text = lambda self, text, *a, **k: texts.append(text) or add_text(self, text, *a, **k)\n"
+            "paraview.plot(__import__('pathlib').Path(sys.argv[1]), 'target_normal_stress_Pa', 2.1e-5, "
+            "__import__('pathlib').Path(sys.argv[2]))\n"
+            "print(json.dumps(texts))")
+    env = dict(os.environ, VTK_DEFAULT_OPENGL_WINDOW="vtkOSOpenGLRenderWindow")
+    r = subprocess.run([sys.executable, "-c", code, str(run), str(tmp_path / "t.png")], capture_output=True,
+                       text=True, env=env)
+    assert r.returncode == 0, r.stderr[-1500:]
+    assert json.loads(r.stdout.splitlines()[-1]) == [paraview.view_title(run, "target_normal_stress_Pa", 2e-5)]
     assert (tmp_path / "t.png").is_file()
 
 
