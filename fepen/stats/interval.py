@@ -25,12 +25,13 @@ from __future__ import annotations
 import functools
 import math
 from dataclasses import dataclass, field
+from statistics import NormalDist
 
 import numpy as np
 
 __all__ = ["LEVELS", "SPEED_REGIME_M_S", "DEPTH_OUTCOMES", "ErrorModel", "regime", "fit", "fit_small", "model",
            "coverage", "predict", "model_markdown", "coverage_markdown",
-           "lateral_coverage", "interval", "quantile_z"]
+           "lateral_coverage", "interval", "quantile_z", "quantile_t"]
 
 #: the interval's probabilities: 10 % and 90 %
 LEVELS = (0.1, 0.9)
@@ -46,10 +47,48 @@ def regime(speed_m_s: float) -> str:
 
 
 def quantile_z(p: float) -> float:
-    """The standard normal's quantile at p."""
-    from scipy.special import ndtri
+    """The standard normal's quantile at p (Python's own, Wichura's AS 241: a rigid run's process does not load
+    scipy for two numbers)."""
+    return NormalDist().inv_cdf(p)
 
-    return float(ndtri(p))
+
+def _t_cdf(t: float, dof: int) -> float:
+    """Student's t distribution's CDF at t for a whole number of degrees of freedom: the finite series of
+    Abramowitz and Stegun 26.7.3 (odd) and 26.7.4 (even) in theta = atan(t / sqrt(dof))."""
+    theta = math.atan(t / math.sqrt(dof))
+    s, c = math.sin(theta), math.cos(theta)
+    if dof % 2:  # odd: (2/pi) [theta + sin cos (1 + 2/3 cos^2 + 2 4/(3 5) cos^4 + ...)], the sum to cos^(dof-3)
+        term, total = 1.0, 1.0 if dof > 1 else 0.0
+        for j in range(1, (dof - 1) // 2):
+            term *= (2.0 * j) / (2.0 * j + 1.0) * c * c
+            total += term
+        a = 2.0 / math.pi * (theta + (s * c * total if dof > 1 else 0.0))
+    else:  # even: sin (1 + 1/2 cos^2 + 1 3/(2 4) cos^4 + ...), the sum to cos^(dof-2)
+        term = total = 1.0
+        for j in range(1, dof // 2):
+            term *= (2.0 * j - 1.0) / (2.0 * j) * c * c
+            total += term
+        a = s * total
+    return 0.5 + 0.5 * a
+
+
+def quantile_t(p: float, dof: int) -> float:
+    """Student's t quantile at p for a whole number of degrees of freedom (>= 1): Newton's method on _t_cdf from the
+    normal quantile, to the last few bits (tests/unit/stats: against scipy's stdtrit)."""
+    if dof < 1 or dof != int(dof):
+        raise ValueError(f"degrees of freedom: a whole number >= 1, got {dof!r}")
+    dof = int(dof)
+    if p == 0.5:
+        return 0.0
+    log_norm = math.lgamma((dof + 1) / 2.0) - math.lgamma(dof / 2.0) - 0.5 * math.log(dof * math.pi)
+    t = quantile_z(p)
+    for _ in range(100):
+        density = math.exp(log_norm - 0.5 * (dof + 1) * math.log1p(t * t / dof))
+        step = (_t_cdf(t, dof) - p) / density
+        t -= step
+        if abs(step) <= 1e-15 * max(1.0, abs(t)):
+            break
+    return t
 
 
 @dataclass(frozen=True)
@@ -83,10 +122,8 @@ class ErrorModel:
     def z(self, p: float) -> float:
         if self.t_dof is None:
             return quantile_z(p)
-        from scipy.special import stdtrit  # Student's t quantile, scipy.stats.t.ppf's own (a third of its import)
-
         n = self.shots["all"]
-        return float(stdtrit(self.t_dof, p)) * math.sqrt(1.0 + 1.0 / n)
+        return quantile_t(p, self.t_dof) * math.sqrt(1.0 + 1.0 / n)
 
     def log_bounds(self, speed_m_s: float, levels=LEVELS) -> tuple:
         """ln(M/P) at the probabilities ``levels``."""
