@@ -72,7 +72,7 @@ class Kernel:
 #: every compiled kernel fepen builds
 KERNELS = {
     "target": Kernel("laws/target_kernel.c", "laws/target_kernel.h", (), True,
-                     ("point_forces", "cavity_wall_stress", "tunnel_sectors", "strength_field")),
+                     ("point_forces", "cavity_wall_stress", "tunnel_sectors", "tunnel_probe", "strength_field")),
     "materials": Kernel("laws/materials_kernel.c", "laws/materials_kernel.h", NO_CONTRACT, True,
                         ("material_radial_return", "material_yield_stress")),
     "events": Kernel("runs/events_kernel.c", "runs/events_kernel.h", NO_CONTRACT, True, ("penetration_outcome",)),

@@ -148,14 +148,14 @@ static inline int law_at_point(const double *p, const LawConstants *c, const dou
     double frac = clip01(0.5 - (y + p[P_TOP]) / ell);
     if (p[P_LOWER] >= 0.0) frac *= clip01(0.5 + (y + p[P_LOWER]) / ell);
     if (!(frac > 0.0)) return 0;
-    double vn = normal_speed(vi, ni);
-    double speed = sqrt(vi[0] * vi[0] + vi[1] * vi[1] + vi[2] * vi[2]);
-    double sin_phi = speed > 0.0 ? vn / fmax(speed, 1e-300) : 0.0, u = 0.0;
+    double vn = normal_speed(vi, ni), u = 0.0;
     int loaded;
     if (wall) { /* in the tunnel (§8.7): loaded while it faces the wall and is pressed into it, however it moves */
         u = vi[0] * wall->er[0] + vi[1] * wall->er[1] + vi[2] * wall->er[2];
         loaded = wall_push(wall) > 0.0 && ni[0] * wall->er[0] + ni[1] * wall->er[1] + ni[2] * wall->er[2] > 0.0;
-    } else {
+    } else { /* the open face: loaded where it moves into the target, past the separation angle */
+        double speed = sqrt(vi[0] * vi[0] + vi[1] * vi[1] + vi[2] * vi[2]);
+        double sin_phi = speed > 0.0 ? vn / fmax(speed, 1e-300) : 0.0;
         loaded = sin_phi > SIN_TOL && vn > 0.0;
         /* the wake: moving backward, a point meets the open tunnel, not concrete */
         if (axis) loaded = loaded && (vi[0] * axis[0] + vi[1] * axis[1] + vi[2] * axis[2] > 0.0);
@@ -263,8 +263,10 @@ __attribute__((noinline)) static int32_t law_points(int32_t k, const double *x, 
     for (int j = 0; j < SUM_COUNT; ++j) sums[j] = 0.0;
     for (int32_t i = 0; i < k; ++i) {
         double sg = 0.0;
+        if (!may_load(v + 3 * i, n + 3 * i, T, T ? body_xi[i] : 0.0)) continue;
+        if (T && tunnel_clear(T, &end, x + 3 * i, body_xi[i])) continue; /* in the tunnel, clear of its wall */
         const double ell_i = ell ? ell[i] : sqrt(area[i]);
-        if (above_face(p, x + 3 * i, ell_i) || !may_load(v + 3 * i, n + 3 * i, T, T ? body_xi[i] : 0.0)) continue;
+        if (above_face(p, x + 3 * i, ell_i)) continue;
         WallHit hit;
         const WallHit *wall = wall_of(T, &end, x + 3 * i, T ? body_xi[i] : 0.0, &hit);
         if (!law_at_point(p, &c, x + 3 * i, v + 3 * i, n + 3 * i, area[i], ell_i, radius[i], Rm[i], sphi0[i], axis,
@@ -333,5 +335,22 @@ void tunnel_sectors(int32_t k, const double *r, const double *t, int32_t S, int3
         for (int j = 0; j < 3; ++j) u1[j] /= n1;
         double e2[3] = {ti[1] * u1[2] - ti[2] * u1[1], ti[2] * u1[0] - ti[0] * u1[2], ti[0] * u1[1] - ti[1] * u1[0]};
         q_exact[i] = tunnel_sector_exact(tdot(ri, e2), tdot(ri, u1), S);
+    }
+}
+
+/* Where k points x (k, 3) at body-axial distances xi (k) lie in the tunnel T as it is now (its shoulder and axis
+ * set): clear[i] tunnel_clear's answer, located[i] tunnel_locate's, and where located, its push delta[i] (m) and
+ * distance from the axis rho[i] (m); for the tests (the clear test never skips a point the locate would find
+ * pressed; the located distances against a curved tunnel's exact ones). */
+void tunnel_probe(const double *T, int32_t k, const double *x, const double *xi, int32_t *clear, int32_t *located,
+                  double *delta, double *rho) {
+    TunnelEnd e, f;
+    tunnel_end(T, &e);
+    tunnel_end(T, &f);
+    for (int32_t i = 0; i < k; ++i) {
+        double er[3];
+        int32_t kn, sec;
+        clear[i] = tunnel_clear(T, &e, x + 3 * i, xi[i]);
+        located[i] = tunnel_locate(T, &f, x + 3 * i, xi[i], delta + i, er, &kn, &sec, rho + i);
     }
 }

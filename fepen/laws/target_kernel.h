@@ -35,4 +35,8 @@ int32_t strength_field(int32_t k, const double *x, const double *p, double *out)
 /* the tunnel's sectors of k offsets, by the polynomial and by atan2 alone (the tests) */
 void tunnel_sectors(int32_t k, const double *r, const double *t, int32_t S, int32_t *q, int32_t *q_exact);
 
+/* where k points lie in the tunnel: tunnel_clear's and tunnel_locate's answers, the push and distance (the tests) */
+void tunnel_probe(const double *T, int32_t k, const double *x, const double *xi, int32_t *clear, int32_t *located,
+                  double *delta, double *rho);
+
 #endif

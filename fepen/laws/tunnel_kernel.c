@@ -104,23 +104,29 @@ static void tunnel_at(const double *T, double s, const double *c_end, const doub
 }
 
 /* The open end of one call's tunnel (tunnel_open_end), computed once per call after the station is recorded:
- * every point of the call is located against the same end. hint: the station the call's last point was found
- * at (-1: none yet); the points of a call come ring by ring, so the next one's station is near it and the search
- * starts there (the same station however it is searched: no bit changes). */
+ * every point of the call is located against the same end. hint: the station the call's last ring was found at
+ * (-1: none yet). The points of a call come ring by ring (the points of a ring share their distance xi behind the
+ * tip); a ring is located once (tunnel_ring): its centre on the body's axis projected onto the tunnel's axis, the
+ * station there, the sector frame e1 of that station's direction. Its points are then measured against that
+ * place alone: their offsets from the axis, their sectors, the wall's radius there. */
 typedef struct {
     double c[3], t[3], s;
     int32_t hint;
-    /* the last point's first guess (tunnel_locate): its arc length and where it lies. The points of a ring share
-     * their distance behind the tip, so the ring's points after the first take it as it is (a station's place
-     * depends on s alone, and a call changes no station's place: the same numbers, once a ring) */
-    double guess_s;
-    TunnelAt guess;
-    int32_t has_guess;
+    /* the last ring: its xi, where it lies, the sector frame there (e1, not of unit length, n1sq = e1 . e1) */
+    double ring_xi;
+    TunnelAt ring;
+    double e1[3], n1sq;
+    /* the square of the smallest push a point of the ring may have and still be clear of the wall (tunnel_clear) */
+    double clear2;
+    /* the ring's arc length, and how far along the path from the ring's centre a point may lie and still be
+     * measured where its ring lies (RING_REACH of the spacing; beyond, at its own place) */
+    double ring_s, reach;
+    int32_t has_ring;
 } TunnelEnd;
 
 static inline void tunnel_end(const double *T, TunnelEnd *e) {
     e->hint = -1;
-    e->has_guess = 0;
+    e->has_ring = 0;
     if ((int32_t)T[T_M] >= 1) tunnel_open_end(T, e->c, e->t, &e->s);
 }
 
@@ -171,49 +177,107 @@ static inline int32_t tunnel_sector(const double *r, const double *t, double *e1
     return tunnel_sector_exact(tdot(r, e2u), tdot(r, e1), S);
 }
 
-/* A point p at body-axial distance xi in the tunnel (e: its open end, tunnel_end): returns 1 with its penetration
- * of the wall delta (m), the outward unit vector er, its nearest recorded station kn (-1: the open end) and sector
- * sec and its distance rho from the axis; 0 when it is not in the tunnel (ahead of the shoulder, no station yet,
- * or on the axis). */
-static int tunnel_locate(const double *T, TunnelEnd *e, const double *p, double xi, double *delta,
-                         double *er, int32_t *kn, int32_t *sec, double *rho) {
-    const int32_t m = (int32_t)T[T_M], S = (int32_t)T[T_S];
-    if (m < 1) return 0;
-    const double *c_end = e->c, *t_end = e->t, s_end = e->s;
-    double s = s_end - (xi - T[T_XI_SH]);
+/* A point of a ring within this fraction of the station spacing of the ring's centre, along the path, is measured
+ * where its ring lies (its station, sector frame and wall radii the ring's); one farther (a body turned across its
+ * tunnel: a point A0 sin psi from the centre) where it lies itself, as every point was before issue 62 */
+#define RING_REACH 0.05
+
+/* Where the ring at body-axial distance xi lies in the tunnel (e: its open end): its centre on the body's axis
+ * now (the shoulder's centre less xi - xi_sh along the body's axis), the station at that centre's arc length (its
+ * distance behind the shoulder along the path, then one projection onto the axis there: a body turned in its
+ * tunnel), the sector frame of that station's direction. Returns 0 when the ring is ahead of the shoulder (the
+ * nose). */
+static int tunnel_ring(const double *T, TunnelEnd *e, double xi) {
+    const double c_end[3] = {e->c[0], e->c[1], e->c[2]}, s_end = e->s, back = xi - T[T_XI_SH];
+    double s = s_end - back;
     if (s > s_end) return 0; /* ahead of the shoulder: the nose */
     const double s0 = tunnel_station((double *)T, 0)[T_ARC];
     if (s < s0) s = s0;
     TunnelAt at;
-    if (e->has_guess && s == e->guess_s) {
-        at = e->guess;
-    } else {
-        tunnel_at(T, s, c_end, t_end, s_end, e->hint, &at);
-        e->guess_s = s;
-        e->guess = at;
-        e->has_guess = 1;
-    }
-    double d[3] = {p[0] - at.c[0], p[1] - at.c[1], p[2] - at.c[2]};
-    s += tdot(d, at.t); /* one projection onto the axis: a body turned in its tunnel */
+    tunnel_at(T, s, c_end, e->t, s_end, e->hint, &at);
+    double d[3]; /* the ring's centre on the body's axis, against the station's centre */
+    for (int j = 0; j < 3; ++j) d[j] = T[T_CS + j] - back * T[T_TS + j] - at.c[j];
+    s += tdot(d, at.t);
     if (s > s_end) s = s_end;
     if (s < s0) s = s0;
-    tunnel_at(T, s, c_end, t_end, s_end, at.ia, &at); /* near the first: its station is the hint */
-    e->hint = at.ia;
-    for (int j = 0; j < 3; ++j) d[j] = p[j] - at.c[j];
-    double along = tdot(d, at.t), r[3];
-    for (int j = 0; j < 3; ++j) r[j] = d[j] - along * at.t[j];
+    tunnel_at(T, s, c_end, e->t, s_end, at.ia, &e->ring);
+    e->ring_s = s;
+    e->reach = RING_REACH * T[T_SPACING];
+    e->hint = e->ring.ia;
+    e->n1sq = tunnel_e1(e->ring.t, e->e1);
+    /* the wall's smallest radius about the ring (over its sectors), and a point's distance from the axis below
+     * which it cannot press the wall: wall_push's round-off width added, then 1e-12 of it taken off, so that the
+     * few roundings of tunnel_locate's delta never decide otherwise */
+    const int32_t m = (int32_t)T[T_M], S = (int32_t)T[T_S];
+    const double *lo = tunnel_station((double *)T, e->ring.ia) + T_STATION;
+    const double *hi = e->ring.ib < m ? tunnel_station((double *)T, e->ring.ib) + T_STATION : NULL;
+    double amin = INFINITY;
+    for (int32_t q = 0; q < S; ++q) {
+        const double a = lo[q] + e->ring.w * ((hi ? hi[q] : T[T_A0]) - lo[q]);
+        if (a < amin) amin = a;
+    }
+    const double clear = (amin + 1e-9 * T[T_A0]) * (1.0 - 1e-12);
+    e->clear2 = clear > 0.0 ? clear * clear : 0.0;
+    e->ring_xi = xi;
+    e->has_ring = 1;
+    return 1;
+}
+
+/* 1 when the point p at body-axial distance xi is in the tunnel and certainly not pressed into its wall (its
+ * distance from the ring's axis below the wall's smallest radius there and a round-off's width: tunnel_locate
+ * would find it so, and the law would not load it), else 0 (ahead of the shoulder, no station yet, near the axis,
+ * or maybe pressed: tunnel_locate decides). No square root, no division: most of a body in its own tunnel is
+ * clear of it, and the law's loops skip those points with this test alone. The 1e-9 is wall_push's WALL_TOL. */
+static inline int tunnel_clear(const double *T, TunnelEnd *e, const double *p, double xi) {
+    if ((int32_t)T[T_M] < 1) return 0;
+    if (!(e->has_ring && xi == e->ring_xi) && !tunnel_ring(T, e, xi)) return 0;
+    const TunnelAt *at = &e->ring;
+    const double d[3] = {p[0] - at->c[0], p[1] - at->c[1], p[2] - at->c[2]};
+    const double along = tdot(d, at->t);
+    if (fabs(along) > e->reach) return 0; /* measured at its own place: tunnel_locate decides */
+    const double r[3] = {d[0] - along * at->t[0], d[1] - along * at->t[1], d[2] - along * at->t[2]};
+    const double r2 = tdot(r, r);
+    return r2 < e->clear2 && r2 > 2e-24;
+}
+
+/* A point p at body-axial distance xi in the tunnel (e: its open end, tunnel_end): returns 1 with its penetration
+ * of the wall delta (m), the outward unit vector er, its nearest recorded station kn (-1: the open end) and sector
+ * sec and its distance rho from the axis; 0 when it is not in the tunnel (ahead of the shoulder, no station yet,
+ * or on the axis). The point is measured where its ring lies (tunnel_ring, once a ring). */
+static int tunnel_locate(const double *T, TunnelEnd *e, const double *p, double xi, double *delta,
+                         double *er, int32_t *kn, int32_t *sec, double *rho) {
+    const int32_t m = (int32_t)T[T_M], S = (int32_t)T[T_S];
+    if (m < 1) return 0;
+    if (!(e->has_ring && xi == e->ring_xi) && !tunnel_ring(T, e, xi)) return 0;
+    const TunnelAt *at = &e->ring;
+    TunnelAt own;
+    double d[3] = {p[0] - at->c[0], p[1] - at->c[1], p[2] - at->c[2]};
+    double along = tdot(d, at->t), r[3], e1[3], n1sq;
+    if (fabs(along) > e->reach) { /* far along the path from its ring's centre: located at its own place */
+        const double s0 = tunnel_station((double *)T, 0)[T_ARC];
+        double s = e->ring_s + along;
+        if (s > e->s) s = e->s;
+        if (s < s0) s = s0;
+        tunnel_at(T, s, e->c, e->t, e->s, at->ia, &own);
+        at = &own;
+        for (int j = 0; j < 3; ++j) d[j] = p[j] - at->c[j];
+        along = tdot(d, at->t);
+        n1sq = tunnel_e1(at->t, e1);
+    } else {
+        for (int j = 0; j < 3; ++j) e1[j] = e->e1[j];
+        n1sq = e->n1sq;
+    }
+    for (int j = 0; j < 3; ++j) r[j] = d[j] - along * at->t[j];
     double rr = sqrt(tdot(r, r));
     if (!(rr > 1e-12)) return 0;
     for (int j = 0; j < 3; ++j) er[j] = r[j] / rr;
-    double e1[3]; /* the sector: the angle of r about t from e1 */
-    const double n1sq = tunnel_e1(at.t, e1);
-    const int32_t q = tunnel_sector(r, at.t, e1, n1sq, S);
-    double a_lo = tunnel_station((double *)T, at.ia)[T_STATION + q];
-    double a_hi = at.ib < m ? tunnel_station((double *)T, at.ib)[T_STATION + q] : T[T_A0];
-    *delta = rr - (a_lo + at.w * (a_hi - a_lo));
+    const int32_t q = tunnel_sector(r, at->t, e1, n1sq, S); /* the sector: the angle of r about t from e1 */
+    double a_lo = tunnel_station((double *)T, at->ia)[T_STATION + q];
+    double a_hi = at->ib < m ? tunnel_station((double *)T, at->ib)[T_STATION + q] : T[T_A0];
+    *delta = rr - (a_lo + at->w * (a_hi - a_lo));
     *rho = rr;
     *sec = q;
-    *kn = at.w < 0.5 ? at.ia : (at.ib < m ? at.ib : -1);
+    *kn = at->w < 0.5 ? at->ia : (at->ib < m ? at->ib : -1);
     return 1;
 }
 

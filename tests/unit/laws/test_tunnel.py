@@ -195,3 +195,104 @@ def test_the_sector_is_atan2s_sector_everywhere_and_at_every_edge():
         r = np.cos(ang).ravel()[:, None] * np.array(e1) + np.sin(ang).ravel()[:, None] * np.array(e2)
         q, qe = sectors(r * 0.0118, np.tile(axis, (len(r), 1)))
         assert np.array_equal(q, qe)
+
+
+RC = 3.0  # the curved tunnel's radius of curvature (m)
+
+
+def curved_tunnel(depth=0.5):
+    """A tunnel dug along a circular arc of radius RC in the x-y plane: from the face straight down, bending toward
+    +x (its centre at (RC, 0, 0)), the shoulder's axis along the arc's tangent; returns it and the arc's angle at
+    its end."""
+    t = Tunnel(XI_SH, A0)
+    none = np.zeros((0, 3))
+    for s in np.arange(1e-4, depth, 0.2 * A0):
+        th = s / RC
+        t.at(np.array([RC - RC * math.cos(th), -RC * math.sin(th), 0.0]), np.array([math.sin(th), -math.cos(th), 0.0]))
+        t.commit = True
+        tg.point_forces(LAW, none, none, none, np.zeros(0), np.zeros(0), np.zeros(0), np.zeros(0), DOWN, t,
+                        np.zeros(0))
+    return t, s / RC
+
+
+def on_the_arc(th_end, offset, tilt_deg, rings=30, per_ring=24, length=0.12):
+    """A shank of radius A0 whose shoulder is on the arc at its end, moved sideways by offset (m, toward +x across
+    the path) and tilted by tilt_deg about z: its points, their xi, the shoulder and the axis."""
+    sh = np.array([RC - RC * math.cos(th_end), -RC * math.sin(th_end), 0.0])
+    tangent = np.array([math.sin(th_end), -math.cos(th_end), 0.0])
+    across = np.array([math.cos(th_end), math.sin(th_end), 0.0])
+    sh = sh + offset * across
+    c, s = math.cos(math.radians(tilt_deg)), math.sin(math.radians(tilt_deg))
+    axis, e1 = c * tangent + s * across, -s * tangent + c * across
+    xi = XI_SH + (np.arange(rings) + 0.5) * length / rings
+    phi = (np.arange(per_ring) + 0.5) * 2 * math.pi / per_ring
+    XI, PHI = np.meshgrid(xi, phi, indexing="ij")
+    n = (np.cos(PHI)[..., None] * e1 + np.sin(PHI)[..., None] * np.array([0.0, 0.0, 1.0])).reshape(-1, 3)
+    return sh - (XI - XI_SH).reshape(-1, 1) * axis + A0 * n, XI.ravel(), sh, axis
+
+
+def probe(t, x, xi, sh, axis):
+    from fepen import native
+
+    t.at(sh, axis)
+    k = len(x)
+    x, xi = np.ascontiguousarray(x, dtype=float), np.ascontiguousarray(xi, dtype=float)
+    clear, located = np.zeros(k, np.int32), np.zeros(k, np.int32)
+    delta, rho = np.full(k, np.nan), np.full(k, np.nan)
+    native.kernel("target").tunnel_probe(t.buf.ctypes.data, k, x.ctypes.data, xi.ctypes.data, clear.ctypes.data,
+                                         located.ctypes.data, delta.ctypes.data, rho.ctypes.data)
+    return clear.astype(bool), located.astype(bool), delta, rho
+
+
+@pytest.mark.parametrize("offset, tilt", [(0.0, 0.0), (2e-4, 0.0), (-5e-4, 1.0), (1e-3, -2.0), (1e-9, 0.3)])
+def test_the_clear_test_skips_no_point_the_wall_would_load(offset, tilt):
+    """tunnel_clear lets the law's loops skip a point without a square root or a division: every point it calls
+    clear is one tunnel_locate finds in the tunnel and not pressed past wall_push's round-off width, on a curved
+    tunnel with the body centred, moved off its axis and tilted (and a point it does not call clear is left to
+    the locate, which decides)."""
+    t, th = curved_tunnel()
+    x, xi, sh, axis = on_the_arc(th, offset, tilt)
+    clear, located, delta, _ = probe(t, x, xi, sh, axis)
+    assert located.all()
+    assert np.all(delta[clear] - 1e-9 * A0 <= 0.0)
+    if offset or tilt:  # off the axis: one side clear of the wall, the other pressed into it (a point turned far
+        # across the path from its ring's centre is located at its own place, and the clear test leaves it be)
+        assert clear.sum() > 0.2 * len(x) and (delta - 1e-9 * A0 > 0.0).sum() > 0.2 * len(x)
+
+
+@pytest.mark.parametrize("tilt", [0.0, 1.0, -3.0])
+def test_a_point_is_measured_against_the_curved_axis(tilt):
+    """A point's distance from the axis of a tunnel dug along an arc of radius RC, located where its ring lies,
+    against its exact distance from the arc: within twice the chords' sag (spacing^2 / 8 RC: the stations' centres
+    joined by straight lines, the distance taken across the interpolated direction, not the chord's) and the
+    ring's reach along the path (a point of a ring tilted by psi lies A0 sin psi along the path from the ring's
+    centre, where the axis has turned by A0 sin psi / RC: A0 (A0 sin psi) / RC),
+    docs/theory.md §8.7. Behind the last station only: ahead of it the tunnel ends at the shoulder where it is."""
+    t, th = curved_tunnel()
+    x, xi, sh, axis = on_the_arc(th, 0.0, tilt)
+    _, located, _, rho = probe(t, x, xi, sh, axis)
+    assert located.all()
+    exact = np.hypot(np.hypot(x[:, 0] - RC, x[:, 1]) - RC, x[:, 2])
+    st = t.stations()
+    gap = math.hypot(*(sh - st["centre"][-1]))  # from the last station to the shoulder
+    behind = xi - XI_SH > gap
+    assert behind.sum() > len(x) // 2
+    chord = np.diff(st["s"]).max()
+    bound = chord**2 / (4 * RC) + A0 * A0 * math.sin(math.radians(abs(tilt))) / RC + 1e-12
+    assert np.abs(rho - exact)[behind].max() <= bound
+    assert bound < 1e-3 * A0  # at most a dozen micrometres
+
+
+@pytest.mark.parametrize("delta", [0.0, 5e-12, 2e-11, 1e-10, 1e-9, 1e-8])
+def test_the_clear_test_at_the_round_off_width(delta):
+    """A centred body moved sideways by delta in a straight tunnel of its own radius: pressed by delta on one side,
+    which the wall loads only past wall_push's round-off width (1e-9 of the radius, 1.2e-11 m). The clear test
+    calls clear exactly what the locate leaves unpressed there too, from 0 to a thousand widths."""
+    t = straight_tunnel()
+    x, _, _, _, xi, sh, axis = sideways(delta)
+    clear, located, d, _ = probe(t, x, xi, sh, axis)
+    assert located.all()
+    pressed = d - 1e-9 * A0 > 0.0
+    assert not np.any(clear & pressed)
+    assert pressed.any() == (delta > 1.5e-11)  # pressed only past the width
+    assert clear.sum() >= len(x) // 2 - 48  # the far side and the flanks are clear
