@@ -430,12 +430,20 @@ def values(run, t: float, s) -> list:
         ValueError: the snapshot carries a body column that no group the run writes declares.
     """
     row = Row(t, s, run)
-    groups = [g for g in HISTORY if g.on(run)]
-    if s.extra:
-        undeclared = set(s.extra) - {n for g in groups for q in g.quantities if q.value is None for n in q.names}
-        if undeclared:
-            raise ValueError(f"history columns written but not declared in fepen.io.columns: {sorted(undeclared)}")
-    return [v for g in groups for q in g.quantities for v in q.values(row)]
+    cached = getattr(run, "_history_quantities", None)
+    if cached is None:  # the run's groups, as its header has them (fixed when history.csv is opened): once a run
+        groups = [g for g in HISTORY if g.on(run)]
+        cached = ([q for g in groups for q in g.quantities],
+                  frozenset(n for g in groups for q in g.quantities if q.value is None for n in q.names))
+        try:
+            run._history_quantities = cached
+        except AttributeError:  # a run that keeps no attributes: computed each row
+            pass
+    quantities, declared = cached
+    if s.extra and not declared.issuperset(s.extra):
+        raise ValueError("history columns written but not declared in fepen.io.columns: "
+                         f"{sorted(set(s.extra) - declared)}")
+    return [v for q in quantities for v in q.values(row)]
 
 
 def markdown(groups=HISTORY, width: int = 115, file: str = "history.csv") -> str:
