@@ -4,6 +4,9 @@ cache empty (a fresh machine) and with every cache warm, for this tree and a bas
     .venv/bin/python benchmarks/latency.py [--baseline REV] [--ranks 2] [--repeats 2] [--set KEY=VALUE ...]
         [--warm-only]
 
+The rigid shot (issue 62's second figure, a rigid C3 process): ``--ranks 1 --set effects.fidelity=rigid --set
+run.fields=false --set run.figures=false``: one rank is started as a user starts it, without mpirun.
+
 Each run is a whole ``mpirun -n RANKS python -m fepen run scenes/default.toml`` process, timed from outside,
 with the settings given (``--set mesh.size=0.0012 --set run.fields=false --warm-only``: issue 48's second
 figure, the loop in ns per cell-step·core, loop × ranks / (cells × steps), beside the baseline). The ranks
@@ -40,7 +43,9 @@ def one(tree: Path, caches: Path, ranks: int, sets: list[str] = ()) -> dict:
                FEPEN_KERNEL_CACHE=str(caches / "kernels"), NUMBA_CACHE_DIR=str(caches / "numba"),
                XDG_CACHE_HOME=str(caches / "xdg"), MPLCONFIGDIR=str(caches / "mpl"), FEPEN_PROGRESS="0")
     env.pop("OMPI_MCA_mpi_yield_when_idle", None)
-    cmd = ["mpirun", "-n", str(ranks), sys.executable, "-m", "fepen", "run", str(tree / "scenes" / "default.toml"),
+    env.pop("PYTHONDONTWRITEBYTECODE", None)  # a user's Python keeps its compiled modules
+    launcher = ["mpirun", "-n", str(ranks)] if ranks > 1 else []  # one rank: started as a user starts a rigid shot
+    cmd = [*launcher, sys.executable, "-m", "fepen", "run", str(tree / "scenes" / "default.toml"),
            "--out", str(out), "--force", *[a for kv in sets for a in ("--set", kv)]]
     t0 = time.perf_counter()
     r = subprocess.run(cmd, cwd=tree, env=env, capture_output=True, text=True)
@@ -52,7 +57,8 @@ def one(tree: Path, caches: Path, ranks: int, sets: list[str] = ()) -> dict:
     split = s.get("time_split_s", {})
     return {"whole_s": whole, "loop_s": split.get("time_loop", float("nan")), "mesh_s": split.get("mesh", 0.0),
             "setup_s": split.get("setup_jit", 0.0), "output_s": split.get("output", 0.0), "Hy_mm": s["Hy_mm"],
-            "steps": s["steps"], "ns": 1e9 * split.get("time_loop", float("nan")) * ranks / (s["cells"] * s["steps"])}
+            "steps": s["steps"], "ns": (1e9 * split.get("time_loop", float("nan")) * ranks / (s["cells"] * s["steps"])
+                                        if s["cells"] > 1 else float("nan"))}
 
 
 def measure(tree: Path, label: str, ranks: int, repeats: int, sets: list[str] = (), warm_only: bool = False
@@ -99,7 +105,7 @@ def main(argv=None) -> int:
     print(f"{'tree':24s} {'caches':6s} {'whole_s':>8} {'loop_s':>7} {'ratio':>6} {'mesh_s':>7} {'setup_s':>8} "
           f"{'output_s':>8} {'steps':>6} {'ns/cell-step-core':>17} {'Hy_mm':>8}")
     for r in rows:
-        print(f"{r['tree']:24s} {r['caches']:6s} {r['whole_s']:8.1f} {r['loop_s']:7.1f} "
+        print(f"{r['tree']:24s} {r['caches']:6s} {r['whole_s']:8.3f} {r['loop_s']:7.3f} "
               f"{r['whole_s'] / r['loop_s']:6.2f} {r['mesh_s']:7.2f} {r['setup_s']:8.2f} {r['output_s']:8.2f} "
               f"{r['steps']:6d} {r['ns']:17.1f} {r['Hy_mm']:8.2f}")
     return 0
