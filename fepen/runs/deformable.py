@@ -272,15 +272,7 @@ class DeformableRun(Run):
                 "stress_kernel": s.kernel, "step_gain": s.clock.step_gain, **self.closing.summary(),
                 "acceleration_filter": o.acceleration_filter,
                 "acceleration_filter_hz": signals.corner_hz(o.acceleration_filter, o.acceleration_filter_hz),
-                "communication": self.communication()}
-
-    def communication(self) -> dict:
-        """summary.json's ``communication`` block (collective): the exchanges of the time loop so far, per rank,
-        and the model's bytes a step from this partition (fepen.solver.traffic)."""
-        s = self.solver
-        sent = getattr(self.load, "sent_terms", 0)
-        model_bytes = traffic.step_bytes(s.ghosts, len(s.materials), sent, self.comm.size)
-        return traffic.block(self.comm, s.n_cells, len(getattr(self.load, "last_X", ())), s.ghosts.reverse, model_bytes)
+                "communication": traffic.of_run(self.comm, self.solver, self.load)}
 
     def stop_extra(self) -> dict:
         return {"mass_kg": self.solver.total_mass}

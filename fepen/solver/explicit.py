@@ -141,22 +141,6 @@ class ExplicitSolver:
         self.total_mass = assembly.exact_sum(self.mass[: self.n_owned], self.comm)
 
     # ------------------------------------------------------------------------------------------------
-    def _ghost_sum(self, vec) -> None:
-        """The nodal volumes' ghost terms added to their owners, the sums sent back to the ghosts (counted:
-        fepen.solver.traffic's ``volumes``)."""
-        t0 = perf_counter()
-        dx.scatter_reverse_add(vec)
-        vec.scatter_forward()
-        g = self.ghosts
-        traffic.count("volumes", 2, traffic.WORD * len(self.materials) * (g.reverse + g.forward),
-                      g.reverse_ranks + g.forward_ranks, t0)
-
-    def _forces_to_owners(self) -> None:
-        """The internal forces' ghost terms added to their owners (ghost rows stale; counted: ``forces``)."""
-        t0 = perf_counter()
-        dx.scatter_reverse_add(self.node.fint_fn.x)
-        traffic.count("forces", 1, 3 * traffic.WORD * self.ghosts.reverse, self.ghosts.reverse_ranks, t0)
-
     def volumes_to_nodes(self, cvol: np.ndarray, vec) -> None:
         """Nodal volumes per material (the vector vec), Σ V_e / 4 over live cells, the terms on the volume
         grid (exact sums: the same on any partition), ghosts summed and refreshed."""
@@ -166,7 +150,7 @@ class ExplicitSolver:
                                               arr)
         else:
             kernels.grid_scatter(self.dofs, self.mat, cvol.reshape(-1, 1, 1), False, self.internal.volume_quantum, arr)
-        self._ghost_sum(vec)
+        _ghost_sum(self, vec)
 
     def _cells_to_nodes(self, Fc: np.ndarray, out: np.ndarray) -> None:
         """The cells' nodal forces Fc (n_cells, 4, 3) summed into out (n_nodes, 3), the terms on the force
@@ -175,7 +159,7 @@ class ExplicitSolver:
             self.passes.nodes.scatter_forces(self.passes.cells.dofs32, Fc, self.internal.force_quantum, out)
         else:
             kernels.grid_scatter(self.dofs, self.mat, Fc, True, self.internal.force_quantum, out)
-        self._forces_to_owners()
+        _forces_to_owners(self)
 
     def positions(self) -> np.ndarray:
         """Current node positions (n_nodes, 3), ghosts included."""
@@ -272,14 +256,14 @@ class ExplicitSolver:
             jmin, worst, h_c, self.cell.step_cell = cells.kinematics(with_step, q_vol)  # the inverted cells eroded
             if self._any_inverted(jmin):
                 failures.inverted(self, x, jmin, worst)
-        self._ghost_sum(self.node.nvol)
+        _ghost_sum(self, self.node.nvol)
         t1 = perf_counter()
         self.passes.nodes.nodal_pressure(self.node.vol, self.node.vol0, self.cell.bulk, self.nodal_p)
         cells.cells(dt, q_force)  # and the cells' forces summed at the nodes
         self.sums.plastic += self.sums.totals[0]
         self.sums.heat += self.sums.totals[1]
         t2 = perf_counter()
-        self._forces_to_owners()  # ghost terms to their owners (ghost rows stale)
+        _forces_to_owners(self)  # ghost terms to their owners (ghost rows stale)
         t3 = perf_counter()
         self._external_forces()
         self.clock.times.add(t0, t1, t2, t3, perf_counter())
@@ -390,6 +374,24 @@ class ExplicitSolver:
             reference.rebuild(self, np.arange(self.n_cells))
             self.internal.P_packed[: self.n_cells][self.mat < 0] = 0.0
             self.sums.removed[:] = removed
+
+
+def _ghost_sum(s: ExplicitSolver, vec) -> None:
+    """The nodal volumes' ghost terms added to their owners, the sums sent back to the ghosts (counted:
+    fepen.solver.traffic's ``volumes``)."""
+    t0 = perf_counter()
+    dx.scatter_reverse_add(vec)
+    vec.scatter_forward()
+    g = s.ghosts
+    traffic.count("volumes", 2, traffic.WORD * len(s.materials) * (g.reverse + g.forward),
+                  g.reverse_ranks + g.forward_ranks, t0)
+
+
+def _forces_to_owners(s: ExplicitSolver) -> None:
+    """The internal forces' ghost terms added to their owners (ghost rows stale; counted: ``forces``)."""
+    t0 = perf_counter()
+    dx.scatter_reverse_add(s.node.fint_fn.x)
+    traffic.count("forces", 1, 3 * traffic.WORD * s.ghosts.reverse, s.ghosts.reverse_ranks, t0)
 
 
 def _get(s: ExplicitSolver, where: str):

@@ -34,7 +34,7 @@ from time import perf_counter
 import numpy as np
 
 __all__ = ["KINDS", "STEP_KINDS", "Counter", "Ledger", "LEDGER", "reset", "count", "rounds", "step_done", "GhostPlan",
-           "step_bytes", "block", "imbalance", "Machine", "step_time", "largest_run"]
+           "step_bytes", "block", "of_run", "imbalance", "Machine", "step_time", "largest_run"]
 
 #: the exchanges counted, in the order the summary lists them
 KINDS = ("volumes", "forces", "accelerations", "load_points", "inverted", "nose_axis", "tunnel", "stable_step",
@@ -168,6 +168,18 @@ def block(comm, cells: int, load_points: int, ghosts: int, model_bytes: int) -> 
             "wait_s_per_step": [w / steps for w in total_wait],
             "exchanges": [{"name": k, "calls": [r[4][i][0] for r in ranks], "bytes": [r[4][i][1] for r in ranks],
                            "wait_s": [r[4][i][2] for r in ranks]} for i, k in enumerate(KINDS)]}
+
+
+def of_run(comm, solver, load) -> dict:
+    """summary.json's ``communication`` block of a deformable run (collective): ``block`` with the solver's
+    cells and ghosts, the load's points (a rigid wall: none) and the model's bytes a step from this partition.
+
+    Args:
+        comm: the run's communicator. solver: its ExplicitSolver. load: its external load.
+    """
+    sent = getattr(load, "sent_terms", 0)
+    model_bytes = step_bytes(solver.ghosts, len(solver.materials), sent, comm.size)
+    return block(comm, solver.n_cells, len(getattr(load, "last_X", ())), solver.ghosts.reverse, model_bytes)
 
 
 # -----------------------------------------------------------------------------------------------------------
