@@ -190,25 +190,30 @@ class Machine:
     """The model's constants.
 
     Attributes:
-        t_cell_s: wall seconds of one cell's step on one core (its load points included).
+        t_cell_s: wall seconds of one cell's step on one core (its share of the load points included).
         alpha_s: a message's latency (s). beta_B_s: the bandwidth (bytes/s).
-        reductions: allreduces per step (each ceil(log2 ranks) latencies).
+        t_step_s: a step's fixed wall seconds on every rank, whatever its cells (the interpreter's dispatch of the
+            step's passes, the load's and the clock's arithmetic).
+        reductions: allreduces per step (each ceil(log2 ranks) latencies): the inverted flag, the nose axis, the
+            tunnel, a quarter of the stable step's.
     """
 
     t_cell_s: float
     alpha_s: float
     beta_B_s: float
+    t_step_s: float = 0.0
     reductions: float = 3.25
 
 
 def step_time(m: Machine, cells: float, ranks: int, imbalance_: float, messages: float, nbytes: float) -> float:
-    """Wall seconds of a step: the busiest rank's cells, its messages and bytes, the allreduces' rounds.
+    """Wall seconds of a step: the fixed part, the busiest rank's cells, its messages and bytes, the allreduces'
+    rounds.
 
     Args:
         m: the Machine. cells: all cells. ranks: ranks. imbalance_: the busiest rank's work over the mean.
         messages, nbytes: the busiest rank's messages and bytes a step.
     """
-    return (imbalance_ * cells / ranks * m.t_cell_s + messages * m.alpha_s + nbytes / m.beta_B_s
+    return (m.t_step_s + imbalance_ * cells / ranks * m.t_cell_s + messages * m.alpha_s + nbytes / m.beta_B_s
             + m.reductions * rounds(ranks) * m.alpha_s)
 
 

@@ -30,10 +30,10 @@ def test_rounds_and_imbalance():
 
 
 def test_step_time_adds_the_busiest_ranks_cells_its_messages_and_the_reductions():
-    m = traffic.Machine(t_cell_s=1e-7, alpha_s=2e-6, beta_B_s=1e9, reductions=3.0)
+    m = traffic.Machine(t_cell_s=1e-7, alpha_s=2e-6, beta_B_s=1e9, t_step_s=5e-4, reductions=3.0)
     t = traffic.step_time(m, cells=1e6, ranks=8, imbalance_=1.1, messages=10, nbytes=5e5)
-    assert t == pytest.approx(1.1 * 1e6 / 8 * 1e-7 + 10 * 2e-6 + 5e5 / 1e9 + 3.0 * 3 * 2e-6, rel=1e-14)
-    assert traffic.step_time(m, 1e6, 1, 1.0, 0, 0) == pytest.approx(0.1, rel=1e-14)  # one rank: cells alone
+    assert t == pytest.approx(5e-4 + 1.1 * 1e6 / 8 * 1e-7 + 10 * 2e-6 + 5e5 / 1e9 + 3.0 * 3 * 2e-6, rel=1e-14)
+    assert traffic.step_time(m, 1e6, 1, 1.0, 0, 0) == pytest.approx(0.1005, rel=1e-14)  # one rank: no messages
 
 
 def test_largest_run_meets_the_budget():
