@@ -87,7 +87,8 @@ SLOW_TESTS = {
 #: marked too. The system lane runs them after the others, one at a time, so that each 2-rank run has both
 #: cores: beside the other xdist worker's test, three processes on two cores, a 2-rank run waits on every
 #: collective for its descheduled rank (the API tour on 2 ranks: 8.8 s alone, 65 s beside another test).
-TWO_RANKS_MODULES = {"tests/system/test_charge_safety.py", "tests/system/test_paraview.py"}
+TWO_RANKS_MODULES = {"tests/system/test_charge_safety.py", "tests/system/test_paraview.py",
+                     "tests/system/test_scaling_model.py"}  # its 4-rank run too
 TWO_RANKS_TESTS = {
     "tests/system/test_demos.py::test_mpi_shot_demo", "tests/system/test_demos.py::test_hard_cases_demo",
     "tests/system/test_demos.py::test_charge_demo_tied_against_frictional",

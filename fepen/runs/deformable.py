@@ -20,7 +20,7 @@ from fepen.runs import checkpoint, closing, events, model, outputs, shot
 from fepen.runs import probes as run_probes
 from fepen.runs.charge_safety import ChargeSafety
 from fepen.runs.run import Removal, Run, Snapshot
-from fepen.solver import diagnostics, explicit, probes
+from fepen.solver import diagnostics, explicit, probes, traffic
 
 #: steps between two checks of the stop rules in the target (each costs a few reductions)
 EVENT_EVERY = 20
@@ -66,6 +66,7 @@ class DeformableRun(Run):
         self.outputs += [x for x in (self.fields_out, self.checkpoints) if x is not None]
         if progress_end is not None and comm.rank == 0:
             self.outputs.append(outputs.Progress(progress_end, self.t))
+        traffic.reset()  # the communication block counts the time loop's exchanges
 
     @property
     def t(self) -> float:
@@ -270,7 +271,8 @@ class DeformableRun(Run):
                 "mass_kg": s.total_mass, "cells": self.pm.mesh.topology.index_map(3).size_global,
                 "stress_kernel": s.kernel, "step_gain": s.clock.step_gain, **self.closing.summary(),
                 "acceleration_filter": o.acceleration_filter,
-                "acceleration_filter_hz": signals.corner_hz(o.acceleration_filter, o.acceleration_filter_hz)}
+                "acceleration_filter_hz": signals.corner_hz(o.acceleration_filter, o.acceleration_filter_hz),
+                "communication": traffic.of_run(self.comm, self.solver, self.load)}
 
     def stop_extra(self) -> dict:
         return {"mass_kg": self.solver.total_mass}

@@ -20,10 +20,13 @@ inputs by the same code (per cell, per facet, per node), which is what the solve
 from __future__ import annotations
 
 import math
+from time import perf_counter
 
 import numba
 import numpy as np
 from mpi4py import MPI
+
+from fepen.solver import traffic
 
 __all__ = ["NodalSum", "exact_sum", "ExactAccumulator", "input_keys"]
 
@@ -79,6 +82,7 @@ class NodalSum:
         size = comm.size
         self._send = np.zeros(0, dtype=np.int64)
         self._graph = None
+        self.sent_ranks = 0  # the ranks this rank sends terms to
         remote_node = np.zeros(0, dtype=np.int64)
         remote_keys = np.zeros((0, keys.shape[1]), dtype=np.int64)
         if size > 1:
@@ -101,6 +105,7 @@ class NodalSum:
             remote_keys = np.concatenate([incoming[r][1] for r in sources]) if sources else remote_keys
             self._recv_counts = np.array([len(incoming[r][0]) for r in sources], dtype=np.int64)
             self._send_counts = np.array([counts[int(d)] for d in dests], dtype=np.int64)
+            self.sent_ranks = len(dests)
             self._graph = comm.Create_dist_graph_adjacent([int(r) for r in sources], [int(d) for d in dests],
                                                           reorder=False)
             assert np.all((remote_node >= 0) & (remote_node < n_owned))
@@ -131,6 +136,7 @@ class NodalSum:
         self._pos_recv = where[n_local:]
         self.n_terms = len(order)
         self.n_recv = len(remote_node)
+        self.sent = len(self._send)  # the terms this rank sends to other ranks' nodes, a call (times bs numbers)
         self._terms = {}
 
     def __call__(self, values: np.ndarray, out: np.ndarray) -> np.ndarray:
@@ -295,7 +301,9 @@ def _reduced(limbs: np.ndarray, bad: np.ndarray, comm) -> tuple[np.ndarray, np.n
     if comm is None or comm.size == 1:
         return limbs, bad
     buf = np.concatenate([limbs.ravel(), bad])
+    t0 = perf_counter()
     comm.Allreduce(MPI.IN_PLACE, buf, op=MPI.SUM)
+    traffic.count("exact_sums", 1, buf.nbytes, traffic.rounds(comm.size), t0)
     limbs = buf[: limbs.size].reshape(limbs.shape)
     _carry(limbs)
     return limbs, buf[limbs.size:]

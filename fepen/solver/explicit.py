@@ -14,7 +14,7 @@ from mpi4py import MPI
 from fepen import dolfinx_api as dx
 from fepen.errors import SimulationError
 from fepen.laws import materials as M
-from fepen.solver import assembly, ckernel, failures, kernels, reference, time_step
+from fepen.solver import assembly, ckernel, failures, kernels, reference, time_step, traffic
 from fepen.solver import state as st
 
 dx.quiet()  # quiet dolfinx wherever the solver is used
@@ -141,10 +141,6 @@ class ExplicitSolver:
         self.total_mass = assembly.exact_sum(self.mass[: self.n_owned], self.comm)
 
     # ------------------------------------------------------------------------------------------------
-    def _ghost_sum(self, vec) -> None:
-        dx.scatter_reverse_add(vec)
-        vec.scatter_forward()
-
     def volumes_to_nodes(self, cvol: np.ndarray, vec) -> None:
         """Nodal volumes per material (the vector vec), Σ V_e / 4 over live cells, the terms on the volume
         grid (exact sums: the same on any partition), ghosts summed and refreshed."""
@@ -154,7 +150,7 @@ class ExplicitSolver:
                                               arr)
         else:
             kernels.grid_scatter(self.dofs, self.mat, cvol.reshape(-1, 1, 1), False, self.internal.volume_quantum, arr)
-        self._ghost_sum(vec)
+        _ghost_sum(self, vec)
 
     def _cells_to_nodes(self, Fc: np.ndarray, out: np.ndarray) -> None:
         """The cells' nodal forces Fc (n_cells, 4, 3) summed into out (n_nodes, 3), the terms on the force
@@ -163,7 +159,7 @@ class ExplicitSolver:
             self.passes.nodes.scatter_forces(self.passes.cells.dofs32, Fc, self.internal.force_quantum, out)
         else:
             kernels.grid_scatter(self.dofs, self.mat, Fc, True, self.internal.force_quantum, out)
-        dx.scatter_reverse_add(self.node.fint_fn.x)
+        _forces_to_owners(self)
 
     def positions(self) -> np.ndarray:
         """Current node positions (n_nodes, 3), ghosts included."""
@@ -260,14 +256,14 @@ class ExplicitSolver:
             jmin, worst, h_c, self.cell.step_cell = cells.kinematics(with_step, q_vol)  # the inverted cells eroded
             if self._any_inverted(jmin):
                 failures.inverted(self, x, jmin, worst)
-        self._ghost_sum(self.node.nvol)
+        _ghost_sum(self, self.node.nvol)
         t1 = perf_counter()
         self.passes.nodes.nodal_pressure(self.node.vol, self.node.vol0, self.cell.bulk, self.nodal_p)
         cells.cells(dt, q_force)  # and the cells' forces summed at the nodes
         self.sums.plastic += self.sums.totals[0]
         self.sums.heat += self.sums.totals[1]
         t2 = perf_counter()
-        dx.scatter_reverse_add(self.node.fint_fn.x)  # ghost terms to their owners (ghost rows stale)
+        _forces_to_owners(self)  # ghost terms to their owners (ghost rows stale)
         t3 = perf_counter()
         self._external_forces()
         self.clock.times.add(t0, t1, t2, t3, perf_counter())
@@ -301,7 +297,9 @@ class ExplicitSolver:
         bad = not (jmin > 0.0)
         if self.comm.size > 1:  # every rank must stop together (and rank 0 must be able to say why)
             self.passes.flag[0] = 1.0 if bad else 0.0
+            t0 = perf_counter()
             self.comm.Allreduce(MPI.IN_PLACE, self.passes.flag, op=MPI.MAX)
+            traffic.count("inverted", 1, traffic.WORD, traffic.rounds(self.comm.size), t0)
             bad = self.passes.flag[0] > 0.0
         return bad
 
@@ -331,7 +329,10 @@ class ExplicitSolver:
             if self.node.fixed is not None:
                 self.acc[self.node.fixed] = 0.0
             kernels.work_halves(du, self.node.fint, self.fext, n, self.sums.work)
+        t1 = perf_counter()
         self.node.a_fn.x.scatter_forward()
+        traffic.count("accelerations", 1, 3 * traffic.WORD * self.ghosts.forward, self.ghosts.forward_ranks, t1)
+        traffic.step_done()
         self.t = self.clock.land_at if self.clock.land_at >= 0.0 else self.t + dt
         self.step_count += 1
         self.dt_prev = dt
@@ -373,6 +374,24 @@ class ExplicitSolver:
             reference.rebuild(self, np.arange(self.n_cells))
             self.internal.P_packed[: self.n_cells][self.mat < 0] = 0.0
             self.sums.removed[:] = removed
+
+
+def _ghost_sum(s: ExplicitSolver, vec) -> None:
+    """The nodal volumes' ghost terms added to their owners, the sums sent back to the ghosts (counted:
+    fepen.solver.traffic's ``volumes``)."""
+    t0 = perf_counter()
+    dx.scatter_reverse_add(vec)
+    vec.scatter_forward()
+    g = s.ghosts
+    traffic.count("volumes", 2, traffic.WORD * len(s.materials) * (g.reverse + g.forward),
+                  g.reverse_ranks + g.forward_ranks, t0)
+
+
+def _forces_to_owners(s: ExplicitSolver) -> None:
+    """The internal forces' ghost terms added to their owners (ghost rows stale; counted: ``forces``)."""
+    t0 = perf_counter()
+    dx.scatter_reverse_add(s.node.fint_fn.x)
+    traffic.count("forces", 1, 3 * traffic.WORD * s.ghosts.reverse, s.ghosts.reverse_ranks, t0)
 
 
 def _get(s: ExplicitSolver, where: str):
@@ -435,6 +454,7 @@ def _reference_body(s: ExplicitSolver, mesh) -> None:
     imap = V.dofmap.index_map
     s.n_owned = imap.size_local
     s.n_nodes = imap.size_local + imap.num_ghosts
+    s.ghosts = traffic.GhostPlan.of(imap, s.comm)  # what the nodal scatters move (fepen.solver.traffic)
     n_cells = mesh.topology.index_map(mesh.topology.dim).size_local
     s.n_cells = n_cells
     s.dofs = np.ascontiguousarray(dx.cell_dofs(V)[:n_cells]).astype(np.int64)

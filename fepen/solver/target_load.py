@@ -16,7 +16,7 @@ from mpi4py import MPI
 
 from fepen.geometry.frames import REFERENCE_AXIS, rotation_onto, unit_axis
 from fepen.laws import target as tg
-from fepen.solver import assembly, probes
+from fepen.solver import assembly, probes, traffic
 from fepen.solver.surface import Surface
 
 
@@ -119,6 +119,8 @@ class TargetLoad:
         t0 = perf_counter()
         tip, tail = probes.node_values(solver, (self.tip, self.tail), x_all)  # one reduction for both
         comm_s = perf_counter() - t0
+        if solver.comm.size > 1:
+            traffic.count("nose_axis", 1, 6 * traffic.WORD, traffic.rounds(solver.comm.size), t0)
         axis = unit_axis(tip, tail)
         self.axis = axis
         comm = solver.comm
@@ -158,13 +160,17 @@ class TargetLoad:
         self.moment_o = m_o
         if self.tunnel is not None and comm.size > 1:  # every rank's pushes of the wall
             t1 = perf_counter()
-            comm.Allreduce(MPI.IN_PLACE, self.tunnel.recorded(), op=MPI.MAX)
+            radii = self.tunnel.recorded()
+            comm.Allreduce(MPI.IN_PLACE, radii, op=MPI.MAX)
             comm_s += perf_counter() - t1
+            traffic.count("tunnel", 1, radii.nbytes, traffic.rounds(comm.size), t1)
         if self.wear is not None:
             self.wear.add(load.force, n, v, dt)
         t1 = perf_counter()
         if self.nodal is None:
-            self._facet_sum(solver)(load.force / 3.0, self._nodes)  # a third to each corner
+            facets = self._facet_sum(solver)
+            facets(load.force / 3.0, self._nodes)  # a third to each corner
+            traffic.count("load_points", 1, 3 * traffic.WORD * facets.sent, facets.sent_ranks, t1)
         else:
             self.nodal.to_nodes(load.force, self._nodes)  # each point's force is its node's
         comm_s += perf_counter() - t1
@@ -232,6 +238,12 @@ class TargetLoad:
         self.angular_impulse = self.angular_impulse + assembly.exact_sum(self.angular_since[None, :], comm)
         self.angular_since = np.zeros(3)
         return self.angular_impulse
+
+    @property
+    def sent_terms(self) -> int:
+        """The point forces a step sends to other ranks' nodes (fepen.solver.traffic; facet points: their nodal
+        sum's terms, 0 on one rank; node points: none)."""
+        return self._sum.sent if self.nodal is None and self._sum is not None else 0
 
     @property
     def nodal_force(self) -> np.ndarray:

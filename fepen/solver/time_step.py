@@ -7,11 +7,12 @@ Functions of an ExplicitSolver ``s`` (fepen.solver.explicit), which calls them.
 from __future__ import annotations
 
 import math
+from time import perf_counter
 
 import numpy as np
 from mpi4py import MPI
 
-from fepen.solver import failures, kernels
+from fepen.solver import failures, kernels, traffic
 
 __all__ = ["stable", "new_stable", "choose", "calibrate", "LANDING_SLIVER", "GAIN_QUANTUM"]
 
@@ -32,7 +33,9 @@ def stable(s) -> float:
 
 def new_stable(s, h_c: float) -> None:
     """The next stable Δt from this rank's h/c (all ranks agree), or SimulationError if it collapsed."""
+    t0 = perf_counter()
     new = s.clock.safety * s.clock.step_gain * s.comm.allreduce(h_c, op=MPI.MIN)
+    traffic.count("stable_step", 1, traffic.WORD if s.comm.size > 1 else 0, traffic.rounds(s.comm.size), t0)
     if not (new > 1e-3 * s.clock.dt0):
         failures.step_collapsed(s, h_c, new)
     s.clock.dt_stable = new
