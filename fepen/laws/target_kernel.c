@@ -15,13 +15,18 @@
 
 #include "tunnel_kernel.c"
 
-/* A point in the tunnel (tunnel_kernel.c): its push into the wall (m), the outward unit vector, and the cavity's
- * radius a0 (m), which sets the wall's stiffness */
+/* A point in the tunnel (tunnel_kernel.c): its push into the wall (m), the outward unit vector, the cavity's
+ * radius a0 (m), and the wall's stiffness there (wall_stiffness: the same for every point of a call) */
 typedef struct {
-    double delta, er[3], a;
+    double delta, er[3], a, k;
 } WallHit;
 
 static double clip01(double x) { return x < 0.0 ? 0.0 : (x > 1.0 ? 1.0 : x); }
+
+/* fmax(x, c) and fmin(x, c) for a bound c that is never NaN, the same value for every x (NaN included: then c)
+ * and inlined (libm's are calls: a few per cent of a rigid shot) */
+static inline double max_c(double x, double c) { return x > c ? x : c; }
+static inline double min_c(double x, double c) { return x < c ? x : c; }
 
 /* The quasi-static radial stress at the cavity wall (Pa) of the elastic-cracked-plastic cavity expansion
  * (docs/theory.md §4.1), its one home (fepen.laws.target.quasi_static_stress calls it):
@@ -103,8 +108,8 @@ static inline double static_stress(const double *p, const LawConstants *c, doubl
     double s = p[P_SIGMA_S];
     if (p[P_FREE_SURFACE] != 0.0) {
         /* L_e: the shortest distance to the block's front face, or its rear face when it has one */
-        double depth = fmax(-y, 0.0), Le = c->thk >= 0.0 ? fmin(depth, fmax(c->thk - depth, 0.0)) : depth;
-        double ca = fmin(p[P_C_OVER_A], 1.0 + Le / (p[P_SURFACE_RANGE] * fmax(radius, 1e-12)));
+        double depth = max_c(-y, 0.0), Le = c->thk >= 0.0 ? fmin(depth, max_c(c->thk - depth, 0.0)) : depth;
+        double ca = fmin(p[P_C_OVER_A], 1.0 + Le / (p[P_SURFACE_RANGE] * max_c(radius, 1e-12)));
         if (ca == p[P_C_OVER_A]) s = c->whole;
         else s = p[P_GIVEN_SIGMA_S] != 0.0 ? p[P_SIGMA_S] * cavity_stress(p, ca) / c->ref : cavity_stress(p, ca);
     }
@@ -126,26 +131,31 @@ static inline double wall_limit(const double *p, double s, double u) {
     return p[P_RELOAD] * s + p[P_B] * p[P_DENSITY] * up * up;
 }
 
-static inline double wall_stiffness(const double *p, const WallHit *wall) {
-    return p[P_WALL_SHEAR2] / fmax(wall->a, 1e-12);
-}
+static inline double wall_stiffness(const double *p, double a) { return p[P_WALL_SHEAR2] / max_c(a, 1e-12); }
 
 /* a point's push into the wall (m): its penetration less a round-off's width (1e-9 of the radius), so that a body
  * on the wall it opened, centred to the last bit or not, carries nothing (the spring's force is continuous) */
 #define WALL_TOL 1e-9
 static inline double wall_push(const WallHit *wall) { return wall->delta - WALL_TOL * wall->a; }
 
+/* The immersed fraction of a point's patch below the target's face (its first factor: the rear face's is
+ * law_at_point's), its one expression */
+static inline double immersed(const double *p, const double *xi, double ell) {
+    return clip01(0.5 - (xi[1] + p[P_TOP]) / ell);
+}
+
 /* THE LAW AT ONE POINT (docs/theory.md §8), its one text: the single rigid path and the deformable load reach it
  * through point_forces below, the batched rigid shots (fepen/runs/rigid_batch.c) include this file and call it.
- * The point (x, v, n: 3 each; its patch area and ell = sqrt(area); its surface radius, meridian radius and
- * sin phi0) under the law p (with c = law_constants(p)); axis (3) or NULL. Writes the point's force f (3) and
- * stress *sig only when it is loaded and returns 1; returns 0 (f, *sig untouched) when it is not. */
+ * The point (x, v, n: 3 each; its patch area and ell = sqrt(area); top = immersed(p, x, ell), which the loops
+ * have from their own test; its surface radius, meridian radius and sin phi0) under the law p (with c =
+ * law_constants(p)); axis (3) or NULL. Writes the point's force f (3) and stress *sig only when it is loaded and
+ * returns 1; returns 0 (f, *sig untouched) when it is not. */
 static inline int law_at_point(const double *p, const LawConstants *c, const double *xi, const double *vi,
-                               const double *ni, double area, double ell, double radius, double Rm, double sphi0,
-                               const double *axis, const WallHit *wall, const double *gauss, int32_t ng, double *fi,
-                               double *sig) {
+                               const double *ni, double area, double ell, double top, double radius, double Rm,
+                               double sphi0, const double *axis, const WallHit *wall, const double *gauss, int32_t ng,
+                               double *fi, double *sig) {
     double y = xi[1];
-    double frac = clip01(0.5 - (y + p[P_TOP]) / ell);
+    double frac = top;
     if (p[P_LOWER] >= 0.0) frac *= clip01(0.5 + (y + p[P_LOWER]) / ell);
     if (!(frac > 0.0)) return 0;
     double vn = normal_speed(vi, ni), u = 0.0;
@@ -155,7 +165,7 @@ static inline int law_at_point(const double *p, const LawConstants *c, const dou
         loaded = wall_push(wall) > 0.0 && ni[0] * wall->er[0] + ni[1] * wall->er[1] + ni[2] * wall->er[2] > 0.0;
     } else { /* the open face: loaded where it moves into the target, past the separation angle */
         double speed = sqrt(vi[0] * vi[0] + vi[1] * vi[1] + vi[2] * vi[2]);
-        double sin_phi = speed > 0.0 ? vn / fmax(speed, 1e-300) : 0.0;
+        double sin_phi = speed > 0.0 ? vn / max_c(speed, 1e-300) : 0.0;
         loaded = sin_phi > SIN_TOL && vn > 0.0;
         /* the wake: moving backward, a point meets the open tunnel, not concrete */
         if (axis) loaded = loaded && (vi[0] * axis[0] + vi[1] * axis[1] + vi[2] * axis[2] > 0.0);
@@ -165,16 +175,16 @@ static inline int law_at_point(const double *p, const LawConstants *c, const dou
     const double s = local_stress(p, c, xi, radius);
     /* the nose: the cavity-expansion stress at any speed into the target (sigma_s is its static limit); the
      * wall: elastic up to its reload limit, so a body pressed into it at rest is held, and let go of as it leaves */
-    double sg = (wall ? fmin(wall_stiffness(p, wall) * wall_push(wall), wall_limit(p, s, u))
+    double sg = (wall ? fmin(wall->k * wall_push(wall), wall_limit(p, s, u))
                       : s + p[P_B] * p[P_DENSITY] * vn * vn) * frac;
-    const double vx = wall ? fmax(u, 0.0) : vn; /* the speed that throws the medium out at the crater */
+    const double vx = wall ? max_c(u, 0.0) : vn; /* the speed that throws the medium out at the crater */
     if (p[P_CRATER] == 2.0 && -y < p[P_K] * p[P_D]) { /* the splash-streamline energy balance (§8.3) */
-        double rho = fmax(radius, 1e-12), l = (p[P_C_OVER_A] - 1.0) * rho, integral = 0.0;
+        double rho = max_c(radius, 1e-12), l = (p[P_C_OVER_A] - 1.0) * rho, integral = 0.0;
         for (int32_t g = 0; g < ng; ++g) {
             double w = 0.5 * l * (gauss[g] + 1.0), q = rho / (rho + w);
             integral += 0.5 * l * gauss[ng + g] * (1.0 + w / Rm) * (1.0 + w * sphi0 / rho) * q * q * q * q;
         }
-        double depth = fmax(-y, 0.0), Le = c->thk >= 0.0 ? fmin(depth, fmax(c->thk - depth, 0.0)) : depth;
+        double depth = max_c(-y, 0.0), Le = c->thk >= 0.0 ? fmin(depth, max_c(c->thk - depth, 0.0)) : depth;
         double e_kin = 0.5 * p[P_LOCK_DENSITY] * vx * vx * integral;
         double e_str = p[P_CRUSH_STRAIN] * p[P_Y] * (2.0 * rho * Le + Le * Le) / rho;
         if (e_kin - e_str >= 0.0) sg = 0.0;
@@ -199,12 +209,6 @@ static inline int law_at_point(const double *p, const LawConstants *c, const dou
     return 1;
 }
 
-/* 1 when the point's patch lies wholly above the target's face (law_at_point's immersed fraction is 0 there,
- * whatever else holds): the loops skip it before locating it in the tunnel, which changes no bit */
-static inline int above_face(const double *p, const double *xi, double ell) {
-    return !(clip01(0.5 - (xi[1] + p[P_TOP]) / ell) > 0.0);
-}
-
 /* 0 when the point can carry no load: it moves out of its surface's outside (law_at_point's vn > 0 at the nose,
  * the same function) and cannot be in the tunnel (ahead of the shoulder, or no tunnel), where the elastic wall
  * holds a point pressed into it however it moves. The loops skip the others before locating them in the tunnel
@@ -213,15 +217,17 @@ static inline int may_load(const double *vi, const double *ni, const double *T, 
     return normal_speed(vi, ni) > 0.0 || (T && xi > T[T_XI_SH] && T[T_M] >= 1.0);
 }
 
-/* The point's wall, when it is in the tunnel T (NULL: no tunnel): the WallHit, or NULL */
-static inline const WallHit *wall_of(const double *T, TunnelEnd *e, const double *xi_point, double xi,
-                                     WallHit *hit) {
-    if (!T) return 0;
+/* Where the point is in the tunnel T (NULL: no tunnel): TUNNEL_IN with its WallHit, TUNNEL_CLEAR (clear of the
+ * wall: the law would not load it), or TUNNEL_OUT (not in the tunnel: the open face's law) */
+static inline int wall_of(const double *T, TunnelEnd *e, const double *xi_point, double xi, double k,
+                          WallHit *hit) {
+    if (!T) return TUNNEL_OUT;
     int32_t kn, sec;
     double rho;
-    if (!tunnel_locate(T, e, xi_point, xi, &hit->delta, hit->er, &kn, &sec, &rho)) return 0;
+    const int at = tunnel_locate(T, e, xi_point, xi, 1, &hit->delta, hit->er, &kn, &sec, &rho);
     hit->a = T[T_A0];
-    return hit;
+    hit->k = k;
+    return at;
 }
 
 /* A step's first stage, after the law: where the wall is pressed past its reload limit it yields, the plastic
@@ -233,16 +239,17 @@ static void wall_yield(double *T, TunnelEnd *e, const double *p, const LawConsta
                        const double *vi, double radius, double xi) {
     double delta, er[3], rho;
     int32_t kn, sec;
-    if (!tunnel_locate(T, e, xi_point, xi, &delta, er, &kn, &sec, &rho) || kn < 0) return;
-    const WallHit hit = {delta, {er[0], er[1], er[2]}, T[T_A0]};
+    if (tunnel_locate(T, e, xi_point, xi, 0, &delta, er, &kn, &sec, &rho) != TUNNEL_IN || kn < 0) return;
+    const WallHit hit = {delta, {er[0], er[1], er[2]}, T[T_A0], wall_stiffness(p, T[T_A0])};
     const double u = vi[0] * er[0] + vi[1] * er[1] + vi[2] * er[2];
     const double limit = wall_limit(p, local_stress(p, c, xi_point, radius), u);
-    tunnel_widen(T, kn, sec, rho - WALL_TOL * hit.a - limit / wall_stiffness(p, &hit));
+    tunnel_widen(T, kn, sec, rho - WALL_TOL * hit.a - limit / hit.k);
 }
 
 /* The law on k points, its one driver: point_forces's, and the rigid run's step's (fepen/runs/rigid_batch.c, which
  * includes this file). ell (k): each patch's sqrt(area) when given (NULL: taken here, the same bits); idx: NULL, or
- * room for k indices. The law is evaluated at the points that may load (above_face, may_load), their forces into f
+ * room for k indices. The law is evaluated at the points that may load (may_load, not clear of the tunnel's wall, not
+ * wholly above the face: the tests in that order, none of which changes another's answer), their forces into f
  * and stresses into sig, and the others left as they are: the caller zeroes them (point_forces: every point;
  * the step: at the points it loaded before). With idx the evaluated points' indices go into it, in order, and only
  * their forces are summed (the others are zero: a zero term changes no sum, and a sum from +0 is never -0); without
@@ -259,18 +266,20 @@ __attribute__((noinline)) static int32_t law_points(int32_t k, const double *x, 
     if (commit) tunnel_record(T);
     TunnelEnd end;
     if (T) tunnel_end(T, &end);
+    const double k_wall = T ? wall_stiffness(p, T[T_A0]) : 0.0;
     int32_t m = 0;
     for (int j = 0; j < SUM_COUNT; ++j) sums[j] = 0.0;
     for (int32_t i = 0; i < k; ++i) {
         double sg = 0.0;
         if (!may_load(v + 3 * i, n + 3 * i, T, T ? body_xi[i] : 0.0)) continue;
-        if (T && tunnel_clear(T, &end, x + 3 * i, body_xi[i])) continue; /* in the tunnel, clear of its wall */
-        const double ell_i = ell ? ell[i] : sqrt(area[i]);
-        if (above_face(p, x + 3 * i, ell_i)) continue;
         WallHit hit;
-        const WallHit *wall = wall_of(T, &end, x + 3 * i, T ? body_xi[i] : 0.0, &hit);
-        if (!law_at_point(p, &c, x + 3 * i, v + 3 * i, n + 3 * i, area[i], ell_i, radius[i], Rm[i], sphi0[i], axis,
-                          wall, gauss, ng, f + 3 * i, &sg))
+        const int at = wall_of(T, &end, x + 3 * i, T ? body_xi[i] : 0.0, k_wall, &hit);
+        if (at == TUNNEL_CLEAR) continue; /* in the tunnel, clear of its wall */
+        const double ell_i = ell ? ell[i] : sqrt(area[i]);
+        const double top = immersed(p, x + 3 * i, ell_i);
+        if (!(top > 0.0)) continue; /* wholly above the face */
+        if (!law_at_point(p, &c, x + 3 * i, v + 3 * i, n + 3 * i, area[i], ell_i, top, radius[i], Rm[i], sphi0[i],
+                          axis, at == TUNNEL_IN ? &hit : NULL, gauss, ng, f + 3 * i, &sg))
             continue;
         if (sg > 0.0) {
             sums[SUM_LOADED] += 1.0;
@@ -339,7 +348,7 @@ void tunnel_sectors(int32_t k, const double *r, const double *t, int32_t S, int3
 }
 
 /* Where k points x (k, 3) at body-axial distances xi (k) lie in the tunnel T as it is now (its shoulder and axis
- * set): clear[i] tunnel_clear's answer, located[i] tunnel_locate's, and where located, its push delta[i] (m) and
+ * set): clear[i] whether tunnel_locate calls it clear, located[i] whether it locates it without that test, and where located, its push delta[i] (m) and
  * distance from the axis rho[i] (m); for the tests (the clear test never skips a point the locate would find
  * pressed; the located distances against a curved tunnel's exact ones). */
 void tunnel_probe(const double *T, int32_t k, const double *x, const double *xi, int32_t *clear, int32_t *located,
@@ -350,7 +359,8 @@ void tunnel_probe(const double *T, int32_t k, const double *x, const double *xi,
     for (int32_t i = 0; i < k; ++i) {
         double er[3];
         int32_t kn, sec;
-        clear[i] = tunnel_clear(T, &e, x + 3 * i, xi[i]);
-        located[i] = tunnel_locate(T, &f, x + 3 * i, xi[i], delta + i, er, &kn, &sec, rho + i);
+        double d0;
+        clear[i] = tunnel_locate(T, &e, x + 3 * i, xi[i], 1, &d0, er, &kn, &sec, &d0) == TUNNEL_CLEAR;
+        located[i] = tunnel_locate(T, &f, x + 3 * i, xi[i], 0, delta + i, er, &kn, &sec, rho + i) == TUNNEL_IN;
     }
 }

@@ -116,7 +116,8 @@ typedef struct {
     double ring_xi;
     TunnelAt ring;
     double e1[3], n1sq;
-    /* the square of the smallest push a point of the ring may have and still be clear of the wall (tunnel_clear) */
+    /* the square of the largest distance from the axis at which a point of the ring is clear of the wall
+     * (tunnel_locate's clear_ok) */
     double clear2;
     /* the ring's arc length, and how far along the path from the ring's centre a point may lie and still be
      * measured where its ring lies (RING_REACH of the spacing; beyond, at its own place) */
@@ -223,36 +224,27 @@ static int tunnel_ring(const double *T, TunnelEnd *e, double xi) {
     return 1;
 }
 
-/* 1 when the point p at body-axial distance xi is in the tunnel and certainly not pressed into its wall (its
- * distance from the ring's axis below the wall's smallest radius there and a round-off's width: tunnel_locate
- * would find it so, and the law would not load it), else 0 (ahead of the shoulder, no station yet, near the axis,
- * or maybe pressed: tunnel_locate decides). No square root, no division: most of a body in its own tunnel is
- * clear of it, and the law's loops skip those points with this test alone. The 1e-9 is wall_push's WALL_TOL. */
-static inline int tunnel_clear(const double *T, TunnelEnd *e, const double *p, double xi) {
-    if ((int32_t)T[T_M] < 1) return 0;
-    if (!(e->has_ring && xi == e->ring_xi) && !tunnel_ring(T, e, xi)) return 0;
-    const TunnelAt *at = &e->ring;
-    const double d[3] = {p[0] - at->c[0], p[1] - at->c[1], p[2] - at->c[2]};
-    const double along = tdot(d, at->t);
-    if (fabs(along) > e->reach) return 0; /* measured at its own place: tunnel_locate decides */
-    const double r[3] = {d[0] - along * at->t[0], d[1] - along * at->t[1], d[2] - along * at->t[2]};
-    const double r2 = tdot(r, r);
-    return r2 < e->clear2 && r2 > 2e-24;
-}
+/* tunnel_locate's answers: not in the tunnel, clear of its wall (asked for), located */
+enum { TUNNEL_OUT = 0, TUNNEL_IN = 1, TUNNEL_CLEAR = 2 };
 
-/* A point p at body-axial distance xi in the tunnel (e: its open end, tunnel_end): returns 1 with its penetration
- * of the wall delta (m), the outward unit vector er, its nearest recorded station kn (-1: the open end) and sector
- * sec and its distance rho from the axis; 0 when it is not in the tunnel (ahead of the shoulder, no station yet,
- * or on the axis). The point is measured where its ring lies (tunnel_ring, once a ring). */
-static int tunnel_locate(const double *T, TunnelEnd *e, const double *p, double xi, double *delta,
-                         double *er, int32_t *kn, int32_t *sec, double *rho) {
+/* A point p at body-axial distance xi in the tunnel (e: its open end, tunnel_end): returns TUNNEL_IN with its
+ * penetration of the wall delta (m), the outward unit vector er, its nearest recorded station kn (-1: the open
+ * end) and sector sec and its distance rho from the axis; TUNNEL_OUT when it is not in the tunnel (ahead of the
+ * shoulder, no station yet, or on the axis). The point is measured where its ring lies (tunnel_ring, once a ring).
+ *
+ * With clear_ok, TUNNEL_CLEAR (nothing else written) when the point is certainly clear of the wall: its squared
+ * distance from the ring's axis below the wall's smallest radius about the ring and wall_push's round-off width
+ * (clear2), before any square root or division. Most of a body that follows its own tunnel is clear of it, and the
+ * law's loops skip those points so; the locate would find them unpressed, and the law would not load them. */
+/* tunnel_locate's measure of a point that is not clear (d: its offset from the ring's station, along: d's part
+ * along the axis there): out of line, so that the clear test stays a few instructions in the law's loop */
+__attribute__((noinline)) static int tunnel_place(const double *T, TunnelEnd *e, const double *p, double *d,
+                                                  double along, double *delta, double *er, int32_t *kn,
+                                                  int32_t *sec, double *rho) {
     const int32_t m = (int32_t)T[T_M], S = (int32_t)T[T_S];
-    if (m < 1) return 0;
-    if (!(e->has_ring && xi == e->ring_xi) && !tunnel_ring(T, e, xi)) return 0;
     const TunnelAt *at = &e->ring;
     TunnelAt own;
-    double d[3] = {p[0] - at->c[0], p[1] - at->c[1], p[2] - at->c[2]};
-    double along = tdot(d, at->t), r[3], e1[3], n1sq;
+    double r[3], e1[3], n1sq;
     if (fabs(along) > e->reach) { /* far along the path from its ring's centre: located at its own place */
         const double s0 = tunnel_station((double *)T, 0)[T_ARC];
         double s = e->ring_s + along;
@@ -269,7 +261,7 @@ static int tunnel_locate(const double *T, TunnelEnd *e, const double *p, double 
     }
     for (int j = 0; j < 3; ++j) r[j] = d[j] - along * at->t[j];
     double rr = sqrt(tdot(r, r));
-    if (!(rr > 1e-12)) return 0;
+    if (!(rr > 1e-12)) return TUNNEL_OUT;
     for (int j = 0; j < 3; ++j) er[j] = r[j] / rr;
     const int32_t q = tunnel_sector(r, at->t, e1, n1sq, S); /* the sector: the angle of r about t from e1 */
     double a_lo = tunnel_station((double *)T, at->ia)[T_STATION + q];
@@ -278,7 +270,22 @@ static int tunnel_locate(const double *T, TunnelEnd *e, const double *p, double 
     *rho = rr;
     *sec = q;
     *kn = at->w < 0.5 ? at->ia : (at->ib < m ? at->ib : -1);
-    return 1;
+    return TUNNEL_IN;
+}
+
+static inline int tunnel_locate(const double *T, TunnelEnd *e, const double *p, double xi, int clear_ok,
+                                double *delta, double *er, int32_t *kn, int32_t *sec, double *rho) {
+    if ((int32_t)T[T_M] < 1) return TUNNEL_OUT;
+    if (!(e->has_ring && xi == e->ring_xi) && !tunnel_ring(T, e, xi)) return TUNNEL_OUT;
+    const TunnelAt *at = &e->ring;
+    double d[3] = {p[0] - at->c[0], p[1] - at->c[1], p[2] - at->c[2]};
+    const double along = tdot(d, at->t);
+    if (clear_ok && !(fabs(along) > e->reach)) {
+        const double r[3] = {d[0] - along * at->t[0], d[1] - along * at->t[1], d[2] - along * at->t[2]};
+        const double r2 = tdot(r, r);
+        if (r2 < e->clear2 && r2 > 2e-24) return TUNNEL_CLEAR;
+    }
+    return tunnel_place(T, e, p, d, along, delta, er, kn, sec, rho);
 }
 
 /* A step's first stage: a new station at the shoulder once it is below the face and has advanced `spacing` along
