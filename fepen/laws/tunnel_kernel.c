@@ -206,17 +206,14 @@ static int tunnel_ring(const double *T, TunnelEnd *e, double xi) {
     e->reach = RING_REACH * T[T_SPACING];
     e->hint = e->ring.ia;
     e->n1sq = tunnel_e1(e->ring.t, e->e1);
-    /* the wall's smallest radius about the ring (over its sectors), and a point's distance from the axis below
-     * which it cannot press the wall: wall_push's round-off width added, then 1e-12 of it taken off, so that the
-     * few roundings of tunnel_locate's delta never decide otherwise */
-    const int32_t m = (int32_t)T[T_M], S = (int32_t)T[T_S];
-    const double *lo = tunnel_station((double *)T, e->ring.ia) + T_STATION;
-    const double *hi = e->ring.ib < m ? tunnel_station((double *)T, e->ring.ib) + T_STATION : NULL;
-    double amin = INFINITY;
-    for (int32_t q = 0; q < S; ++q) {
-        const double a = lo[q] + e->ring.w * ((hi ? hi[q] : T[T_A0]) - lo[q]);
-        if (a < amin) amin = a;
-    }
+    /* the wall's smallest radius about the ring (of its two stations' smallest radii: the interpolated radius of
+     * every sector lies between its stations'), and a point's distance from the axis below which it cannot press
+     * the wall: wall_push's round-off width added, then 1e-12 of it taken off, so that the few roundings of
+     * tunnel_locate's delta never decide otherwise */
+    const int32_t m = (int32_t)T[T_M];
+    const double lo = tunnel_station((double *)T, e->ring.ia)[T_AMIN];
+    const double hi = e->ring.ib < m ? tunnel_station((double *)T, e->ring.ib)[T_AMIN] : T[T_A0];
+    const double amin = lo < hi ? lo : hi;
     const double clear = (amin + 1e-9 * T[T_A0]) * (1.0 - 1e-12);
     e->clear2 = clear > 0.0 ? clear * clear : 0.0;
     e->ring_xi = xi;
@@ -227,15 +224,6 @@ static int tunnel_ring(const double *T, TunnelEnd *e, double xi) {
 /* tunnel_locate's answers: not in the tunnel, clear of its wall (asked for), located */
 enum { TUNNEL_OUT = 0, TUNNEL_IN = 1, TUNNEL_CLEAR = 2 };
 
-/* A point p at body-axial distance xi in the tunnel (e: its open end, tunnel_end): returns TUNNEL_IN with its
- * penetration of the wall delta (m), the outward unit vector er, its nearest recorded station kn (-1: the open
- * end) and sector sec and its distance rho from the axis; TUNNEL_OUT when it is not in the tunnel (ahead of the
- * shoulder, no station yet, or on the axis). The point is measured where its ring lies (tunnel_ring, once a ring).
- *
- * With clear_ok, TUNNEL_CLEAR (nothing else written) when the point is certainly clear of the wall: its squared
- * distance from the ring's axis below the wall's smallest radius about the ring and wall_push's round-off width
- * (clear2), before any square root or division. Most of a body that follows its own tunnel is clear of it, and the
- * law's loops skip those points so; the locate would find them unpressed, and the law would not load them. */
 /* tunnel_locate's measure of a point that is not clear (d: its offset from the ring's station, along: d's part
  * along the axis there): out of line, so that the clear test stays a few instructions in the law's loop */
 __attribute__((noinline)) static int tunnel_place(const double *T, TunnelEnd *e, const double *p, double *d,
@@ -273,6 +261,15 @@ __attribute__((noinline)) static int tunnel_place(const double *T, TunnelEnd *e,
     return TUNNEL_IN;
 }
 
+/* A point p at body-axial distance xi in the tunnel (e: its open end, tunnel_end): returns TUNNEL_IN with its
+ * penetration of the wall delta (m), the outward unit vector er, its nearest recorded station kn (-1: the open
+ * end) and sector sec and its distance rho from the axis; TUNNEL_OUT when it is not in the tunnel (ahead of the
+ * shoulder, no station yet, or on the axis). The point is measured where its ring lies (tunnel_ring, once a ring).
+ *
+ * With clear_ok, TUNNEL_CLEAR (nothing else written) when the point is certainly clear of the wall: its squared
+ * distance from the ring's axis below the wall's smallest radius about the ring and wall_push's round-off width
+ * (clear2), before any square root or division. Most of a body that follows its own tunnel is clear of it, and the
+ * law's loops skip those points so; the locate would find them unpressed, and the law would not load them. */
 static inline int tunnel_locate(const double *T, TunnelEnd *e, const double *p, double xi, int clear_ok,
                                 double *delta, double *er, int32_t *kn, int32_t *sec, double *rho) {
     if ((int32_t)T[T_M] < 1) return TUNNEL_OUT;
@@ -310,7 +307,7 @@ static void tunnel_record(double *T) {
         }
         st[T_ARC] = s;
     }
-    st[T_ARC + 1] = 0.0;
+    st[T_AMIN] = T[T_A0];
     for (int32_t q = 0; q < S; ++q) st[T_STATION + q] = T[T_A0];
     T[T_M] = m + 1;
 }
@@ -318,7 +315,14 @@ static void tunnel_record(double *T) {
 /* The plastic cavity at station kn and sector sec opened out to radius r (it keeps the largest it was opened to):
  * the wall's yield (target_kernel.c's wall_yield) */
 static void tunnel_widen(double *T, int32_t kn, int32_t sec, double r) {
-    double *a = tunnel_station(T, kn) + T_STATION + sec;
-    if (r > *a) *a = r;
+    double *st = tunnel_station(T, kn), *a = st + T_STATION + sec;
+    if (!(r > *a)) return;
+    const double was = *a;
+    *a = r;
+    if (was > st[T_AMIN]) return; /* not the smallest: the smallest stays */
+    double amin = INFINITY; /* the smallest grew, or was this one's: found again */
+    for (int32_t q = 0; q < (int32_t)T[T_S]; ++q)
+        if (st[T_STATION + q] < amin) amin = st[T_STATION + q];
+    st[T_AMIN] = amin;
 }
 #endif
