@@ -34,7 +34,7 @@ def output(cmd: list[str], ranks: int = 1) -> tuple[str, float]:
     if min(ranks, md.RANKS) > 1:
         full = ["mpirun", "-n", str(min(ranks, md.RANKS)), *full]
     t0 = time.perf_counter()
-    r = subprocess.run(full, cwd=ROOT, capture_output=True, text=True)
+    r = subprocess.run(full, cwd=ROOT, capture_output=True, text=True, env=md.child_env())
     if r.returncode != 0:
         raise SystemExit(f"make docs: {' '.join(cmd[:3])} failed (exit {r.returncode}):\n{r.stdout[-2000:]}\n"
                          f"{r.stderr[-2000:]}")

@@ -53,6 +53,15 @@ def took(seconds: float, ranks: int = 2) -> str:
     return f"{seconds:.0f} s on {r} rank{'s' if r > 1 else ''}"
 
 
+def child_env() -> dict:
+    """The environment of a command make docs starts: Python's copy of this process's, passed explicitly. Without
+    it a child inherits the C environment, which Open MPI's MPI_Init writes into once a block has loaded MPI in this
+    process (PMIX_RANK, PMIX_SERVER_URI*, OMPI_MCA_ess=singleton, ...): the child then takes itself for a rank of
+    this process's singleton job, and a relaunching command (fepen validate --workers 2) ended at once with exit
+    1 and nothing said."""
+    return dict(os.environ)
+
+
 def fepen(*args, ranks: int = 1) -> float:
     """Run a fepen command from the project root; its wall time (s). A failing command stops make docs."""
     ranks = min(ranks, RANKS)
@@ -61,7 +70,7 @@ def fepen(*args, ranks: int = 1) -> float:
         cmd = ["mpirun", "-n", str(ranks), *cmd]
     for attempt in (1, 2):
         t0 = time.perf_counter()
-        r = subprocess.run(cmd, cwd=ROOT, capture_output=True, text=True)
+        r = subprocess.run(cmd, cwd=ROOT, capture_output=True, text=True, env=child_env())
         if r.returncode == 0:
             return time.perf_counter() - t0
         if attempt == 1 and r.returncode == 1 and not (r.stdout + r.stderr).strip():
@@ -232,7 +241,7 @@ def _mesh_facets(shot: str, tmp: Path) -> dict:
             f"sc = fepen.Scene(sets=['impact.shot={shot}', 'effects.fidelity=rigid']); "
             "s = RigidRun(sc, None, MPI.COMM_SELF, points='mesh').run(); "
             "print(json.dumps({k: s[k] for k in ('Hy_mm', 'final_axis_angle_deg')}))")
-    r = subprocess.run([PY, "-c", code], cwd=ROOT, capture_output=True, text=True)
+    r = subprocess.run([PY, "-c", code], cwd=ROOT, capture_output=True, text=True, env=child_env())
     if r.returncode != 0:
         raise SystemExit(f"make docs: the rigid run on the mesh's facets failed:\n{r.stderr[-2000:]}")
     return json.loads(r.stdout.strip().splitlines()[-1])
@@ -570,7 +579,7 @@ def throughput(tmp: Path) -> str:
 def _run_lines(tmp: Path, name: str, *sets: str) -> tuple[list[str], dict]:
     """A rigid run's printed interval and envelope lines, and its summary."""
     cmd = [PY, "-m", "fepen", "run", *RIGID, *_sets(list(sets)), "--out", str(tmp / name)]
-    r = subprocess.run(cmd, cwd=ROOT, capture_output=True, text=True)
+    r = subprocess.run(cmd, cwd=ROOT, capture_output=True, text=True, env=child_env())
     if r.returncode != 0:
         raise SystemExit(f"make docs: fepen run {' '.join(sets)} failed:\n{r.stderr[-2000:]}")
     text = r.stdout + r.stderr
@@ -607,7 +616,7 @@ def worked_example(tmp: Path) -> str:
     """The plastic C3 run's printed figures and how to read them."""
     cmd = [PY, "-m", "fepen", "run", "scenes/default.toml", "--set", "run.fields=false", "--out", str(tmp / "p")]
     t0 = time.perf_counter()
-    r = subprocess.run(cmd, cwd=ROOT, capture_output=True, text=True)
+    r = subprocess.run(cmd, cwd=ROOT, capture_output=True, text=True, env=child_env())
     if r.returncode != 0:
         raise SystemExit(f"make docs: the plastic C3 run failed:\n{r.stderr[-2000:]}")
     seconds = time.perf_counter() - t0

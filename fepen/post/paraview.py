@@ -342,8 +342,8 @@ def render_png(script: Path, png: str | Path, options=(), tries: int = 3) -> Non
     cmd = ["pvpython", "--force-offscreen-rendering", str(script), "--png", str(Path(png).resolve()), *options]
     if shutil.which("xvfb-run"):
         cmd = ["xvfb-run", "-a", "-s", "-screen 0 1280x1024x24", *cmd]
-    for _ in range(tries):
-        r = subprocess.run(cmd, capture_output=True, text=True)
+    for _ in range(tries):  # Python's copy of the environment: not the one MPI_Init wrote PMIX_RANK etc. into
+        r = subprocess.run(cmd, capture_output=True, text=True, env=dict(os.environ))
         if r.returncode == 0 and Path(png).is_file():
             return
     raise SimulationError(f"ParaView could not render {png}: {r.stderr.strip()[-400:]}")
