@@ -32,6 +32,8 @@ import tempfile
 import time
 from pathlib import Path
 
+import baseline  # benchmarks/baseline.py: this tree and a baseline worktree
+
 ROOT = Path(__file__).resolve().parents[1]
 
 
@@ -87,19 +89,9 @@ def main(argv=None) -> int:
                     help="a scene setting for every run (repeatable)")
     ap.add_argument("--warm-only", action="store_true", help="report the warm runs only")
     args = ap.parse_args(argv)
-    trees = [(ROOT, "this tree")]
-    worktree = None
-    if args.baseline:
-        worktree = Path(tempfile.mkdtemp(prefix="fepen-baseline-")) / "tree"
-        subprocess.run(["git", "worktree", "add", "--detach", str(worktree), args.baseline], cwd=ROOT, check=True,
-                       capture_output=True)
-        trees.append((worktree, f"baseline {args.baseline}"))
-    try:
+    with baseline.trees(args.baseline) as trees:
         rows = [r for tree, label in trees for r in measure(tree, label, args.ranks, args.repeats, args.sets,
                                                                 args.warm_only)]
-    finally:
-        if worktree is not None:
-            subprocess.run(["git", "worktree", "remove", "--force", str(worktree)], cwd=ROOT, capture_output=True)
     print(f"default C3 shot{' with ' + ', '.join(args.sets) if args.sets else ''}, {args.ranks} ranks, whole "
           "process against its time loop")
     print(f"{'tree':24s} {'caches':6s} {'whole_s':>8} {'loop_s':>7} {'ratio':>6} {'mesh_s':>7} {'setup_s':>8} "

@@ -27,6 +27,8 @@ import tempfile
 import time
 from pathlib import Path
 
+import baseline  # benchmarks/baseline.py: this tree and a baseline worktree
+
 ROOT = Path(__file__).resolve().parents[1]
 DEMO = ROOT / "demos" / "studies" / "c3_scatter.toml"
 IN_PROCESS = 400  # shots of the in-process figure
@@ -86,24 +88,14 @@ def main(argv=None) -> int:
     ap.add_argument("--ranks", type=int, default=2)
     ap.add_argument("--repeats", type=int, default=3)
     args = ap.parse_args(argv)
-    trees = [(ROOT, "this tree")]
-    base = None
-    if args.baseline:
-        base = Path(tempfile.mkdtemp(prefix="fepen-baseline-")) / "tree"
-        subprocess.run(["git", "worktree", "add", "--detach", str(base), args.baseline], cwd=ROOT, check=True,
-                       capture_output=True)
-        trees.append((base, f"baseline {args.baseline}"))
     rows = []
-    try:
+    with baseline.trees(args.baseline) as trees:
         for tree, label in trees:
             work = Path(tempfile.mkdtemp(prefix="fepen-rigid-throughput-"))
             try:
                 rows.append((label, measure(tree, args.shots, args.ranks, args.repeats, work)))
             finally:
                 shutil.rmtree(work, ignore_errors=True)
-    finally:
-        if base is not None:
-            subprocess.run(["git", "worktree", "remove", "--force", str(base)], cwd=ROOT, capture_output=True)
     lines = [f"`benchmarks/rigid_throughput.py --shots {args.shots} --ranks {args.ranks}"
              + (f" --baseline {args.baseline}`" if args.baseline else "`") + ", one run, this machine's 2 cores.", "",
              f"| tree | {args.shots}-shot sweep on {args.ranks} ranks: wall (s) | per shot·core (ms, whole process) "
