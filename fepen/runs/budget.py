@@ -26,6 +26,12 @@ NOSE_MARGIN = 2.0
 #: memory before the first step: per process and per cell (bytes), the measured 0.53 GB (0.72 GB when gmsh
 #: meshes in the process: a 3 mm mesh built afresh) and 1.84 kB with a margin
 PROCESS_BYTES, CELL_BYTES = 0.8e9, 2.2e3
+#: the address space a meshing and running process maps once its libraries are in (dolfinx, PETSc, numba, gmsh,
+#: matplotlib, pyvista and VTK: 0.85 GiB measured with fepen 0.7.0, Debian's stack). An address-space limit (ulimit
+#: -v) is checked against at least this much held: since fepen 0.7.0 a command loads them after the check (the
+#: check saw 0.5 GiB held at 0.6.0, whose command had loaded numba and matplotlib to build its parser), and
+#: `fepen mesh` under 1300 MiB then ended in VTK's render with std::bad_alloc instead of this check's one line
+LIBRARIES_VM_BYTES = 0.85 * (1 << 30)
 #: the coarsest mesh.size, as a fraction of the calibre: two cells across the body (coarser, gmsh fails on the
 #: default body's 5.8 mm wall, or the cavity cannot be sized to the mass on the mesh)
 COARSEST = 0.5
@@ -106,6 +112,9 @@ def _check_room(room: tuple, size: float, cells: float, processes: int, coarsest
     rank 0 the whole mesh's cells (gmsh makes it there, and dolfinx distributes it from there). InputError
     naming mesh.size when a coarser mesh fits; MachineFault naming the limit when none does."""
     left, name, limit, held = room
+    if name == "ulimit -v" and held < LIBRARIES_VM_BYTES:  # the libraries still to load count against the limit
+        held = LIBRARIES_VM_BYTES
+        left = limit - held
     need = expected_bytes(cells, 1)
     if need <= left:
         return
@@ -114,7 +123,8 @@ def _check_room(room: tuple, size: float, cells: float, processes: int, coarsest
     whole = "the whole mesh on rank 0 while it is made" if processes > 1 else ""
     fits = size * (cells * CELL_BYTES / max(left - PROCESS_BYTES, 1.0)) ** (1.0 / 3.0)
     if left <= PROCESS_BYTES or fits > coarsest:
-        raise MachineFault(f"{what} is {limit / _MIB:.0f} MiB and this process already maps {held / _MIB:.0f} MiB: "
+        raise MachineFault(f"{what} is {limit / _MIB:.0f} MiB and this process maps {held / _MIB:.0f} MiB with its "
+                           f"libraries: "
                            f"a deformable run needs about {need / _MIB:.0f} MiB more per process before its first "
                            f"step ({cells:.3g} cells at mesh.size = {size:g} m{', ' + whole if whole else ''}): "
                            f"{raise_it} to at least {(held + need) / _MIB:.0f} MiB")
