@@ -23,15 +23,20 @@ CELLS_PER_SIZE3 = 5.5
 #: the graded nose's cells over the estimate below (measured: 7,100 more cells for a 0.5 mm tip at 2.5 mm, 1.9
 #: times the integral's 3,750)
 NOSE_MARGIN = 2.0
-#: memory before the first step: per process and per cell (bytes), the measured 0.53 GB (0.72 GB when gmsh
-#: meshes in the process: a 3 mm mesh built afresh) and 1.84 kB with a margin
-PROCESS_BYTES, CELL_BYTES = 0.8e9, 2.2e3
+#: a run's memory per process and per cell (bytes): the measured 0.53 GB (0.72 GB when gmsh meshes in the process:
+#: a 3 mm mesh built afresh; 0.26 GB before the closing figures, whose matplotlib and VTK take the rest; 0.86 and
+#: 0.87 GB in CI's system lane at fepen 0.7.0, twice, the figures' render the larger there) and 1.84 kB, with a margin
+PROCESS_BYTES, CELL_BYTES = 0.95e9, 2.2e3
 #: the address space a meshing and running process maps once its libraries are in (dolfinx, PETSc, numba, gmsh,
 #: matplotlib, pyvista and VTK: 0.85 GiB measured with fepen 0.7.0, Debian's stack). An address-space limit (ulimit
 #: -v) is checked against at least this much held: since fepen 0.7.0 a command loads them after the check (the
 #: check saw 0.5 GiB held at 0.6.0, whose command had loaded numba and matplotlib to build its parser), and
 #: `fepen mesh` under 1300 MiB then ended in VTK's render with std::bad_alloc instead of this check's one line
 LIBRARIES_VM_BYTES = 0.85 * (1 << 30)
+#: the address space a process maps beyond its libraries besides its cells' (the mesh's making, the solver, the
+#: closing pictures' VTK render): `fepen mesh` of 502 cells and its picture need 1,400 MiB in all, 0.52 GiB beyond
+#: the libraries (measured, fepen 0.7.0); with a margin
+RUN_VM_BYTES = 0.6 * (1 << 30)
 #: the coarsest mesh.size, as a fraction of the calibre: two cells across the body (coarser, gmsh fails on the
 #: default body's 5.8 mm wall, or the cavity cannot be sized to the mass on the mesh)
 COARSEST = 0.5
@@ -112,17 +117,20 @@ def _check_room(room: tuple, size: float, cells: float, processes: int, coarsest
     rank 0 the whole mesh's cells (gmsh makes it there, and dolfinx distributes it from there). InputError
     naming mesh.size when a coarser mesh fits; MachineFault naming the limit when none does."""
     left, name, limit, held = room
-    if name == "ulimit -v" and held < LIBRARIES_VM_BYTES:  # the libraries still to load count against the limit
-        held = LIBRARIES_VM_BYTES
-        left = limit - held
-    need = expected_bytes(cells, 1)
+    base = PROCESS_BYTES
+    if name == "ulimit -v":  # the address space: the libraries still to load count, then the run's own maps
+        if held < LIBRARIES_VM_BYTES:
+            held = LIBRARIES_VM_BYTES
+            left = limit - held
+        base = RUN_VM_BYTES
+    need = base + cells * CELL_BYTES
     if need <= left:
         return
     what = f"the {'address-space' if name == 'ulimit -v' else 'data'} limit {name}"
     raise_it = f"raise {name} (a batch system's h_vmem)" if name == "ulimit -v" else f"raise {name}"
     whole = "the whole mesh on rank 0 while it is made" if processes > 1 else ""
-    fits = size * (cells * CELL_BYTES / max(left - PROCESS_BYTES, 1.0)) ** (1.0 / 3.0)
-    if left <= PROCESS_BYTES or fits > coarsest:
+    fits = size * (cells * CELL_BYTES / max(left - base, 1.0)) ** (1.0 / 3.0)
+    if left <= base or fits > coarsest:
         raise MachineFault(f"{what} is {limit / _MIB:.0f} MiB and this process maps {held / _MIB:.0f} MiB with its "
                            f"libraries: "
                            f"a deformable run needs about {need / _MIB:.0f} MiB more per process before its first "

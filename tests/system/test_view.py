@@ -164,7 +164,9 @@ def test_the_paraview_picture_carries_the_title(run, tmp_path):
             "print('TITLE=' + FindSource('title').Text)\n")
     cmd = [XVFB, "-a", "-s", "-screen 0 1280x1024x24", PVPYTHON, "--force-offscreen-rendering", "-c", code,
            str(run / "view.py"), str(png), paraview.run_name(run)]
-    r = subprocess.run(cmd, capture_output=True, text=True, timeout=300)
+    # Python's copy of the environment, as fepen.post.paraview passes it: not the C environment, where this worker's
+    # MPI (once loaded) left PMIX_RANK and its server's address for pvpython's MPI to take as its own job's
+    r = subprocess.run(cmd, capture_output=True, text=True, timeout=300, env=dict(os.environ))
     assert r.returncode == 0, r.stderr[-1500:]
     assert f"TITLE={title}" in r.stdout.splitlines()
     assert png.is_file()
