@@ -19,6 +19,11 @@ import numpy as np
 import pytest
 from conftest import check_bad_input_line, run_fepen
 
+#: one worker for these and tests/system/test_paraview.py: both start pvpython under `xvfb-run -a`, whose choice of
+#: a free display races another xvfb-run started at the same moment (pvpython then aborts creating its window:
+#: twice in CI of issue 62, never alone)
+pytestmark = pytest.mark.xdist_group("test_paraview")
+
 PVPYTHON = shutil.which("pvpython")
 XVFB = shutil.which("xvfb-run")
 needs_paraview = pytest.mark.skipif(PVPYTHON is None or XVFB is None,
