@@ -24,8 +24,9 @@ from fepen.studies.study import Round, Study, register
 __all__ = ["Sweep", "SweepStudy", "SweepPlan", "read", "run", "table_rows", "write_table", "resized",
            "DISTRIBUTIONS", "MAX_SHOTS", "IMPACT", "monte_carlo", "measured_shot"]
 
-#: summary entries that describe the machine or the run's cost, not the shot (costs.csv holds some)
-MACHINE = ("wall_s", "time_split_s", "peak_memory_bytes", "ranks", "scene", "versions")
+#: summary entries that describe the machine or the run's cost, not the shot (costs.csv holds some; a deformable
+#: run's communication block depends on its ranks)
+MACHINE = ("wall_s", "time_split_s", "peak_memory_bytes", "ranks", "scene", "versions", "communication")
 #: what a sweep writes into its folder (fepen.io.rundir.study_directory)
 SWEEP_NAMES = ("sweep.json", "shots.jsonl", "shots", "sweep.csv", "costs.csv", "sweep.parquet", "sweep.md", "sweep.png",
                "histograms.png")
