@@ -25,7 +25,7 @@ ROOT = Path(__file__).resolve().parents[1]
 #: the two stacks' interpreters (make setup, make setup-current)
 STACKS = {"debian": ROOT / ".venv/bin/python", "current": ROOT / ".venv-current/bin/python"}
 #: summary keys that measure the machine or the software, not the shot
-VOLATILE = {"wall_s", "time_split_s", "peak_memory_bytes", "versions", "mesh_s", "interval"}
+VOLATILE = {"wall_s", "time_split_s", "peak_memory_bytes", "versions", "mesh_s", "interval", "communication"}
 
 
 def numbers(d, prefix: str = "") -> dict[str, float]:
